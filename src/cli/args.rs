@@ -1,0 +1,125 @@
+//! Argument groups shared by several subcommands.
+
+use clap::Args;
+use glam::DVec3;
+use mmbm::error::{Error, Result};
+use mmbm::{Camera, Plane};
+use std::path::PathBuf;
+
+/// Parses `X,Y,Z` into a vector.
+pub fn parse_vec3(s: &str) -> std::result::Result<DVec3, String> {
+    let v: Vec<f64> = s
+        .split(',')
+        .map(|x| x.trim().parse::<f64>())
+        .collect::<std::result::Result<_, _>>()
+        .map_err(|_| format!("'{s}': expected three comma-separated numbers, e.g. 0.1,-0.2,0"))?;
+    if v.len() != 3 {
+        return Err(format!(
+            "'{s}': expected three comma-separated numbers, got {}",
+            v.len()
+        ));
+    }
+    if v.iter().any(|x| !x.is_finite()) {
+        return Err(format!("'{s}': values must be finite"));
+    }
+    Ok(DVec3::new(v[0], v[1], v[2]))
+}
+
+/// Parses `NX,NY,NZ,D` into a plane.
+pub fn parse_plane(s: &str) -> std::result::Result<Plane, String> {
+    let v: Vec<f64> = s
+        .split(',')
+        .map(|x| x.trim().parse::<f64>())
+        .collect::<std::result::Result<_, _>>()
+        .map_err(|_| format!("'{s}': expected NX,NY,NZ,D (four numbers)"))?;
+    if v.len() != 4 || v.iter().any(|x| !x.is_finite()) {
+        return Err(format!("'{s}': expected NX,NY,NZ,D (four finite numbers)"));
+    }
+    Ok(Plane {
+        normal: DVec3::new(v[0], v[1], v[2]),
+        d: v[3],
+    })
+}
+
+/// Parses `WxH`.
+pub fn parse_resolution(s: &str) -> std::result::Result<(u32, u32), String> {
+    let (a, b) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("'{s}': expected WxH, e.g. 320x240"))?;
+    let w: u32 = a
+        .parse()
+        .map_err(|_| format!("'{s}': expected WxH, e.g. 320x240"))?;
+    let h: u32 = b
+        .parse()
+        .map_err(|_| format!("'{s}': expected WxH, e.g. 320x240"))?;
+    if w == 0 || h == 0 {
+        return Err(format!("'{s}': width and height must be positive"));
+    }
+    Ok((w, h))
+}
+
+/// Camera options (thesis camera by default).
+#[derive(Args, Debug, Clone)]
+pub struct CameraArgs {
+    /// Camera file (TOML or JSON: focal_mm, pitch_mm or pitch_x_mm/pitch_y_mm, width, height, [cx, cy, skew]).
+    #[arg(long, value_name = "FILE")]
+    pub camera: Option<PathBuf>,
+    /// Focal length, mm (overrides the camera file; thesis: 4.2548).
+    #[arg(long, value_name = "MM")]
+    pub focal: Option<f64>,
+    /// Square pixel pitch, mm (thesis: 0.00465).
+    #[arg(long, value_name = "MM")]
+    pub pitch: Option<f64>,
+    /// Sensor resolution WxH, principal point at the centre (thesis: 640x480).
+    #[arg(long, value_name = "WxH", value_parser = parse_resolution)]
+    pub sensor: Option<(u32, u32)>,
+}
+
+impl CameraArgs {
+    /// The camera these options describe, validated.
+    pub fn camera(&self) -> Result<Camera> {
+        let mut c = match &self.camera {
+            Some(p) => Camera::load(p)?,
+            None => Camera::thesis(),
+        };
+        if let Some(f) = self.focal {
+            c.focal_mm = f;
+        }
+        if let Some(p) = self.pitch {
+            c.pitch_x_mm = p;
+            c.pitch_y_mm = p;
+        }
+        if let Some((w, h)) = self.sensor {
+            c = c.with_resolution(w, h);
+        }
+        c.validate()?;
+        Ok(c)
+    }
+}
+
+/// Scene depth options.
+#[derive(Args, Debug, Clone)]
+pub struct SceneArgs {
+    /// Depth of a fronto-parallel scene plane, m (needed with translation).
+    #[arg(long, value_name = "Z", conflicts_with = "plane")]
+    pub depth: Option<f64>,
+    /// Tilted scene plane n.X = d in the camera frame (metres), e.g. 0,0.2,1,3.
+    #[arg(long, value_name = "NX,NY,NZ,D", value_parser = parse_plane, allow_hyphen_values = true)]
+    pub plane: Option<Plane>,
+}
+
+impl SceneArgs {
+    /// The plane, if any (depth must be positive and finite).
+    pub fn plane(&self) -> Result<Option<Plane>> {
+        if let Some(z) = self.depth {
+            if !(z.is_finite() && z > 0.0) {
+                return Err(Error::invalid(
+                    "--depth",
+                    format!("must be a positive number of metres, got {z}"),
+                ));
+            }
+            return Ok(Some(Plane::fronto(z)));
+        }
+        Ok(self.plane)
+    }
+}

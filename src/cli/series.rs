@@ -1,0 +1,101 @@
+//! `mmbm series`: MMBM for every gyro sample.
+
+use super::args::{CameraArgs, SceneArgs};
+use clap::Args;
+use mmbm::error::Result;
+use mmbm::gyro::{parse_rotation, AngleUnit, GyroOptions, GyroReader, TimeUnit};
+use mmbm::series::{self, SeriesOptions};
+use mmbm::{Method, Scene};
+use std::path::PathBuf;
+
+/// Options for reading a gyro log (shared by the commands that read one).
+#[derive(Args, Debug, Clone)]
+pub struct GyroArgs {
+    /// Unit of the `t` column: s, ms, us or ns.
+    #[arg(long, default_value = "s")]
+    pub time_unit: String,
+    /// Unit of wx, wy, wz: rad or deg (per second).
+    #[arg(long, default_value = "rad")]
+    pub angle_unit: String,
+    /// IMU-to-camera rotation, 9 numbers row-major (applied to w and v).
+    #[arg(long, value_name = "R11,...,R33", allow_hyphen_values = true)]
+    pub imu_rotation: Option<String>,
+    /// Added to every time stamp, s.
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    pub time_offset: f64,
+}
+
+impl GyroArgs {
+    pub fn options(&self) -> Result<GyroOptions> {
+        Ok(GyroOptions {
+            time_unit: self.time_unit.parse::<TimeUnit>()?,
+            angle_unit: self.angle_unit.parse::<AngleUnit>()?,
+            imu_to_camera: match &self.imu_rotation {
+                Some(s) => parse_rotation(s)?,
+                None => glam::DMat3::IDENTITY,
+            },
+            time_offset: mmbm::error::finite("--time-offset", self.time_offset)?,
+        })
+    }
+}
+
+/// MMBM for every gyro sample: CSV `t,mmbm_mm_s,mmbm_px_s`.
+#[derive(Args, Debug)]
+#[command(after_help = "Examples:
+  mmbm series --gyro ../shared/data/running_phone/gyro.csv --out mmbm.csv
+  mmbm series --gyro log.csv --time-unit ms --angle-unit deg --method gauss:4
+  mmbm series --gyro log.csv --use-velocity --depth 3 --method gpu:64x48")]
+pub struct SeriesArgs {
+    /// Gyro CSV: t,wx,wy,wz[,vx,vy,vz][,depth].
+    #[arg(long, value_name = "FILE")]
+    pub gyro: PathBuf,
+    /// riemann[:NUxNV], gauss[:N], exact[:TOL] or gpu[:WxH].
+    #[arg(long, default_value = "riemann:8x6")]
+    pub method: String,
+    /// Output CSV (default: stdout).
+    #[arg(long, value_name = "FILE")]
+    pub out: Option<PathBuf>,
+    /// Include the log's vx,vy,vz (needs a depth column, --depth or --plane).
+    #[arg(long)]
+    pub use_velocity: bool,
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    #[command(flatten)]
+    pub gyro_opts: GyroArgs,
+    #[command(flatten)]
+    pub camera: CameraArgs,
+}
+
+pub fn run(a: SeriesArgs) -> Result<()> {
+    let method: Method = a.method.parse()?;
+    let opts = SeriesOptions {
+        scene: Scene {
+            camera: a.camera.camera()?,
+            plane: a.scene.plane()?,
+        },
+        method,
+        use_velocity: a.use_velocity,
+    };
+    if let Some(p) = &opts.scene.plane {
+        p.validate_for(&opts.scene.camera)?;
+    }
+    let reader = GyroReader::open(&a.gyro, a.gyro_opts.options()?)?;
+    let mut eval: Box<series::BatchFn> = match method {
+        Method::Gpu { width, height } => mmbm::gpu::flow::series_evaluator(opts, width, height)?,
+        _ => Box::new(move |b: &[mmbm::gyro::GyroSample]| series::eval_batch_cpu(b, &opts)),
+    };
+    let pitch = opts.scene.camera.pitch_x_mm;
+    let n = match &a.out {
+        Some(p) => {
+            let mut n = 0;
+            mmbm::output::write_atomic(p, |w| {
+                n = series::run(reader, &mut eval, pitch, w)?;
+                Ok(())
+            })?;
+            n
+        }
+        None => series::run(reader, &mut eval, pitch, std::io::stdout().lock())?,
+    };
+    eprintln!("{n} samples, method {method}");
+    Ok(())
+}

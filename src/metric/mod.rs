@@ -1,0 +1,217 @@
+//! The MMBM metric (thesis eq. 3.11): the mean image-plane flow speed over the
+//! sensor, mm/s. Several methods behind one API:
+//!
+//! - [`Method::Riemann`]: midpoint rule on an `n_u x n_v` grid of equal cells
+//!   (thesis eq. 4.1, MMBM*; the thesis used 8 x 6);
+//! - [`Method::Gauss`]: tensor Gauss-Legendre, `n_u x n_v` nodes (a real-time rule);
+//! - [`Method::Exact`]: adaptive Gauss-Kronrod cubature to a relative tolerance,
+//!   with an error estimate;
+//! - [`Method::Gpu`]: full-resolution per-pixel field on the GPU (see `crate::gpu`).
+
+mod exact;
+mod grid;
+
+pub use exact::{exact, roll_mean_closed_form, ExactResult};
+pub use grid::{gauss, gauss_legendre, riemann, GridRule};
+
+use crate::camera::Camera;
+use crate::error::{Error, Result};
+use crate::flow::FlowPoly;
+use crate::motion::{Plane, Twist};
+use std::fmt;
+use std::str::FromStr;
+
+/// How MMBM is computed.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Method {
+    /// Midpoint grid of `nu x nv` cells (`riemann[:NUxNV]`, default 8x6).
+    Riemann { nu: u32, nv: u32 },
+    /// Tensor Gauss-Legendre with `nu x nv` nodes (`gauss[:N]` = N x N, or `gauss:NUxNV`).
+    Gauss { nu: u32, nv: u32 },
+    /// Adaptive cubature to relative tolerance `tol` (`exact[:TOL]`, default 1e-9).
+    Exact { tol: f64 },
+    /// Full field on the GPU at `width x height` samples (`gpu` = sensor resolution, or `gpu:WxH`).
+    Gpu { width: u32, height: u32 },
+}
+
+impl Default for Method {
+    fn default() -> Self {
+        Method::Riemann { nu: 8, nv: 6 }
+    }
+}
+
+fn parse_dims(s: &str, what: &str) -> Result<(u32, u32)> {
+    let bad = || {
+        Error::invalid(
+            "method",
+            format!("'{s}': expected {what} as NxM with positive integers, e.g. 8x6"),
+        )
+    };
+    let (a, b) = s.split_once(['x', 'X']).ok_or_else(bad)?;
+    let a: u32 = a.trim().parse().map_err(|_| bad())?;
+    let b: u32 = b.trim().parse().map_err(|_| bad())?;
+    if a == 0 || b == 0 {
+        return Err(bad());
+    }
+    Ok((a, b))
+}
+
+impl FromStr for Method {
+    type Err = Error;
+
+    /// Parses `riemann[:NUxNV]`, `gauss[:N|:NUxNV]`, `exact[:TOL]`, `gpu[:WxH]`.
+    fn from_str(s: &str) -> Result<Self> {
+        let (name, arg) = match s.split_once(':') {
+            Some((n, a)) => (n, Some(a)),
+            None => (s, None),
+        };
+        match (name.trim().to_ascii_lowercase().as_str(), arg) {
+            ("riemann", None) => Ok(Method::default()),
+            ("riemann", Some(a)) => {
+                let (nu, nv) = parse_dims(a, "grid")?;
+                Ok(Method::Riemann { nu, nv })
+            }
+            ("gauss", None) => Ok(Method::Gauss { nu: 4, nv: 3 }),
+            ("gauss", Some(a)) => {
+                if a.contains(['x', 'X']) {
+                    let (nu, nv) = parse_dims(a, "nodes")?;
+                    Ok(Method::Gauss { nu, nv })
+                } else {
+                    let n: u32 = a.trim().parse().ok().filter(|&n| n > 0).ok_or_else(|| {
+                        Error::invalid(
+                            "method",
+                            format!("'{s}': gauss:N needs a positive integer N"),
+                        )
+                    })?;
+                    Ok(Method::Gauss { nu: n, nv: n })
+                }
+            }
+            ("exact", None) => Ok(Method::Exact { tol: 1e-9 }),
+            ("exact", Some(a)) => {
+                let tol: f64 = a
+                    .trim()
+                    .parse()
+                    .ok()
+                    .filter(|t: &f64| *t > 0.0 && t.is_finite())
+                    .ok_or_else(|| {
+                        Error::invalid(
+                            "method",
+                            format!("'{s}': exact:TOL needs a positive tolerance, e.g. exact:1e-9"),
+                        )
+                    })?;
+                Ok(Method::Exact { tol })
+            }
+            ("gpu", None) => Ok(Method::Gpu {
+                width: 0,
+                height: 0,
+            }),
+            ("gpu", Some(a)) => {
+                let (width, height) = parse_dims(a, "grid")?;
+                Ok(Method::Gpu { width, height })
+            }
+            _ => Err(Error::invalid(
+                "method",
+                format!("'{s}': expected riemann[:NUxNV], gauss[:N], exact[:TOL] or gpu[:WxH]"),
+            )),
+        }
+    }
+}
+
+impl fmt::Display for Method {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match *self {
+            Method::Riemann { nu, nv } => write!(f, "riemann:{nu}x{nv}"),
+            Method::Gauss { nu, nv } => write!(f, "gauss:{nu}x{nv}"),
+            Method::Exact { tol } => write!(f, "exact:{tol:e}"),
+            Method::Gpu { width, .. } if width == 0 => write!(f, "gpu"),
+            Method::Gpu { width, height } => write!(f, "gpu:{width}x{height}"),
+        }
+    }
+}
+
+/// One MMBM value.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Mmbm {
+    /// Mean flow speed over the sensor, mm/s.
+    pub mm_s: f64,
+    /// Same in pixels per second (`mm_s / pitch_x`).
+    pub px_s: f64,
+    /// Error estimate (mm/s), for the exact method.
+    pub error_estimate: Option<f64>,
+    /// Number of integrand evaluations used.
+    pub evaluations: u64,
+}
+
+/// The scene and camera an MMBM value is computed for.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Scene {
+    /// Camera intrinsics.
+    pub camera: Camera,
+    /// Scene plane; required when the twist has translation.
+    pub plane: Option<Plane>,
+}
+
+impl Scene {
+    /// Thesis camera, no plane (rotation-only).
+    pub fn thesis() -> Self {
+        Scene {
+            camera: Camera::thesis(),
+            plane: None,
+        }
+    }
+
+    /// Validates the camera, the plane and that a plane exists when `tw` translates.
+    pub fn validate_for(&self, tw: &Twist) -> Result<()> {
+        self.camera.validate()?;
+        tw.validate()?;
+        match &self.plane {
+            Some(p) => p.validate_for(&self.camera),
+            None if !tw.is_rotation_only() => Err(Error::invalid(
+                "depth",
+                "the twist has a linear velocity, so a scene depth (--depth Z) or plane (--plane) is required",
+            )),
+            None => Ok(()),
+        }
+    }
+
+    /// The flow polynomial for twist `tw` in this scene.
+    pub fn flow_poly(&self, tw: &Twist) -> FlowPoly {
+        FlowPoly::new(self.camera.focal_mm, tw, self.plane.as_ref())
+    }
+}
+
+/// Computes MMBM with a CPU method. Validates inputs first. `Method::Gpu` is
+/// rejected here: use [`crate::gpu::flow::GpuFlow`].
+pub fn mmbm(scene: &Scene, tw: &Twist, method: Method) -> Result<Mmbm> {
+    scene.validate_for(tw)?;
+    let poly = scene.flow_poly(tw);
+    mmbm_poly(&scene.camera, &poly, method)
+}
+
+/// MMBM of a pre-expanded flow polynomial (no validation; the hot path).
+pub fn mmbm_poly(cam: &Camera, poly: &FlowPoly, method: Method) -> Result<Mmbm> {
+    let rect = cam.sensor_rect();
+    let (mm_s, err, evals) = match method {
+        Method::Riemann { nu, nv } => (riemann(poly, &rect, nu, nv), None, (nu * nv) as u64),
+        Method::Gauss { nu, nv } => (gauss(poly, &rect, nu, nv), None, (nu * nv) as u64),
+        Method::Exact { tol } => {
+            let r = exact(poly, &rect, tol);
+            (r.value, Some(r.error), r.evaluations)
+        }
+        Method::Gpu { .. } => {
+            return Err(Error::invalid(
+                "method",
+                "gpu is evaluated by crate::gpu, not by the CPU metric",
+            ))
+        }
+    };
+    Ok(Mmbm {
+        mm_s,
+        px_s: mm_s / cam.pitch_x_mm,
+        error_estimate: err,
+        evaluations: evals,
+    })
+}
+
+#[cfg(test)]
+mod tests;
