@@ -9,17 +9,23 @@
 //! angular velocity rad/s, linear velocity m/s, depth m, time s. The metric is
 //! in mm/s on the sensor (also px/s). Camera frame: x right, y down, z forward.
 
+pub mod assess;
+pub mod blobs;
 pub mod camera;
 pub mod error;
 pub mod flow;
 pub mod gpu;
 pub mod gyro;
+pub mod imageio;
 pub mod metric;
 pub mod motion;
 pub mod output;
 pub mod plot;
+pub mod render;
 pub mod series;
+pub mod sim;
 pub mod tables;
+pub mod trigger;
 
 pub use camera::Camera;
 pub use error::{Error, Result};

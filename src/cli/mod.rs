@@ -1,11 +1,19 @@
 //! Command-line parsing (clap derive) and dispatch to the subcommands.
 
 mod args;
+mod assess;
 mod bench;
+mod blobs;
+mod demo;
 mod eval;
+mod experiment;
+mod flow;
 mod info;
+mod render;
 mod series;
+mod simulate;
 mod tables;
+mod trigger;
 
 use clap::{Parser, Subcommand};
 
@@ -37,6 +45,22 @@ enum Command {
     Info,
     /// Measure throughput of the metric methods (and GPU kernels).
     Bench(bench::BenchArgs),
+    /// Per-pixel flow field at sensor resolution on the GPU (EXR, optional quiver PNG).
+    Flow(flow::FlowArgs),
+    /// Render a ground-truth motion-blurred image of a planar target.
+    Render(render::RenderArgs),
+    /// Simulate a legged gait: a seeded gyro log.
+    Simulate(simulate::SimulateArgs),
+    /// Run a trigger policy on a gyro log.
+    Trigger(trigger::TriggerArgs),
+    /// Image blur metrics (JNBM, CPBD, blur effect, Laplacian variance).
+    Assess(assess::AssessArgs),
+    /// Extract the 16 red blobs of the thesis target from an image.
+    Blobs(blobs::BlobsArgs),
+    /// The thesis experiment from a config: walk, triggers, rendered frames, report.
+    Experiment(experiment::ExperimentArgs),
+    /// The experiment with built-in defaults (the README's first command).
+    Demo(demo::DemoArgs),
 }
 
 /// Parses arguments, runs, prints errors; returns the exit code.
@@ -48,6 +72,14 @@ pub fn main() -> i32 {
         Command::Tables(a) => tables::run(a),
         Command::Info => info::run(),
         Command::Bench(a) => bench::run(a),
+        Command::Flow(a) => flow::run(a),
+        Command::Render(a) => render::run(a),
+        Command::Simulate(a) => simulate::run(a),
+        Command::Trigger(a) => trigger::run(a),
+        Command::Assess(a) => assess::run(a),
+        Command::Blobs(a) => blobs::run(a),
+        Command::Experiment(a) => experiment::run(a),
+        Command::Demo(a) => demo::run(a),
     };
     match r {
         Ok(()) => 0,

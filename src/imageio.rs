@@ -1,0 +1,157 @@
+//! Image files: float EXR with named channels, sRGB PNG from linear values,
+//! and reading textures. All writes are atomic (temp file + rename).
+
+use crate::error::{Error, Result};
+use crate::output::write_atomic_path;
+use exr::prelude::*;
+use std::path::Path;
+
+/// Writes a float EXR with the given named channels (`width * height` values
+/// each, row-major, top row first). Channel names may contain dots (`flow.u`).
+pub fn write_exr(
+    path: &Path,
+    width: usize,
+    height: usize,
+    channels: &[(&str, &[f32])],
+) -> Result<()> {
+    for (name, data) in channels {
+        if data.len() != width * height {
+            return Err(Error::invalid(
+                "EXR channel",
+                format!(
+                    "'{name}' has {} values, expected {width}x{height}",
+                    data.len()
+                ),
+            ));
+        }
+    }
+    let list: Vec<AnyChannel<FlatSamples>> = channels
+        .iter()
+        .map(|(name, data)| AnyChannel::new(*name, FlatSamples::F32(data.to_vec())))
+        .collect();
+    let layer = Layer::new(
+        (width, height),
+        LayerAttributes::default(),
+        Encoding::SMALL_LOSSLESS,
+        AnyChannels::sort(list.into()),
+    );
+    let image = exr::image::Image::from_layer(layer);
+    write_atomic_path(path, |tmp| {
+        image.write().to_file(tmp).map_err(|e| Error::Image {
+            path: path.into(),
+            message: e.to_string(),
+        })
+    })
+}
+
+/// Reads every f32 (or f16, converted) channel of the first layer of an EXR:
+/// `(width, height, [(name, values)])`.
+pub fn read_exr(path: &Path) -> Result<(usize, usize, Vec<(String, Vec<f32>)>)> {
+    let img = read_all_flat_layers_from_file(path).map_err(|e| Error::Image {
+        path: path.into(),
+        message: e.to_string(),
+    })?;
+    let layer = img.layer_data.first().ok_or_else(|| Error::Image {
+        path: path.into(),
+        message: "no layers".into(),
+    })?;
+    let (w, h) = (layer.size.width(), layer.size.height());
+    let chans = layer
+        .channel_data
+        .list
+        .iter()
+        .map(|c| {
+            let v: Vec<f32> = c.sample_data.values_as_f32().collect();
+            (c.name.to_string(), v)
+        })
+        .collect();
+    Ok((w, h, chans))
+}
+
+/// Linear light (0..1) to 8-bit sRGB.
+pub fn linear_to_srgb8(x: f32) -> u8 {
+    let x = x.clamp(0.0, 1.0);
+    let s = if x <= 0.003_130_8 {
+        12.92 * x
+    } else {
+        1.055 * x.powf(1.0 / 2.4) - 0.055
+    };
+    (s * 255.0 + 0.5) as u8
+}
+
+/// 8-bit sRGB to linear light (0..1).
+pub fn srgb8_to_linear(v: u8) -> f32 {
+    let s = v as f32 / 255.0;
+    if s <= 0.040_45 {
+        s / 12.92
+    } else {
+        ((s + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+/// Saves an RGB8 (or any `image`-supported) buffer as PNG/JPEG by extension, atomically.
+pub fn save_rgb8(path: &Path, img: &image::RgbImage) -> Result<()> {
+    let format = image::ImageFormat::from_path(path).map_err(|e| Error::Image {
+        path: path.into(),
+        message: e.to_string(),
+    })?;
+    write_atomic_path(path, |tmp| {
+        img.save_with_format(tmp, format).map_err(|e| Error::Image {
+            path: path.into(),
+            message: e.to_string(),
+        })
+    })
+}
+
+/// Writes linear RGB (interleaved, 0..1) as an sRGB 8-bit PNG.
+pub fn write_png_linear_rgb(path: &Path, width: u32, height: u32, rgb: &[f32]) -> Result<()> {
+    let bytes: Vec<u8> = rgb.iter().map(|&x| linear_to_srgb8(x)).collect();
+    let img = image::RgbImage::from_raw(width, height, bytes).ok_or_else(|| {
+        Error::invalid(
+            "PNG",
+            format!(
+                "{} values do not make a {width}x{height} RGB image",
+                rgb.len()
+            ),
+        )
+    })?;
+    save_rgb8(path, &img)
+}
+
+/// Reads any PNG/JPEG as RGB8, naming the file in errors.
+pub fn read_rgb8(path: &Path) -> Result<image::RgbImage> {
+    let r = image::ImageReader::open(path).map_err(|e| Error::io(path, e))?;
+    let r = r.with_guessed_format().map_err(|e| Error::io(path, e))?;
+    Ok(r.decode()
+        .map_err(|e| Error::Image {
+            path: path.into(),
+            message: e.to_string(),
+        })?
+        .to_rgb8())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn exr_round_trip_and_srgb() {
+        let d = tempfile::tempdir().unwrap();
+        let p = d.path().join("x.exr");
+        let a: Vec<f32> = (0..12).map(|i| i as f32 * 0.5).collect();
+        let b: Vec<f32> = (0..12).map(|i| -(i as f32)).collect();
+        write_exr(&p, 4, 3, &[("flow.u", &a), ("flow.v", &b)]).unwrap();
+        let (w, h, ch) = read_exr(&p).unwrap();
+        assert_eq!((w, h), (4, 3));
+        let u = &ch.iter().find(|c| c.0 == "flow.u").unwrap().1;
+        assert_eq!(u, &a);
+        assert!(write_exr(&p, 5, 3, &[("x", &a)]).is_err());
+        for v in [0u8, 1, 10, 100, 200, 255] {
+            assert_eq!(linear_to_srgb8(srgb8_to_linear(v)), v);
+        }
+        assert!(read_rgb8(&d.path().join("missing.png"))
+            .unwrap_err()
+            .to_string()
+            .contains("missing.png"));
+    }
+}
