@@ -3,7 +3,7 @@
 
 use crate::error::{Error, Result};
 use crate::gyro::{GyroReader, GyroSample};
-use crate::metric::{mmbm_poly, Method, Scene};
+use crate::metric::{Evaluator, Method, Scene};
 use crate::motion::{Plane, Twist};
 use rayon::prelude::*;
 use std::io::Write;
@@ -46,6 +46,7 @@ pub fn sample_scene(s: &GyroSample, opts: &SeriesOptions) -> Result<(Twist, Opti
 
 /// Evaluates a batch of samples on the CPU (rayon), mm/s per sample.
 pub fn eval_batch_cpu(batch: &[GyroSample], opts: &SeriesOptions) -> Result<Vec<f64>> {
+    let ev = Evaluator::new(&opts.scene.camera, opts.method)?;
     batch
         .par_iter()
         .with_min_len(1024)
@@ -60,7 +61,7 @@ pub fn eval_batch_cpu(batch: &[GyroSample], opts: &SeriesOptions) -> Result<Vec<
                     Error::invalid(format!("sample at t = {} s", s.t), e.to_string())
                 })?;
             }
-            Ok(mmbm_poly(&scene.camera, &scene.flow_poly(&tw), opts.method)?.mm_s)
+            Ok(ev.mean_speed(&scene.flow_poly(&tw)))
         })
         .collect()
 }

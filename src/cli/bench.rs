@@ -2,7 +2,7 @@
 
 use clap::Args;
 use mmbm::error::Result;
-use mmbm::metric::{mmbm_poly, Method};
+use mmbm::metric::{Evaluator, Method};
 use mmbm::{Scene, Twist};
 use std::hint::black_box;
 use std::time::Instant;
@@ -68,9 +68,10 @@ fn metric() -> Result<()> {
         } else {
             polys.len()
         };
+        let ev = Evaluator::new(&s.camera, m)?;
         let per = time_per_call(1.0, || {
             for p in &polys[..n] {
-                black_box(mmbm_poly(&s.camera, black_box(p), m).unwrap());
+                black_box(ev.mean_speed(black_box(p)));
             }
         }) / n as f64;
         // Flow expansion included (what series does per sample).
@@ -81,9 +82,10 @@ fn metric() -> Result<()> {
             1e-6 / per
         );
     }
+    let ev = Evaluator::new(&s.camera, Method::default())?;
     let per = time_per_call(1.0, || {
         for t in &tws {
-            black_box(mmbm_poly(&s.camera, &s.flow_poly(black_box(t)), Method::default()).unwrap());
+            black_box(ev.mean_speed(&s.flow_poly(black_box(t))));
         }
     }) / tws.len() as f64;
     println!(

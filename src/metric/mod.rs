@@ -213,5 +213,54 @@ pub fn mmbm_poly(cam: &Camera, poly: &FlowPoly, method: Method) -> Result<Mmbm> 
     })
 }
 
+/// A prepared CPU method for many evaluations with one camera: the grid rules
+/// are built once (structure-of-arrays, vectorised), which is what `series`
+/// and the trigger policies use per gyro sample.
+#[derive(Debug, Clone)]
+pub struct Evaluator {
+    camera: Camera,
+    method: Method,
+    rule: Option<GridRule>,
+}
+
+impl Evaluator {
+    /// Prepares `method` for `camera` (`Method::Gpu` is rejected).
+    pub fn new(camera: &Camera, method: Method) -> Result<Self> {
+        camera.validate()?;
+        let r = camera.sensor_rect();
+        let rule = match method {
+            Method::Riemann { nu, nv } => Some(GridRule::riemann(&r, nu, nv)),
+            Method::Gauss { nu, nv } => Some(GridRule::gauss(&r, nu, nv)),
+            Method::Exact { .. } => None,
+            Method::Gpu { .. } => {
+                return Err(Error::invalid(
+                    "method",
+                    "gpu is evaluated by crate::gpu, not by the CPU metric",
+                ))
+            }
+        };
+        Ok(Evaluator {
+            camera: *camera,
+            method,
+            rule,
+        })
+    }
+
+    /// MMBM, mm/s, of a flow polynomial.
+    #[inline]
+    pub fn mean_speed(&self, poly: &FlowPoly) -> f64 {
+        match (&self.rule, self.method) {
+            (Some(rule), _) => rule.mean_speed(poly),
+            (None, Method::Exact { tol }) => exact(poly, &self.camera.sensor_rect(), tol).value,
+            _ => unreachable!("Evaluator::new accepts only CPU methods"),
+        }
+    }
+
+    /// The camera.
+    pub fn camera(&self) -> &Camera {
+        &self.camera
+    }
+}
+
 #[cfg(test)]
 mod tests;
