@@ -101,7 +101,12 @@ impl CameraArgs {
 #[derive(Args, Debug, Clone)]
 pub struct SceneArgs {
     /// Depth of a fronto-parallel scene plane, m (needed with translation).
-    #[arg(long, value_name = "Z", conflicts_with = "plane")]
+    #[arg(
+        long,
+        value_name = "Z",
+        conflicts_with = "plane",
+        allow_hyphen_values = true
+    )]
     pub depth: Option<f64>,
     /// Tilted scene plane n.X = d in the camera frame (metres), e.g. 0,0.2,1,3.
     #[arg(long, value_name = "NX,NY,NZ,D", value_parser = parse_plane, allow_hyphen_values = true)]
