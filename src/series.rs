@@ -70,28 +70,62 @@ pub fn eval_batch_cpu(batch: &[GyroSample], opts: &SeriesOptions) -> Result<Vec<
 pub type BatchFn<'a> = dyn FnMut(&[GyroSample]) -> Result<Vec<f64>> + 'a;
 
 /// Streams `reader` through `eval` in batches of [`BATCH`] and writes the CSV.
-/// Returns the number of samples.
+/// Parsing runs on a second thread, overlapped with evaluation and
+/// formatting (shortest round-trip floats via `ryu`). Returns the number of samples.
 pub fn run<W: Write>(reader: GyroReader, eval: &mut BatchFn, pitch_mm: f64, out: W) -> Result<u64> {
     let mut out = std::io::BufWriter::with_capacity(1 << 16, out);
     let werr = |e: std::io::Error| Error::io("<series output>", e);
     out.write_all(b"t,mmbm_mm_s,mmbm_px_s\n").map_err(werr)?;
-    let mut batch = Vec::with_capacity(BATCH);
-    let mut n = 0;
-    let mut reader = reader.peekable();
-    let mut buf = Vec::with_capacity(64);
-    while reader.peek().is_some() {
-        batch.clear();
-        for s in reader.by_ref().take(BATCH) {
-            batch.push(s?);
+    let (tx, rx) = std::sync::mpsc::sync_channel::<Result<Vec<GyroSample>>>(2);
+    std::thread::scope(|scope| {
+        scope.spawn(move || {
+            let mut reader = reader;
+            loop {
+                let mut batch = Vec::with_capacity(BATCH);
+                let mut failed = None;
+                for s in reader.by_ref().take(BATCH) {
+                    match s {
+                        Ok(s) => batch.push(s),
+                        Err(e) => {
+                            failed = Some(e);
+                            break;
+                        }
+                    }
+                }
+                let done = batch.len() < BATCH || failed.is_some();
+                let msg = match failed {
+                    Some(e) => Err(e),
+                    None => Ok(batch),
+                };
+                // A closed channel means the consumer failed: just stop.
+                if tx.send(msg).is_err() || done {
+                    return;
+                }
+            }
+        });
+        let mut n = 0;
+        let (mut a, mut b, mut c) = (ryu::Buffer::new(), ryu::Buffer::new(), ryu::Buffer::new());
+        for batch in rx {
+            let batch = batch?;
+            if batch.is_empty() {
+                break;
+            }
+            let vals = eval(&batch)?;
+            for (s, m) in batch.iter().zip(&vals) {
+                for (i, x) in [a.format(s.t), b.format(*m), c.format(m / pitch_mm)]
+                    .iter()
+                    .enumerate()
+                {
+                    if i > 0 {
+                        out.write_all(b",").map_err(werr)?;
+                    }
+                    out.write_all(x.as_bytes()).map_err(werr)?;
+                }
+                out.write_all(b"\n").map_err(werr)?;
+            }
+            n += batch.len() as u64;
         }
-        let vals = eval(&batch)?;
-        for (s, m) in batch.iter().zip(&vals) {
-            buf.clear();
-            write!(buf, "{},{},{}\n", s.t, m, m / pitch_mm).map_err(werr)?;
-            out.write_all(&buf).map_err(werr)?;
-        }
-        n += batch.len() as u64;
-    }
-    out.flush().map_err(werr)?;
-    Ok(n)
+        out.flush().map_err(werr)?;
+        Ok(n)
+    })
 }
