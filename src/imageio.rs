@@ -44,9 +44,12 @@ pub fn write_exr(
     })
 }
 
+/// Named channels of an EXR layer: `(name, values)`, row-major.
+pub type ExrChannels = Vec<(String, Vec<f32>)>;
+
 /// Reads every f32 (or f16, converted) channel of the first layer of an EXR:
 /// `(width, height, [(name, values)])`.
-pub fn read_exr(path: &Path) -> Result<(usize, usize, Vec<(String, Vec<f32>)>)> {
+pub fn read_exr(path: &Path) -> Result<(usize, usize, ExrChannels)> {
     let img = read_all_flat_layers_from_file(path).map_err(|e| Error::Image {
         path: path.into(),
         message: e.to_string(),

@@ -123,7 +123,7 @@ impl fmt::Display for Method {
             Method::Riemann { nu, nv } => write!(f, "riemann:{nu}x{nv}"),
             Method::Gauss { nu, nv } => write!(f, "gauss:{nu}x{nv}"),
             Method::Exact { tol } => write!(f, "exact:{tol:e}"),
-            Method::Gpu { width, .. } if width == 0 => write!(f, "gpu"),
+            Method::Gpu { width: 0, .. } => write!(f, "gpu"),
             Method::Gpu { width, height } => write!(f, "gpu:{width}x{height}"),
         }
     }
