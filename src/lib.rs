@@ -13,6 +13,7 @@ pub mod assess;
 pub mod blobs;
 pub mod camera;
 pub mod error;
+pub mod experiment;
 pub mod flow;
 pub mod gpu;
 pub mod gyro;

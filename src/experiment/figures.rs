@@ -1,0 +1,175 @@
+//! Report figures: the MMBM trace with trigger instants and shaded exposures
+//! (thesis Figs. 5.2 and 5.6), blur histograms per policy, and a side-by-side
+//! montage of frames.
+
+use crate::error::Result;
+use crate::imageio::{linear_to_srgb8, save_rgb8};
+use crate::output::write_atomic_path;
+use crate::plot::{ensure_font, plot_error};
+use plotters::prelude::*;
+use std::path::Path;
+
+/// One exposure to shade on the trace: `(trigger_t, exposure_start, exposure_end)`, s.
+pub type Exposure = (f64, f64, f64);
+
+/// MMBM trace (mm/s) over `[t0, t1]` with a horizontal threshold line (if
+/// any), crosses at trigger instants and shaded exposures.
+pub fn mmbm_trace(
+    path: &Path,
+    title: &str,
+    t: &[f64],
+    mmbm: &[f64],
+    window: (f64, f64),
+    exposures: &[Exposure],
+    threshold: Option<f64>,
+) -> Result<()> {
+    ensure_font();
+    write_atomic_path(path, |tmp| {
+        let e = plot_error(path);
+        let root = BitMapBackend::new(tmp, (1000, 400)).into_drawing_area();
+        root.fill(&WHITE).map_err(&e)?;
+        let (t0, t1) = window;
+        let ymax = t
+            .iter()
+            .zip(mmbm)
+            .filter(|(x, _)| **x >= t0 && **x <= t1)
+            .map(|(_, y)| *y)
+            .fold(0.1, f64::max)
+            * 1.1;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, ("sans-serif", 20))
+            .margin(10)
+            .x_label_area_size(40)
+            .y_label_area_size(55)
+            .build_cartesian_2d(t0..t1, 0.0..ymax)
+            .map_err(&e)?;
+        chart
+            .configure_mesh()
+            .x_desc("time (s)")
+            .y_desc("MMBM (mm/s)")
+            .label_style(("sans-serif", 13))
+            .draw()
+            .map_err(&e)?;
+        let shade = RGBColor(120, 170, 255).mix(0.35);
+        chart
+            .draw_series(
+                exposures
+                    .iter()
+                    .filter(|x| x.2 >= t0 && x.1 <= t1)
+                    .map(|&(_, s, en)| Rectangle::new([(s.max(t0), 0.0), (en.min(t1), ymax)], shade.filled())),
+            )
+            .map_err(&e)?;
+        let pts: Vec<(f64, f64)> = t
+            .iter()
+            .zip(mmbm)
+            .filter(|(x, _)| **x >= t0 && **x <= t1)
+            .map(|(x, y)| (*x, *y))
+            .collect();
+        chart.draw_series(LineSeries::new(pts.clone(), BLUE.stroke_width(1))).map_err(&e)?;
+        if let Some(th) = threshold {
+            chart
+                .draw_series(LineSeries::new(vec![(t0, th), (t1, th)], RED.stroke_width(1)))
+                .map_err(&e)?;
+        }
+        let at = |x: f64| {
+            let i = t.partition_point(|&v| v < x).min(t.len().saturating_sub(1));
+            mmbm.get(i).copied().unwrap_or(0.0)
+        };
+        chart
+            .draw_series(
+                exposures
+                    .iter()
+                    .filter(|x| x.0 >= t0 && x.0 <= t1)
+                    .map(|&(tr, _, _)| Cross::new((tr, at(tr)), 5, BLACK.stroke_width(2))),
+            )
+            .map_err(&e)?;
+        root.present().map_err(&e)?;
+        Ok(())
+    })
+}
+
+/// Overlaid histograms of per-frame blur (px), one colour per series.
+pub fn blur_histograms(path: &Path, series: &[(String, Vec<f64>)]) -> Result<()> {
+    ensure_font();
+    write_atomic_path(path, |tmp| {
+        let e = plot_error(path);
+        let root = BitMapBackend::new(tmp, (900, 500)).into_drawing_area();
+        root.fill(&WHITE).map_err(&e)?;
+        let xmax = series
+            .iter()
+            .flat_map(|s| s.1.iter().copied())
+            .fold(1.0, f64::max)
+            * 1.05;
+        let nb = 30usize;
+        let bw = xmax / nb as f64;
+        let hist = |v: &[f64]| {
+            let mut h = vec![0.0; nb];
+            for &x in v {
+                h[((x / bw) as usize).min(nb - 1)] += 1.0 / v.len().max(1) as f64;
+            }
+            h
+        };
+        let hs: Vec<Vec<f64>> = series.iter().map(|s| hist(&s.1)).collect();
+        let ymax = hs.iter().flatten().copied().fold(0.05, f64::max) * 1.1;
+        let mut chart = ChartBuilder::on(&root)
+            .caption("Ground-truth blur per frame (mean path length, px)", ("sans-serif", 20))
+            .margin(10)
+            .x_label_area_size(40)
+            .y_label_area_size(55)
+            .build_cartesian_2d(0.0..xmax, 0.0..ymax)
+            .map_err(&e)?;
+        chart
+            .configure_mesh()
+            .x_desc("blur (px)")
+            .y_desc("share of frames")
+            .label_style(("sans-serif", 13))
+            .draw()
+            .map_err(&e)?;
+        for (k, ((name, _), h)) in series.iter().zip(&hs).enumerate() {
+            let c = Palette99::pick(k).to_rgba();
+            let pts: Vec<(f64, f64)> = h
+                .iter()
+                .enumerate()
+                .flat_map(|(i, &y)| [(i as f64 * bw, y), ((i + 1) as f64 * bw, y)])
+                .collect();
+            chart
+                .draw_series(LineSeries::new(pts, c.stroke_width(2)))
+                .map_err(&e)?
+                .label(name.clone())
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2)));
+        }
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.8))
+            .border_style(BLACK)
+            .label_font(("sans-serif", 14))
+            .draw()
+            .map_err(&e)?;
+        root.present().map_err(&e)?;
+        Ok(())
+    })
+}
+
+/// Places linear-RGB images (same size, interleaved) in a grid of `cols`
+/// columns with a 4-px grey gutter and saves the sRGB montage.
+pub fn montage(path: &Path, width: u32, height: u32, images: &[&[f32]], cols: u32) -> Result<()> {
+    let cols = cols.max(1);
+    let rows = (images.len() as u32).div_ceil(cols).max(1);
+    let g = 4;
+    let (w, h) = (cols * (width + g) + g, rows * (height + g) + g);
+    let mut out = image::RgbImage::from_pixel(w, h, image::Rgb([128, 128, 128]));
+    for (k, img) in images.iter().enumerate() {
+        let (cx, cy) = (k as u32 % cols, k as u32 / cols);
+        let (x0, y0) = (g + cx * (width + g), g + cy * (height + g));
+        for y in 0..height {
+            for x in 0..width {
+                let i = ((y * width + x) * 3) as usize;
+                if i + 2 < img.len() {
+                    let px = [linear_to_srgb8(img[i]), linear_to_srgb8(img[i + 1]), linear_to_srgb8(img[i + 2])];
+                    out.put_pixel(x0 + x, y0 + y, image::Rgb(px));
+                }
+            }
+        }
+    }
+    save_rgb8(path, &out)
+}

@@ -1,0 +1,3 @@
+//! The thesis experiment end to end (being built).
+
+pub mod figures;
