@@ -4,8 +4,13 @@ use std::path::Path;
 
 fn validate(path: &Path) -> Result<(), String> {
     let src = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
-    let module = naga::front::wgsl::parse_str(&src)
-        .map_err(|e| format!("{}: parse error:\n{}", path.display(), e.emit_to_string(&src)))?;
+    let module = naga::front::wgsl::parse_str(&src).map_err(|e| {
+        format!(
+            "{}: parse error:\n{}",
+            path.display(),
+            e.emit_to_string(&src)
+        )
+    })?;
     naga::valid::Validator::new(
         naga::valid::ValidationFlags::all(),
         naga::valid::Capabilities::all(),

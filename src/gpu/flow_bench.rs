@@ -52,8 +52,13 @@ pub fn run() -> Result<()> {
     let all = pool(cores)?;
     let base = Camera::thesis();
     let tw = bench_twists(1, base.focal_mm)[0];
-    println!("GPU flow kernels on {}; CPU twin (f32) on 1 and {cores} threads", gpu.adapter());
-    println!("times in ms per field (mean speed reduced; GPU: kernel + readback of the partial sums)");
+    println!(
+        "GPU flow kernels on {}; CPU twin (f32) on 1 and {cores} threads",
+        gpu.adapter()
+    );
+    println!(
+        "times in ms per field (mean speed reduced; GPU: kernel + readback of the partial sums)"
+    );
     println!(
         "{:<11} {:>10} {:>14} {:>12} {:>12} {:>12}",
         "resolution", "GPU field", "GPU +readback", "GPU mean", "CPU 1 thr", "CPU all"

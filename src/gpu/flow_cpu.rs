@@ -115,7 +115,13 @@ pub fn batch_means(grid: &Grid, twists: &[TwistGpu]) -> Vec<f64> {
     let n = grid.len() as f64;
     twists
         .par_iter()
-        .map(|tw| rows_per_twist(&p, tw).iter().map(|&x| x as f64).sum::<f64>() / n)
+        .map(|tw| {
+            rows_per_twist(&p, tw)
+                .iter()
+                .map(|&x| x as f64)
+                .sum::<f64>()
+                / n
+        })
         .collect()
 }
 

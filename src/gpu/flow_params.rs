@@ -200,7 +200,10 @@ mod tests {
         assert_eq!((g.width, g.height, g.len()), (640, 480, 307_200));
         assert_eq!(g.tiles(), 150);
         let p = Grid::new(&cam, 8, 6).unwrap().params(3, false);
-        assert_eq!((p.step_x, p.step_y, p.tiles, p.n_twists), (80.0, 80.0, 1, 3));
+        assert_eq!(
+            (p.step_x, p.step_y, p.tiles, p.n_twists),
+            (80.0, 80.0, 1, 3)
+        );
         assert!(Grid::new(&cam, 0, 6).is_err());
         assert!(Grid::new(&cam, 100_000, 100_000).is_err());
     }

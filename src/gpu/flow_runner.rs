@@ -129,7 +129,7 @@ fn ensure<'a>(
             lim.max_storage_buffer_binding_size.min(lim.max_buffer_size) as f64 / 1048576.0
         )));
     }
-    if slot.as_ref().is_none_or(|b| b.size < size) {
+    if !matches!(slot, Some(b) if b.size >= size) {
         *slot = None;
         let scope = ctx.device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
         let buf = ctx.device.create_buffer(&wgpu::BufferDescriptor {
@@ -139,7 +139,9 @@ fn ensure<'a>(
             mapped_at_creation: false,
         });
         if let Some(e) = pollster::block_on(scope.pop()) {
-            return Err(Error::Gpu(format!("allocating {label} ({size} bytes): {e}")));
+            return Err(Error::Gpu(format!(
+                "allocating {label} ({size} bytes): {e}"
+            )));
         }
         *slot = Some(Buf { buf, size });
     }
@@ -220,12 +222,36 @@ impl FlowRunner {
         let tw_bytes: &[u8] = bytemuck::cast_slice(twists);
         let pbytes = n_partials * 4;
         let fbytes = field_len * 8;
-        ensure(ctx, &mut self.twists, tw_bytes.len() as u64, STORAGE_DST, "flow twists")?;
-        ensure(ctx, &mut self.partials, pbytes, STORAGE_SRC, "flow partial sums")?;
-        ensure(ctx, &mut self.partials_read, pbytes, READ, "flow partials readback")?;
+        ensure(
+            ctx,
+            &mut self.twists,
+            tw_bytes.len() as u64,
+            STORAGE_DST,
+            "flow twists",
+        )?;
+        ensure(
+            ctx,
+            &mut self.partials,
+            pbytes,
+            STORAGE_SRC,
+            "flow partial sums",
+        )?;
+        ensure(
+            ctx,
+            &mut self.partials_read,
+            pbytes,
+            READ,
+            "flow partials readback",
+        )?;
         ensure(ctx, &mut self.field, fbytes, STORAGE_SRC, "flow field")?;
         if read_field {
-            ensure(ctx, &mut self.field_read, fbytes, READ, "flow field readback")?;
+            ensure(
+                ctx,
+                &mut self.field_read,
+                fbytes,
+                READ,
+                "flow field readback",
+            )?;
         }
         let (tw_buf, part, field) = match (&self.twists, &self.partials, &self.field) {
             (Some(a), Some(b), Some(c)) => (&a.buf, &b.buf, &c.buf),
@@ -258,7 +284,9 @@ impl FlowRunner {
         });
         let mut enc = ctx
             .device
-            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("flow") });
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("flow"),
+            });
         {
             let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some("flow"),
@@ -325,7 +353,8 @@ impl FlowRunner {
         let field_len = if with_field { grid.len() as u64 } else { 0 };
         let groups = (p.tiles_x, n, gz);
         let read = with_field && read_field;
-        let (part, field) = self.dispatch(&p, twists, false, groups, n_partials, field_len, read)?;
+        let (part, field) =
+            self.dispatch(&p, twists, false, groups, n_partials, field_len, read)?;
         let sums = part
             .chunks(p.tiles as usize)
             .map(|c| c.iter().map(|&x| x as f64).sum())
