@@ -86,14 +86,22 @@ fn flow_tiles(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_in
     if (tile < params.tiles) {
         let tw = twists[twist_index];
         let base = tile * TILE + lid;
+        // Column and row of the thread's sample, stepped by WG without a division per sample.
+        var i = base % params.grid_w;
+        var j = base / params.grid_w;
         for (var k = 0u; k < CHUNK; k++) {
             let idx = base + k * WG;
             if (idx < n) {
-                let d = flow_mm(sensor_point(idx % params.grid_w, idx / params.grid_w), tw);
+                let d = flow_mm(sensor_point(i, j), tw);
                 acc += length(d);
                 if (params.write_field != 0u) {
                     field[idx] = px_velocity(d);
                 }
+            }
+            i += WG;
+            while (i >= params.grid_w) {
+                i -= params.grid_w;
+                j += 1u;
             }
         }
     }

@@ -38,19 +38,29 @@ pub fn px_velocity(p: &FlowParams, du: f32, dv: f32) -> [f32; 2] {
 
 /// Twin of one workgroup of `flow_tiles`: writes the tile's field samples (px/s)
 /// into `field` (the tile's slice, or empty to skip) and returns its sum of speeds (mm/s).
+/// Samples are visited in memory order; thread `lid`'s register sum gets the
+/// same terms in the same order as on the GPU.
 fn tile(p: &FlowParams, tw: &TwistGpu, tile: u32, field: &mut [[f32; 2]]) -> f32 {
     let n = p.grid_w * p.grid_h;
+    let base = tile * TILE;
     let mut sums = [0f32; WG as usize];
-    for (lid, acc) in sums.iter_mut().enumerate() {
-        for k in 0..CHUNK {
-            let idx = tile * TILE + lid as u32 + k * WG;
-            if idx < n {
-                let (u, v) = sensor_point(p, idx % p.grid_w, idx / p.grid_w);
-                let (du, dv) = flow_mm(p, tw, u, v);
-                *acc += (du * du + dv * dv).sqrt();
-                if !field.is_empty() {
-                    field[(idx - tile * TILE) as usize] = px_velocity(p, du, dv);
-                }
+    let (mut i, mut j) = (base % p.grid_w, base / p.grid_w);
+    'chunk: for k in 0..CHUNK {
+        for (lid, acc) in sums.iter_mut().enumerate() {
+            let off = k * WG + lid as u32;
+            if base + off >= n {
+                break 'chunk;
+            }
+            let (u, v) = sensor_point(p, i, j);
+            let (du, dv) = flow_mm(p, tw, u, v);
+            *acc += (du * du + dv * dv).sqrt();
+            if let Some(f) = field.get_mut(off as usize) {
+                *f = px_velocity(p, du, dv);
+            }
+            i += 1;
+            if i == p.grid_w {
+                i = 0;
+                j += 1;
             }
         }
     }

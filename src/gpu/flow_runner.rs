@@ -123,7 +123,7 @@ fn ensure<'a>(
     if size > lim.max_buffer_size || (storage && size > lim.max_storage_buffer_binding_size) {
         return Err(Error::Gpu(format!(
             "{label} needs a {:.1} MiB buffer; {} allows at most {:.1} MiB per storage buffer \
-             (use a smaller grid)",
+             (use a smaller sensor or grid)",
             size as f64 / 1048576.0,
             ctx.description,
             lim.max_storage_buffer_binding_size.min(lim.max_buffer_size) as f64 / 1048576.0
