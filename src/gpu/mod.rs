@@ -3,5 +3,9 @@
 
 pub mod context;
 pub mod flow;
+pub mod flow_bench;
+pub mod flow_cpu;
+pub mod flow_params;
+pub mod flow_runner;
 
 pub use context::{gpu, GpuContext};

@@ -1,0 +1,188 @@
+//! CPU twins of `shaders/flow.wgsl`: the same f32 formula and summation
+//! order as the kernels (single-threaded and rayon), plus an f64 reference
+//! built from the library's own [`crate::flow::flow_at`] and [`Camera`] maps.
+
+use super::flow_params::{FlowParams, Grid, TwistGpu, CHUNK, TILE, WG};
+use crate::camera::Camera;
+use crate::flow::flow_at;
+use crate::motion::{Plane, Twist};
+use rayon::prelude::*;
+
+/// Twin of the shader's `sensor_point`: centre of grid cell `(i, j)`, mm.
+#[inline(always)]
+pub fn sensor_point(p: &FlowParams, i: u32, j: u32) -> (f32, f32) {
+    let x = (i as f32 + 0.5) * p.step_x;
+    let y = (j as f32 + 0.5) * p.step_y;
+    let v = (y - p.cy) * p.pitch_y;
+    let u = (x - p.cx - p.skew_over_f * v) * p.pitch_x;
+    (u, v)
+}
+
+/// Twin of the shader's `flow_mm`: flow (mm/s) at sensor point `(u, v)` mm.
+#[inline(always)]
+pub fn flow_mm(p: &FlowParams, tw: &TwistGpu, u: f32, v: f32) -> (f32, f32) {
+    let f = p.f_mm;
+    let [wx, wy, wz, _] = tw.omega;
+    let [tx, ty, tz, _] = tw.velocity;
+    let iz = tw.inv_depth[0] + tw.inv_depth[1] * u + tw.inv_depth[2] * v;
+    let du = wz * v - wy * f - (wy / f) * u * u + (wx / f) * u * v - f * iz * tx + u * iz * tz;
+    let dv = -wz * u + wx * f - (wy / f) * u * v + (wx / f) * v * v - f * iz * ty + v * iz * tz;
+    (du, dv)
+}
+
+/// Twin of the shader's `px_velocity`: mm/s to px/s.
+#[inline(always)]
+pub fn px_velocity(p: &FlowParams, du: f32, dv: f32) -> [f32; 2] {
+    [du / p.pitch_x + p.skew_over_f * dv, dv / p.pitch_y]
+}
+
+/// Twin of one workgroup of `flow_tiles`: writes the tile's field samples (px/s)
+/// into `field` (the tile's slice, or empty to skip) and returns its sum of speeds (mm/s).
+/// Samples are visited in memory order; thread `lid`'s register sum gets the
+/// same terms in the same order as on the GPU.
+fn tile(p: &FlowParams, tw: &TwistGpu, tile: u32, field: &mut [[f32; 2]]) -> f32 {
+    let n = p.grid_w * p.grid_h;
+    let base = tile * TILE;
+    let mut sums = [0f32; WG as usize];
+    let (mut i, mut j) = (base % p.grid_w, base / p.grid_w);
+    'chunk: for k in 0..CHUNK {
+        for (lid, acc) in sums.iter_mut().enumerate() {
+            let off = k * WG + lid as u32;
+            if base + off >= n {
+                break 'chunk;
+            }
+            let (u, v) = sensor_point(p, i, j);
+            let (du, dv) = flow_mm(p, tw, u, v);
+            *acc += (du * du + dv * dv).sqrt();
+            if let Some(f) = field.get_mut(off as usize) {
+                *f = px_velocity(p, du, dv);
+            }
+            i += 1;
+            if i == p.grid_w {
+                i = 0;
+                j += 1;
+            }
+        }
+    }
+    sums.iter().fold(0.0, |s, &x| s + x)
+}
+
+/// A field (px/s, row-major) and the mean speed (mm/s) of its samples.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FieldMean {
+    /// Per-sample flow `[u, v]` in px/s; empty when not requested.
+    pub field: Vec<[f32; 2]>,
+    /// Mean speed, mm/s (partials summed in f64).
+    pub mean_mm_s: f64,
+}
+
+/// Twin of `flow_tiles` for one twist, on the current rayon pool (tiles in parallel).
+pub fn flow_tiles(grid: &Grid, tw: &TwistGpu, with_field: bool) -> FieldMean {
+    let p = grid.params(1, with_field);
+    let n = grid.len();
+    let mut field = if with_field {
+        vec![[0f32; 2]; n]
+    } else {
+        Vec::new()
+    };
+    let partials: Vec<f32> = if with_field {
+        field
+            .par_chunks_mut(TILE as usize)
+            .enumerate()
+            .map(|(t, f)| tile(&p, tw, t as u32, f))
+            .collect()
+    } else {
+        (0..p.tiles)
+            .into_par_iter()
+            .map(|t| tile(&p, tw, t, &mut []))
+            .collect()
+    };
+    let total: f64 = partials.iter().map(|&x| x as f64).sum();
+    FieldMean {
+        field,
+        mean_mm_s: total / n as f64,
+    }
+}
+
+/// Twin of `rows_per_twist`: the row sums of speeds (mm/s) of one twist.
+pub fn rows_per_twist(p: &FlowParams, tw: &TwistGpu) -> Vec<f32> {
+    (0..p.grid_h)
+        .map(|j| {
+            let mut row = 0f32;
+            for i in 0..p.grid_w {
+                let (u, v) = sensor_point(p, i, j);
+                let (du, dv) = flow_mm(p, tw, u, v);
+                row += (du * du + dv * dv).sqrt();
+            }
+            row
+        })
+        .collect()
+}
+
+/// Batched means (mm/s) like the GPU batch path, f32 twin, rayon over twists.
+pub fn batch_means(grid: &Grid, twists: &[TwistGpu]) -> Vec<f64> {
+    let p = grid.params(twists.len() as u32, false);
+    let n = grid.len() as f64;
+    twists
+        .par_iter()
+        .map(|tw| {
+            rows_per_twist(&p, tw)
+                .iter()
+                .map(|&x| x as f64)
+                .sum::<f64>()
+                / n
+        })
+        .collect()
+}
+
+/// f64 reference: the field (px/s) at the grid's cell centres from
+/// [`Camera::pixel_to_mm`], [`flow_at`] and [`Camera::mm_to_px_velocity`], and
+/// the mean speed (mm/s).
+pub fn reference_f64(grid: &Grid, tw: &Twist, plane: Option<&Plane>) -> (Vec<[f64; 2]>, f64) {
+    let c: &Camera = &grid.camera;
+    let (sx, sy) = grid.step();
+    let mut field = Vec::with_capacity(grid.len());
+    let mut sum = 0.0;
+    for j in 0..grid.height {
+        let mut row = 0.0;
+        for i in 0..grid.width {
+            let (u, v) = c.pixel_to_mm((i as f64 + 0.5) * sx, (j as f64 + 0.5) * sy);
+            let (du, dv) = flow_at(c.focal_mm, u, v, tw, plane);
+            row += du.hypot(dv);
+            let (a, b) = c.mm_to_px_velocity(du, dv);
+            field.push([a, b]);
+        }
+        sum += row;
+    }
+    (field, sum / grid.len() as f64)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::DVec3;
+
+    #[test]
+    fn f32_twin_matches_f64_reference() {
+        let cam = Camera::thesis().with_resolution(64, 48);
+        let mut cam = cam;
+        cam.skew = 0.7;
+        let grid = Grid::new(&cam, 0, 0).unwrap();
+        let tw = Twist::new(DVec3::new(0.3, -0.8, 0.5), DVec3::new(0.1, -0.2, 0.4));
+        let plane = Plane {
+            normal: DVec3::new(0.2, -0.1, 1.0),
+            d: 1.5,
+        };
+        let g = TwistGpu::new(cam.focal_mm, &tw, Some(&plane));
+        let twin = flow_tiles(&grid, &g, true);
+        let (reff, mean) = reference_f64(&grid, &tw, Some(&plane));
+        let max = reff.iter().map(|a| a[0].hypot(a[1])).fold(0.0, f64::max);
+        for (a, b) in twin.field.iter().zip(&reff) {
+            assert!((a[0] as f64 - b[0]).abs() < 1e-6 * max, "{a:?} {b:?}");
+            assert!((a[1] as f64 - b[1]).abs() < 1e-6 * max, "{a:?} {b:?}");
+        }
+        assert!((twin.mean_mm_s - mean).abs() < 1e-6 * mean);
+        let rows = batch_means(&grid, &[g]);
+        assert!((rows[0] - mean).abs() < 1e-6 * mean);
+    }
+}

@@ -1,0 +1,403 @@
+//! The compiled `shaders/flow.wgsl` kernels and a runner that owns reusable
+//! buffers and dispatches them. CPU twins: [`super::flow_cpu`].
+
+use super::context::{gpu, GpuContext};
+use super::flow_params::{FlowParams, Grid, TwistGpu, MAX_DISPATCH, WG};
+use crate::error::{Error, Result};
+use std::sync::OnceLock;
+
+/// The WGSL source of the flow kernels.
+pub const FLOW_WGSL: &str = include_str!("../../shaders/flow.wgsl");
+
+/// Grids of at most this many samples use `rows_per_twist` (one thread per
+/// twist) for batches; larger ones use `flow_tiles` (one workgroup per tile).
+pub const ROWS_KERNEL_MAX_SAMPLES: usize = 4096;
+
+/// The bind group layout and the two pipelines.
+pub struct Kernels {
+    bgl: wgpu::BindGroupLayout,
+    tiles: wgpu::ComputePipeline,
+    rows: wgpu::ComputePipeline,
+}
+
+fn storage(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+fn build(ctx: &GpuContext) -> Result<Kernels> {
+    let d = &ctx.device;
+    let scope = d.push_error_scope(wgpu::ErrorFilter::Validation);
+    let module = d.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("flow.wgsl"),
+        source: wgpu::ShaderSource::Wgsl(FLOW_WGSL.into()),
+    });
+    let bgl = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("flow"),
+        entries: &[
+            wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: wgpu::ShaderStages::COMPUTE,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                count: None,
+            },
+            storage(1, true),
+            storage(2, false),
+            storage(3, false),
+        ],
+    });
+    let layout = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some("flow"),
+        bind_group_layouts: &[Some(&bgl)],
+        immediate_size: 0,
+    });
+    let pipe = |entry: &str| {
+        d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some(entry),
+            layout: Some(&layout),
+            module: &module,
+            entry_point: Some(entry),
+            compilation_options: Default::default(),
+            cache: None,
+        })
+    };
+    let tiles = pipe("flow_tiles");
+    let rows = pipe("rows_per_twist");
+    if let Some(e) = pollster::block_on(scope.pop()) {
+        return Err(Error::Gpu(format!("building shaders/flow.wgsl: {e}")));
+    }
+    Ok(Kernels { bgl, tiles, rows })
+}
+
+static KERNELS: OnceLock<std::result::Result<Kernels, String>> = OnceLock::new();
+
+/// The shared device and the flow kernels (compiled once per process).
+pub fn kernels() -> Result<(&'static GpuContext, &'static Kernels)> {
+    let ctx = gpu()?;
+    let k = KERNELS
+        .get_or_init(|| build(ctx).map_err(|e| e.to_string()))
+        .as_ref()
+        .map_err(|e| Error::Gpu(e.trim_start_matches("GPU: ").to_string()))?;
+    Ok((ctx, k))
+}
+
+struct Buf {
+    buf: wgpu::Buffer,
+    size: u64,
+}
+
+/// Dispatches the flow kernels, reusing its buffers between calls (they grow as needed).
+pub struct FlowRunner {
+    ctx: &'static GpuContext,
+    k: &'static Kernels,
+    params: wgpu::Buffer,
+    twists: Option<Buf>,
+    field: Option<Buf>,
+    partials: Option<Buf>,
+    field_read: Option<Buf>,
+    partials_read: Option<Buf>,
+}
+
+fn ensure<'a>(
+    ctx: &GpuContext,
+    slot: &'a mut Option<Buf>,
+    size: u64,
+    usage: wgpu::BufferUsages,
+    label: &str,
+) -> Result<&'a wgpu::Buffer> {
+    let size = size.max(16).next_multiple_of(16);
+    let lim = ctx.device.limits();
+    let storage = usage.contains(wgpu::BufferUsages::STORAGE);
+    if size > lim.max_buffer_size || (storage && size > lim.max_storage_buffer_binding_size) {
+        return Err(Error::Gpu(format!(
+            "{label} needs a {:.1} MiB buffer; {} allows at most {:.1} MiB per storage buffer \
+             (use a smaller sensor or grid)",
+            size as f64 / 1048576.0,
+            ctx.description,
+            lim.max_storage_buffer_binding_size.min(lim.max_buffer_size) as f64 / 1048576.0
+        )));
+    }
+    if !matches!(slot, Some(b) if b.size >= size) {
+        *slot = None;
+        let scope = ctx.device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
+        let buf = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size,
+            usage,
+            mapped_at_creation: false,
+        });
+        if let Some(e) = pollster::block_on(scope.pop()) {
+            return Err(Error::Gpu(format!(
+                "allocating {label} ({size} bytes): {e}"
+            )));
+        }
+        *slot = Some(Buf { buf, size });
+    }
+    Ok(&slot.as_ref().expect("buffer just ensured").buf)
+}
+
+/// Reads `size` bytes of a MAP_READ buffer.
+fn read_back(ctx: &GpuContext, buf: &wgpu::Buffer, size: u64) -> Result<Vec<u8>> {
+    let slice = buf.slice(..size);
+    let (tx, rx) = std::sync::mpsc::channel();
+    slice.map_async(wgpu::MapMode::Read, move |r| {
+        let _ = tx.send(r);
+    });
+    ctx.device
+        .poll(wgpu::PollType::wait_indefinitely())
+        .map_err(|e| Error::Gpu(format!("waiting for the flow kernel: {e}")))?;
+    rx.recv()
+        .map_err(|e| Error::Gpu(format!("buffer map callback lost: {e}")))?
+        .map_err(|e| Error::Gpu(format!("mapping the result buffer: {e}")))?;
+    let out = {
+        let view = slice
+            .get_mapped_range()
+            .map_err(|e| Error::Gpu(format!("reading the result buffer: {e}")))?;
+        view.to_vec()
+    };
+    buf.unmap();
+    Ok(out)
+}
+
+const STORAGE_DST: wgpu::BufferUsages =
+    wgpu::BufferUsages::STORAGE.union(wgpu::BufferUsages::COPY_DST);
+const STORAGE_SRC: wgpu::BufferUsages =
+    wgpu::BufferUsages::STORAGE.union(wgpu::BufferUsages::COPY_SRC);
+const READ: wgpu::BufferUsages = wgpu::BufferUsages::MAP_READ.union(wgpu::BufferUsages::COPY_DST);
+
+impl FlowRunner {
+    /// A runner on the shared device (errors when there is no adapter).
+    pub fn new() -> Result<Self> {
+        let (ctx, k) = kernels()?;
+        let params = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("flow params"),
+            size: std::mem::size_of::<FlowParams>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        Ok(FlowRunner {
+            ctx,
+            k,
+            params,
+            twists: None,
+            field: None,
+            partials: None,
+            field_read: None,
+            partials_read: None,
+        })
+    }
+
+    /// `name (backend, type)` of the adapter.
+    pub fn adapter(&self) -> &str {
+        &self.ctx.description
+    }
+
+    /// Runs one kernel: uploads `p` and `twists`, dispatches `groups`,
+    /// returns `n_partials` f32 partial sums and, with `read_field`, the
+    /// field of `field_len` samples.
+    #[allow(clippy::too_many_arguments)]
+    fn dispatch(
+        &mut self,
+        p: &FlowParams,
+        twists: &[TwistGpu],
+        rows: bool,
+        groups: (u32, u32, u32),
+        n_partials: u64,
+        field_len: u64,
+        read_field: bool,
+    ) -> Result<(Vec<f32>, Vec<[f32; 2]>)> {
+        let ctx = self.ctx;
+        let tw_bytes: &[u8] = bytemuck::cast_slice(twists);
+        let pbytes = n_partials * 4;
+        let fbytes = field_len * 8;
+        ensure(
+            ctx,
+            &mut self.twists,
+            tw_bytes.len() as u64,
+            STORAGE_DST,
+            "flow twists",
+        )?;
+        ensure(
+            ctx,
+            &mut self.partials,
+            pbytes,
+            STORAGE_SRC,
+            "flow partial sums",
+        )?;
+        ensure(
+            ctx,
+            &mut self.partials_read,
+            pbytes,
+            READ,
+            "flow partials readback",
+        )?;
+        ensure(ctx, &mut self.field, fbytes, STORAGE_SRC, "flow field")?;
+        if read_field {
+            ensure(
+                ctx,
+                &mut self.field_read,
+                fbytes,
+                READ,
+                "flow field readback",
+            )?;
+        }
+        let (tw_buf, part, field) = match (&self.twists, &self.partials, &self.field) {
+            (Some(a), Some(b), Some(c)) => (&a.buf, &b.buf, &c.buf),
+            _ => return Err(Error::Gpu("flow buffers missing".into())),
+        };
+        ctx.queue
+            .write_buffer(&self.params, 0, bytemuck::bytes_of(p));
+        ctx.queue.write_buffer(tw_buf, 0, tw_bytes);
+        let bg = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("flow"),
+            layout: &self.k.bgl,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: self.params.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: tw_buf.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: field.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: part.as_entire_binding(),
+                },
+            ],
+        });
+        let mut enc = ctx
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("flow"),
+            });
+        {
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("flow"),
+                timestamp_writes: None,
+            });
+            pass.set_pipeline(if rows { &self.k.rows } else { &self.k.tiles });
+            pass.set_bind_group(0, &bg, &[]);
+            pass.dispatch_workgroups(groups.0, groups.1, groups.2);
+        }
+        let pread = &self.partials_read.as_ref().expect("ensured").buf;
+        enc.copy_buffer_to_buffer(part, 0, pread, 0, pbytes);
+        if read_field {
+            let fread = &self.field_read.as_ref().expect("ensured").buf;
+            enc.copy_buffer_to_buffer(field, 0, fread, 0, fbytes);
+        }
+        ctx.queue.submit([enc.finish()]);
+        let partials: Vec<f32> = bytemuck::pod_collect_to_vec(&read_back(ctx, pread, pbytes)?);
+        let field = if read_field {
+            let fread = &self.field_read.as_ref().expect("ensured").buf;
+            bytemuck::pod_collect_to_vec(&read_back(ctx, fread, fbytes)?)
+        } else {
+            Vec::new()
+        };
+        Ok((partials, field))
+    }
+
+    /// `flow_tiles` for up to [`MAX_DISPATCH`] twists: per twist the sum of
+    /// speeds (mm/s) over the grid, as f32 tile partials summed in f64, and
+    /// (one twist, `with_field`) the field in px/s.
+    pub fn tiles(
+        &mut self,
+        grid: &Grid,
+        twists: &[TwistGpu],
+        with_field: bool,
+    ) -> Result<(Vec<f64>, Vec<[f32; 2]>)> {
+        self.tiles_ext(grid, twists, with_field, with_field)
+    }
+
+    /// [`FlowRunner::tiles`], writing the field on the device without reading
+    /// it back when `read_field` is false (for timing the kernel alone).
+    pub fn tiles_ext(
+        &mut self,
+        grid: &Grid,
+        twists: &[TwistGpu],
+        with_field: bool,
+        read_field: bool,
+    ) -> Result<(Vec<f64>, Vec<[f32; 2]>)> {
+        let n = twists.len() as u32;
+        if n == 0 || n > MAX_DISPATCH || (with_field && n != 1) {
+            return Err(Error::invalid(
+                "flow_tiles",
+                format!("{n} twists: need 1..={MAX_DISPATCH}, and exactly 1 with a field"),
+            ));
+        }
+        let p = grid.params(n, with_field);
+        let n_partials = n as u64 * p.tiles as u64;
+        if n_partials >= u32::MAX as u64 {
+            return Err(Error::invalid(
+                "gpu batch",
+                "too many twists x tiles in one dispatch",
+            ));
+        }
+        let gz = p.tiles.div_ceil(p.tiles_x);
+        let field_len = if with_field { grid.len() as u64 } else { 0 };
+        let groups = (p.tiles_x, n, gz);
+        let read = with_field && read_field;
+        let (part, field) =
+            self.dispatch(&p, twists, false, groups, n_partials, field_len, read)?;
+        let sums = part
+            .chunks(p.tiles as usize)
+            .map(|c| c.iter().map(|&x| x as f64).sum())
+            .collect();
+        Ok((sums, field))
+    }
+
+    /// `rows_per_twist` for up to `MAX_DISPATCH * 64` twists: per twist the
+    /// sum of speeds (mm/s) over the grid, f32 row sums added in f64.
+    pub fn rows(&mut self, grid: &Grid, twists: &[TwistGpu]) -> Result<Vec<f64>> {
+        let n = twists.len() as u64;
+        if n == 0 || n > MAX_DISPATCH as u64 * WG as u64 {
+            return Err(Error::invalid(
+                "rows_per_twist",
+                format!("{n} twists: need 1..={}", MAX_DISPATCH * WG),
+            ));
+        }
+        let p = grid.params(n as u32, false);
+        let n_partials = n * grid.height as u64;
+        let groups = (n as u32).div_ceil(WG);
+        let (part, _) = self.dispatch(&p, twists, true, (groups, 1, 1), n_partials, 0, false)?;
+        Ok(part
+            .chunks(grid.height as usize)
+            .map(|c| c.iter().map(|&x| x as f64).sum())
+            .collect())
+    }
+
+    /// Mean speed (mm/s) per twist over `grid`, any number of twists: small
+    /// grids with `rows_per_twist`, larger ones with `flow_tiles`, in chunks.
+    pub fn batch_means(&mut self, grid: &Grid, twists: &[TwistGpu]) -> Result<Vec<f64>> {
+        let n = grid.len() as f64;
+        let mut out = Vec::with_capacity(twists.len());
+        if grid.len() <= ROWS_KERNEL_MAX_SAMPLES {
+            for c in twists.chunks(16_384) {
+                out.extend(self.rows(grid, c)?.into_iter().map(|s| s / n));
+            }
+        } else {
+            // Keep the partials buffer under ~64 MiB.
+            let per = ((16 << 20) / grid.tiles() as usize).clamp(1, MAX_DISPATCH as usize);
+            for c in twists.chunks(per) {
+                out.extend(self.tiles(grid, c, false)?.0.into_iter().map(|s| s / n));
+            }
+        }
+        Ok(out)
+    }
+}
