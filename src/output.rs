@@ -5,6 +5,18 @@ use crate::error::{Error, Result};
 use std::io::Write;
 use std::path::Path;
 
+/// Temp files are created 0600; give the final file the usual 0644.
+fn publish(tmp: tempfile::NamedTempFile, path: &Path) -> Result<()> {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        std::fs::set_permissions(tmp.path(), std::fs::Permissions::from_mode(0o644))
+            .map_err(|e| Error::io(path, e))?;
+    }
+    tmp.persist(path).map_err(|e| Error::io(path, e.error))?;
+    Ok(())
+}
+
 fn temp_beside(path: &Path) -> Result<tempfile::NamedTempFile> {
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
@@ -32,8 +44,7 @@ where
         write(&mut w)?;
         w.flush().map_err(|e| Error::io(path, e))?;
     }
-    tmp.persist(path).map_err(|e| Error::io(path, e.error))?;
-    Ok(())
+    publish(tmp, path)
 }
 
 /// For encoders that write to a path (EXR, PNG): `write` gets a temporary path
@@ -44,6 +55,5 @@ where
 {
     let tmp = temp_beside(path)?;
     write(tmp.path())?;
-    tmp.persist(path).map_err(|e| Error::io(path, e.error))?;
-    Ok(())
+    publish(tmp, path)
 }

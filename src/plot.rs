@@ -6,18 +6,24 @@ use crate::output::write_atomic_path;
 use crate::tables::GridErrorRow;
 use plotters::prelude::*;
 use std::path::Path;
-use std::sync::Once;
+use std::sync::OnceLock;
 
 static FONT: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
 
-/// Registers the bundled font as `sans-serif` (idempotent).
-pub fn ensure_font() {
-    static ONCE: Once = Once::new();
-    ONCE.call_once(|| {
-        // The font is compiled in and known to be valid; a failure here only
-        // means labels are missing, never a crash.
-        let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, FONT);
+/// Registers the bundled font as plotters' `sans-serif` (once per process).
+pub fn ensure_font() -> Result<()> {
+    static DONE: OnceLock<bool> = OnceLock::new();
+    let ok = *DONE.get_or_init(|| {
+        plotters::style::register_font("sans-serif", FontStyle::Normal, FONT).is_ok()
     });
+    if ok {
+        Ok(())
+    } else {
+        Err(Error::invalid(
+            "font",
+            "the bundled DejaVuSans.ttf could not be loaded",
+        ))
+    }
 }
 
 /// Turns a plotters error into ours, naming the file.
@@ -31,7 +37,7 @@ pub fn plot_error<E: std::fmt::Display>(path: &Path) -> impl Fn(E) -> Error + '_
 /// Fig. 4.6-style plot: max |relative error| (%) of the riemann and gauss
 /// rules against the exact value, versus the number of points (log-log).
 pub fn grid_error_plot(rows: &[GridErrorRow], path: &Path) -> Result<()> {
-    ensure_font();
+    ensure_font()?;
     write_atomic_path(path, |tmp| {
         let e = plot_error(path);
         let root = BitMapBackend::new(tmp, (800, 500)).into_drawing_area();

@@ -6,26 +6,6 @@ use crate::camera::Camera;
 use crate::error::{Error, Result};
 use plotters::prelude::*;
 use std::path::Path;
-use std::sync::OnceLock;
-
-/// DejaVu Sans (Bitstream Vera licence, see `assets/DejaVuSans-LICENSE.txt`).
-static FONT: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
-
-/// Registers the bundled font as plotters' `sans-serif` (once per process).
-pub fn register_font() -> Result<()> {
-    static DONE: OnceLock<bool> = OnceLock::new();
-    let ok = *DONE.get_or_init(|| {
-        plotters::style::register_font("sans-serif", FontStyle::Normal, FONT).is_ok()
-    });
-    if ok {
-        Ok(())
-    } else {
-        Err(Error::invalid(
-            "font",
-            "the bundled DejaVuSans.ttf could not be loaded",
-        ))
-    }
-}
 
 /// Arrows per row of the quiver plot (rows follow the sensor's aspect ratio).
 pub const ARROWS_PER_ROW: u32 = 20;
@@ -160,7 +140,7 @@ pub fn quiver_png(
     path: &Path,
 ) -> Result<()> {
     let (arrows, mag) = arrows(camera, field_u, field_v, exposure_s)?;
-    register_font()?;
+    crate::plot::ensure_font()?;
     let n = field_u.len() as f64;
     let mean = field_u
         .iter()

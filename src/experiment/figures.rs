@@ -23,7 +23,7 @@ pub fn mmbm_trace(
     exposures: &[Exposure],
     threshold: Option<f64>,
 ) -> Result<()> {
-    ensure_font();
+    ensure_font()?;
     write_atomic_path(path, |tmp| {
         let e = plot_error(path);
         let root = BitMapBackend::new(tmp, (1000, 400)).into_drawing_area();
@@ -56,7 +56,9 @@ pub fn mmbm_trace(
                 exposures
                     .iter()
                     .filter(|x| x.2 >= t0 && x.1 <= t1)
-                    .map(|&(_, s, en)| Rectangle::new([(s.max(t0), 0.0), (en.min(t1), ymax)], shade.filled())),
+                    .map(|&(_, s, en)| {
+                        Rectangle::new([(s.max(t0), 0.0), (en.min(t1), ymax)], shade.filled())
+                    }),
             )
             .map_err(&e)?;
         let pts: Vec<(f64, f64)> = t
@@ -65,10 +67,15 @@ pub fn mmbm_trace(
             .filter(|(x, _)| **x >= t0 && **x <= t1)
             .map(|(x, y)| (*x, *y))
             .collect();
-        chart.draw_series(LineSeries::new(pts.clone(), BLUE.stroke_width(1))).map_err(&e)?;
+        chart
+            .draw_series(LineSeries::new(pts.clone(), BLUE.stroke_width(1)))
+            .map_err(&e)?;
         if let Some(th) = threshold {
             chart
-                .draw_series(LineSeries::new(vec![(t0, th), (t1, th)], RED.stroke_width(1)))
+                .draw_series(LineSeries::new(
+                    vec![(t0, th), (t1, th)],
+                    RED.stroke_width(1),
+                ))
                 .map_err(&e)?;
         }
         let at = |x: f64| {
@@ -90,7 +97,7 @@ pub fn mmbm_trace(
 
 /// Overlaid histograms of per-frame blur (px), one colour per series.
 pub fn blur_histograms(path: &Path, series: &[(String, Vec<f64>)]) -> Result<()> {
-    ensure_font();
+    ensure_font()?;
     write_atomic_path(path, |tmp| {
         let e = plot_error(path);
         let root = BitMapBackend::new(tmp, (900, 500)).into_drawing_area();
@@ -112,7 +119,10 @@ pub fn blur_histograms(path: &Path, series: &[(String, Vec<f64>)]) -> Result<()>
         let hs: Vec<Vec<f64>> = series.iter().map(|s| hist(&s.1)).collect();
         let ymax = hs.iter().flatten().copied().fold(0.05, f64::max) * 1.1;
         let mut chart = ChartBuilder::on(&root)
-            .caption("Ground-truth blur per frame (mean path length, px)", ("sans-serif", 20))
+            .caption(
+                "Ground-truth blur per frame (mean path length, px)",
+                ("sans-serif", 20),
+            )
             .margin(10)
             .x_label_area_size(40)
             .y_label_area_size(55)
@@ -136,7 +146,9 @@ pub fn blur_histograms(path: &Path, series: &[(String, Vec<f64>)]) -> Result<()>
                 .draw_series(LineSeries::new(pts, c.stroke_width(2)))
                 .map_err(&e)?
                 .label(name.clone())
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2)));
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2))
+                });
         }
         chart
             .configure_series_labels()
@@ -165,7 +177,11 @@ pub fn montage(path: &Path, width: u32, height: u32, images: &[&[f32]], cols: u3
             for x in 0..width {
                 let i = ((y * width + x) * 3) as usize;
                 if i + 2 < img.len() {
-                    let px = [linear_to_srgb8(img[i]), linear_to_srgb8(img[i + 1]), linear_to_srgb8(img[i + 2])];
+                    let px = [
+                        linear_to_srgb8(img[i]),
+                        linear_to_srgb8(img[i + 1]),
+                        linear_to_srgb8(img[i + 2]),
+                    ];
                     out.put_pixel(x0 + x, y0 + y, image::Rgb(px));
                 }
             }

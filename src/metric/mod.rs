@@ -181,7 +181,7 @@ impl Scene {
 }
 
 /// Computes MMBM with a CPU method. Validates inputs first. `Method::Gpu` is
-/// rejected here: use [`crate::gpu::flow::GpuFlow`].
+/// rejected here: use [`crate::gpu::flow::mmbm_gpu`].
 pub fn mmbm(scene: &Scene, tw: &Twist, method: Method) -> Result<Mmbm> {
     scene.validate_for(tw)?;
     let poly = scene.flow_poly(tw);
