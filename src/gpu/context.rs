@@ -60,9 +60,9 @@ fn create() -> Result<GpuContext> {
     let adapter = adapters
         .into_iter()
         .filter(|a| {
-            filter.as_ref().map_or(true, |f| {
-                a.get_info().name.to_lowercase().contains(&f.to_lowercase())
-            })
+            filter
+                .as_ref()
+                .is_none_or(|f| a.get_info().name.to_lowercase().contains(&f.to_lowercase()))
         })
         .min_by_key(rank)
         .ok_or_else(|| {
