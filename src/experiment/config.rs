@@ -1,0 +1,129 @@
+//! Experiment configuration (TOML). Every field has a default; the defaults
+//! are the thesis setup (chapter 6): 640 x 480, f = 4.2548 mm, 70 ms exposure,
+//! the blob board walked towards from 6 m, the thesis policies and their
+//! successors.
+
+use crate::error::{Error, Result};
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+/// The experiment's configuration.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ExperimentConfig {
+    /// Walk modes to simulate: `slow`, `moderate`, `fast` (ignored with `gyro`).
+    pub walks: Vec<String>,
+    /// Simulated duration per walk, s.
+    pub duration_s: f64,
+    /// Gyro rate of the simulation, Hz.
+    pub rate_hz: f64,
+    /// Simulation seed.
+    pub seed: u64,
+    /// A real gyro log (CSV of SPEC section 5) instead of the simulation.
+    pub gyro: Option<PathBuf>,
+    /// Forward speed (m/s) used for the target distance when the log has no velocity.
+    pub speed_m_s: f64,
+    /// Trigger policies, as `mmbm trigger --policy` strings.
+    pub policies: Vec<String>,
+    /// Exposure, s.
+    pub exposure_s: f64,
+    /// Trigger delay, s.
+    pub delay_s: f64,
+    /// Readout, s.
+    pub readout_s: f64,
+    /// Minimum interval between MMBM triggers, s.
+    pub min_interval_s: f64,
+    /// Target: `blobs` (thesis board) or `blobs:0.5` (half size, thesis Table 6.2).
+    pub target: String,
+    /// Distance to the target at t = 0, m (the walk approaches it).
+    pub start_distance_m: f64,
+    /// Closest allowed distance, m (the walk stops approaching there).
+    pub min_distance_m: f64,
+    /// Rendered resolution `[width, height]` (thesis: 640 x 480), thesis focal length and pitch.
+    pub resolution: [u32; 2],
+    /// Render quality preset: `default` or `fast` (the report states its measured error).
+    pub quality: String,
+    /// Render at most this many frames per policy and walk (evenly spread); 0 = all.
+    pub max_frames_per_policy: usize,
+}
+
+impl Default for ExperimentConfig {
+    fn default() -> Self {
+        ExperimentConfig {
+            walks: vec!["moderate".into()],
+            duration_s: 18.0,
+            rate_hz: 600.0,
+            seed: 1,
+            gyro: None,
+            speed_m_s: 0.17,
+            policies: [
+                "fixed:5",
+                "threshold:0.8",
+                "threshold:0.4",
+                "threshold:0.2",
+                "adaptive",
+                "forecast:0.4",
+                "oracle:0.4",
+                "gate:0.8",
+                "deadline:5",
+            ]
+            .map(String::from)
+            .to_vec(),
+            exposure_s: 0.07,
+            delay_s: 0.0025,
+            readout_s: 0.0125,
+            min_interval_s: 0.2,
+            target: "blobs".into(),
+            start_distance_m: 6.0,
+            min_distance_m: 1.5,
+            resolution: [640, 480],
+            quality: "fast".into(),
+            max_frames_per_policy: 0,
+        }
+    }
+}
+
+impl ExperimentConfig {
+    /// Loads a TOML file; missing fields take the defaults.
+    pub fn load(path: &Path) -> Result<Self> {
+        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+        let cfg: Self = toml::from_str(&text).map_err(|e| Error::Config {
+            path: path.into(),
+            message: e.to_string(),
+        })?;
+        cfg.validate().map_err(|e| Error::Config {
+            path: path.into(),
+            message: e.to_string(),
+        })?;
+        Ok(cfg)
+    }
+
+    /// Checks ranges (times positive, distances positive and ordered, a policy at least).
+    pub fn validate(&self) -> Result<()> {
+        use crate::error::positive;
+        positive("duration_s", self.duration_s)?;
+        positive("rate_hz", self.rate_hz)?;
+        positive("exposure_s", self.exposure_s)?;
+        positive("start_distance_m", self.start_distance_m)?;
+        positive("min_distance_m", self.min_distance_m)?;
+        crate::error::finite("speed_m_s", self.speed_m_s)?;
+        if self.min_distance_m > self.start_distance_m {
+            return Err(Error::invalid("min_distance_m", "must not exceed start_distance_m"));
+        }
+        if self.policies.is_empty() {
+            return Err(Error::invalid("policies", "at least one policy is needed"));
+        }
+        if self.gyro.is_none() && self.walks.is_empty() {
+            return Err(Error::invalid("walks", "at least one walk mode (or a gyro log) is needed"));
+        }
+        if self.resolution[0] == 0 || self.resolution[1] == 0 {
+            return Err(Error::invalid("resolution", "must be positive"));
+        }
+        Ok(())
+    }
+
+    /// The configuration as TOML (written into the report).
+    pub fn to_toml(&self) -> String {
+        toml::to_string_pretty(self).unwrap_or_else(|e| format!("# could not serialise: {e}"))
+    }
+}
