@@ -48,12 +48,15 @@ fn moderate_walk_meets_the_thesis_targets() {
 
 #[test]
 fn speeds_order_the_blur() {
-    // Faster walks blur more: higher typical peak, less time below 0.4.
+    // Faster walks blur more: higher typical peak, less time below 0.2 (slow
+    // and moderate spend about the same time below 0.4, as in thesis Table
+    // 6.2 where both gave about 3.5 fps at threshold 0.4).
     let s = calibration(Gait::Slow, 4);
     let m = calibration(Gait::Moderate, 4);
     let f = calibration(Gait::Fast, 4);
     assert!(s.0 < m.0 && m.0 < f.0, "peaks {} {} {}", s.0, m.0, f.0);
-    assert!(s.1 > m.1 && m.1 > f.1, "below 0.4: {} {} {}", s.1, m.1, f.1);
+    assert!(s.2 > m.2 && m.2 > f.2, "below 0.2: {} {} {}", s.2, m.2, f.2);
+    assert!(m.1 > f.1, "below 0.4: {} {}", m.1, f.1);
     // Thesis: at 0.4 and 0.2 the fast walk gave no frame at all.
     assert!(f.1 < 0.02, "fast walk below 0.4 for {}", f.1);
 }
@@ -78,7 +81,10 @@ fn forward_speed_and_step_rhythm() {
         let cfg = GaitConfig::preset(g);
         let s = simulate(&cfg, 30.0, 600.0, 5).unwrap();
         let vz: f64 = s.iter().map(|x| x.velocity.unwrap().z).sum::<f64>() / s.len() as f64;
-        assert!((vz - cfg.speed_m_s).abs() < 0.03 * cfg.speed_m_s, "{g}: mean vz {vz}");
+        assert!(
+            (vz - cfg.speed_m_s).abs() < 0.03 * cfg.speed_m_s,
+            "{g}: mean vz {vz}"
+        );
         let vy: f64 = s.iter().map(|x| x.velocity.unwrap().y).sum::<f64>() / s.len() as f64;
         assert!(vy.abs() < 0.01 * cfg.speed_m_s, "{g}: mean vy {vy}");
     }
@@ -99,7 +105,12 @@ fn noise_and_bias_show_when_the_body_is_still() {
     let s = simulate(&cfg, 20.0, 600.0, 9).unwrap();
     let n = s.len() as f64;
     let mean = s.iter().fold(glam::DVec3::ZERO, |a, x| a + x.omega) / n;
-    assert!((mean - glam::DVec3::new(0.01, -0.02, 0.03)).abs().max_element() < 0.0005);
+    assert!(
+        (mean - glam::DVec3::new(0.01, -0.02, 0.03))
+            .abs()
+            .max_element()
+            < 0.0005
+    );
     let var = s.iter().map(|x| (x.omega.x - mean.x).powi(2)).sum::<f64>() / n;
     assert!((var.sqrt() - 0.005).abs() < 0.0003, "std {}", var.sqrt());
 }
@@ -132,7 +143,8 @@ fn log_round_trips_through_the_reader() {
 #[test]
 fn toml_config_overrides_the_preset() {
     let p = Path::new("gait.toml");
-    let c = GaitConfig::from_toml_str("step_hz = 1.5\nsway = [0.1, 0.0, 0.0]\n", Gait::Slow, p).unwrap();
+    let c = GaitConfig::from_toml_str("step_hz = 1.5\nsway = [0.1, 0.0, 0.0]\n", Gait::Slow, p)
+        .unwrap();
     let mut want = GaitConfig::preset(Gait::Slow);
     want.step_hz = 1.5;
     want.sway = [0.1, 0.0, 0.0];
@@ -144,7 +156,10 @@ fn toml_config_overrides_the_preset() {
     let c = GaitConfig::from_toml_str(&m.to_toml().unwrap(), Gait::Fast, p).unwrap();
     assert_eq!(c, m);
     let e = GaitConfig::from_toml_str("stepz_hz = 1\n", Gait::Slow, p).unwrap_err();
-    assert!(e.to_string().contains("gait.toml") && e.to_string().contains("stepz_hz"), "{e}");
+    assert!(
+        e.to_string().contains("gait.toml") && e.to_string().contains("stepz_hz"),
+        "{e}"
+    );
     let e = GaitConfig::from_toml_str("step_hz = -1\n", Gait::Slow, p).unwrap_err();
     assert!(e.to_string().contains("step_hz"), "{e}");
 }

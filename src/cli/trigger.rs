@@ -13,7 +13,8 @@ use std::path::PathBuf;
 
 /// Run trigger policies on a gyro log: CSV of frames, summary.
 #[derive(Args, Debug)]
-#[command(after_help = "Policies (X in mm/s, or pNN = NN-th percentile of the log's MMBM):
+#[command(
+    after_help = "Policies (X in mm/s, or pNN = NN-th percentile of the log's MMBM):
   fixed:FPS[@PHASE]  threshold:X  adaptive[:X[:FPS]]  oracle:X[:H]  forecast:X[:H]
   gate:X[:FPS[@PHASE]]  deadline:FPS[:X]
 
@@ -21,7 +22,8 @@ Examples:
   mmbm simulate --gait moderate --duration 16 --out walk.csv
   mmbm trigger --gyro walk.csv --policy fixed:5 --policy threshold:0.4 --exposure 0.07 --out frames.csv
   mmbm trigger --gyro walk.csv --policy oracle:0.4 --policy forecast:0.4 --exposure 0.07 --summary
-  mmbm trigger --gyro ../shared/data/running_phone/gyro.csv --policy threshold:p20 --exposure 0.02 --summary")]
+  mmbm trigger --gyro ../shared/data/running_phone/gyro.csv --policy threshold:p20 --exposure 0.02 --summary"
+)]
 pub struct TriggerArgs {
     /// Gyro CSV: t,wx,wy,wz[,vx,vy,vz][,depth].
     #[arg(long, value_name = "FILE")]

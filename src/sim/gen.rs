@@ -135,8 +135,8 @@ pub fn simulate(
     let n = n_f as usize;
     let mut steps = Steps::new(cfg, seed);
     let mut noise_rng = StdRng::seed_from_u64(seed ^ 0x9E37_79B9_7F4A_7C15);
-    let noise = Normal::new(0.0, cfg.noise_std)
-        .map_err(|e| Error::invalid("noise_std", e.to_string()))?;
+    let noise =
+        Normal::new(0.0, cfg.noise_std).map_err(|e| Error::invalid("noise_std", e.to_string()))?;
     let tr = Transient::new(cfg.touchdown_decay_s, cfg.touchdown_freq_hz);
     let sign = |j: usize, side: f64| if cfg.alternate[j] { side } else { 1.0 };
     let bias = DVec3::from_array(cfg.bias);

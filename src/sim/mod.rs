@@ -208,7 +208,10 @@ impl GaitConfig {
         if self.touchdown_jitter > 0.15 {
             return Err(Error::invalid(
                 "touchdown_jitter",
-                format!("must be <= 0.15 (steps stay in order), got {}", self.touchdown_jitter),
+                format!(
+                    "must be <= 0.15 (steps stay in order), got {}",
+                    self.touchdown_jitter
+                ),
             ));
         }
         nonneg("amplitude_jitter", self.amplitude_jitter)?;
@@ -241,8 +244,8 @@ impl GaitConfig {
             Some(v) => return Err(cfg_err(format!("'gait' must be a string, got {v}"))),
             None => base,
         };
-        let mut table = toml::Table::try_from(GaitConfig::preset(base))
-            .map_err(|e| cfg_err(format!("{e}")))?;
+        let mut table =
+            toml::Table::try_from(GaitConfig::preset(base)).map_err(|e| cfg_err(format!("{e}")))?;
         for (k, v) in file {
             table.insert(k, v);
         }

@@ -273,7 +273,10 @@ pub fn run(
         if !(m.is_finite() && m >= 0.0) {
             return Err(Error::invalid(
                 "mmbm series",
-                format!("value {m} at sample {i} (t = {}) is not a finite number >= 0", t[i]),
+                format!(
+                    "value {m} at sample {i} (t = {}) is not a finite number >= 0",
+                    t[i]
+                ),
             ));
         }
     }

@@ -44,8 +44,9 @@ impl Observation<'_> {
 
     /// True when no frame was triggered yet or the minimum interval has passed.
     pub fn interval_passed(&self) -> bool {
-        self.last_trigger
-            .map_or(true, |lt| self.now() - lt >= self.timing.min_interval - TIME_EPS)
+        self.last_trigger.map_or(true, |lt| {
+            self.now() - lt >= self.timing.min_interval - TIME_EPS
+        })
     }
 }
 
@@ -86,7 +87,9 @@ impl Level {
         let bad = || {
             Error::invalid(
                 what,
-                format!("'{s}': expected a threshold in mm/s (e.g. 0.4) or a percentile pNN (e.g. p20)"),
+                format!(
+                    "'{s}': expected a threshold in mm/s (e.g. 0.4) or a percentile pNN (e.g. p20)"
+                ),
             )
         };
         if let Some(p) = s.strip_prefix(['p', 'P']) {
@@ -107,9 +110,8 @@ impl Level {
     pub fn resolve(&self, mmbm: &[f64]) -> Result<f64> {
         match *self {
             Level::Abs(x) => Ok(x),
-            Level::Percentile(q) => percentile(mmbm, q).ok_or_else(|| {
-                Error::invalid("percentile threshold", "the MMBM series is empty")
-            }),
+            Level::Percentile(q) => percentile(mmbm, q)
+                .ok_or_else(|| Error::invalid("percentile threshold", "the MMBM series is empty")),
         }
     }
 }
@@ -140,12 +142,10 @@ pub fn thesis_rule(m: &[f64], x: f64) -> bool {
 }
 
 pub(crate) fn parse_num(s: &str, what: &str, spec: &str) -> Result<f64> {
-    let x: f64 = s.trim().parse().map_err(|_| {
-        Error::invalid(
-            "policy",
-            format!("'{spec}': {what} '{s}' is not a number"),
-        )
-    })?;
+    let x: f64 = s
+        .trim()
+        .parse()
+        .map_err(|_| Error::invalid("policy", format!("'{spec}': {what} '{s}' is not a number")))?;
     if !x.is_finite() {
         return Err(Error::invalid(
             "policy",
@@ -207,7 +207,9 @@ pub fn parse_policy(spec: &str) -> Result<Box<dyn Policy>> {
             parse_pos(f, "target frame rate", spec)?,
         )),
         ("oracle", [x]) => Box::new(Oracle::new(spec, level(x)?, 0.2)),
-        ("oracle", [x, h]) => Box::new(Oracle::new(spec, level(x)?, parse_pos(h, "horizon", spec)?)),
+        ("oracle", [x, h]) => {
+            Box::new(Oracle::new(spec, level(x)?, parse_pos(h, "horizon", spec)?))
+        }
         ("forecast", [x]) => Box::new(Forecast::new(spec, level(x)?, 0.2)),
         ("forecast", [x, h]) => Box::new(Forecast::new(
             spec,

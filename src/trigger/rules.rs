@@ -177,10 +177,18 @@ impl Policy for Adaptive {
             self.mins.pop_back();
         }
         self.mins.push_back((now, m));
-        while self.mins.front().is_some_and(|&(t, _)| t < now - Self::WINDOW) {
+        while self
+            .mins
+            .front()
+            .is_some_and(|&(t, _)| t < now - Self::WINDOW)
+        {
             self.mins.pop_front();
         }
-        while self.triggers.front().is_some_and(|&t| t < now - Self::WINDOW) {
+        while self
+            .triggers
+            .front()
+            .is_some_and(|&t| t < now - Self::WINDOW)
+        {
             self.triggers.pop_front();
         }
         let recent_min = self.mins.front().map_or(m, |&(_, v)| v);
