@@ -1,12 +1,135 @@
-//! `mmbm trigger` (being built).
+//! `mmbm trigger`: run trigger policies on a gyro log.
 
+use super::args::{CameraArgs, SceneArgs};
+use super::series::GyroArgs;
 use clap::Args;
 use mmbm::error::{Error, Result};
+use mmbm::gyro::read_log;
+use mmbm::series::SeriesOptions;
+use mmbm::trigger::{self, CameraTiming, Frame};
+use mmbm::{Method, Scene};
+use std::io::Write;
+use std::path::PathBuf;
 
-/// (being built)
+/// Run trigger policies on a gyro log: CSV of frames, summary.
 #[derive(Args, Debug)]
-pub struct TriggerArgs {}
+#[command(
+    after_help = "Policies (X in mm/s, or pNN = NN-th percentile of the log's MMBM):
+  fixed:FPS[@PHASE]  threshold:X  adaptive[:X[:FPS]]  oracle:X[:H]  forecast:X[:H]
+  gate:X[:FPS[@PHASE]]  deadline:FPS[:X]
 
-pub fn run(_a: TriggerArgs) -> Result<()> {
-    Err(Error::invalid("trigger", "not implemented yet"))
+Examples:
+  mmbm simulate --gait moderate --duration 16 --out walk.csv
+  mmbm trigger --gyro walk.csv --policy fixed:5 --policy threshold:0.4 --exposure 0.07 --out frames.csv
+  mmbm trigger --gyro walk.csv --policy oracle:0.4 --policy forecast:0.4 --exposure 0.07 --summary
+  mmbm trigger --gyro ../shared/data/running_phone/gyro.csv --policy threshold:p20 --exposure 0.02 --summary"
+)]
+pub struct TriggerArgs {
+    /// Gyro CSV: t,wx,wy,wz[,vx,vy,vz][,depth].
+    #[arg(long, value_name = "FILE")]
+    pub gyro: PathBuf,
+    /// Policy (repeat for several; each row's `policy` column is the string given).
+    #[arg(long, required = true)]
+    pub policy: Vec<String>,
+    /// Exposure t_e, s (thesis: 0.05, 0.07).
+    #[arg(long, value_name = "S")]
+    pub exposure: f64,
+    /// Trigger delay t_d, s.
+    #[arg(long, value_name = "S", default_value_t = 0.0025)]
+    pub delay: f64,
+    /// Readout t_r after the exposure, s.
+    #[arg(long, value_name = "S", default_value_t = 0.0125)]
+    pub readout: f64,
+    /// Minimum interval between MMBM-triggered frames, s.
+    #[arg(long, value_name = "S", default_value_t = 0.2)]
+    pub min_interval: f64,
+    /// Output CSV of frames (default: stdout, unless --summary).
+    #[arg(long, value_name = "FILE")]
+    pub out: Option<PathBuf>,
+    /// Print the summary on stdout (else on stderr).
+    #[arg(long)]
+    pub summary: bool,
+    /// MMBM method (CPU): riemann[:NUxNV], gauss[:N], exact[:TOL].
+    #[arg(long, default_value = "riemann:8x6")]
+    pub method: String,
+    /// Include the log's vx,vy,vz (needs a depth column, --depth or --plane).
+    #[arg(long)]
+    pub use_velocity: bool,
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    #[command(flatten)]
+    pub gyro_opts: GyroArgs,
+    #[command(flatten)]
+    pub camera: CameraArgs,
+}
+
+fn summary_text(frames: &[Frame], spec: &str, duration: f64) -> String {
+    let s = trigger::summary_over(frames, duration);
+    let t = trigger::prediction_error(frames);
+    format!(
+        "{spec}: {} frames, {} kept, {:.3} fps over {:.3} s; exposure MMBM mean {:.4} p95 {:.4} max {:.4} mm/s (trigger mean {:.4})\n  \
+         Table 5.1 (exposure - trigger): min {:.4} max {:.4} mean {:.4} abs mean {:.4} std {:.4} mm/s; \
+         % min {:.2} max {:.2} mean {:.2} abs mean {:.2} std {:.2}\n",
+        s.frames, s.kept, s.effective_fps, s.duration_s, s.mean_mm_s, s.p95_mm_s, s.max_mm_s,
+        s.mean_trigger_mm_s, t.abs.min, t.abs.max, t.abs.mean, t.abs.mean_abs, t.abs.std,
+        t.pct.min, t.pct.max, t.pct.mean, t.pct.mean_abs, t.pct.std
+    )
+}
+
+pub fn run(a: TriggerArgs) -> Result<()> {
+    let method: Method = a.method.parse()?;
+    if matches!(method, Method::Gpu { .. }) {
+        return Err(Error::invalid("--method", "trigger uses a CPU method"));
+    }
+    let timing = CameraTiming {
+        delay: a.delay,
+        exposure: a.exposure,
+        readout: a.readout,
+        min_interval: a.min_interval,
+    };
+    timing.validate()?;
+    let mut policies = Vec::new();
+    for p in &a.policy {
+        policies.push(trigger::parse_policy(p)?);
+    }
+    let opts = SeriesOptions {
+        scene: Scene {
+            camera: a.camera.camera()?,
+            plane: a.scene.plane()?,
+        },
+        method,
+        use_velocity: a.use_velocity,
+    };
+    let samples = read_log(&a.gyro, a.gyro_opts.options()?)?;
+    let m = trigger::mmbm_series_with(&samples, &opts)?;
+    let duration = samples[samples.len() - 1].t - samples[0].t;
+    let mut all = Vec::new();
+    let mut text = String::new();
+    for (p, spec) in policies.iter_mut().zip(&a.policy) {
+        let frames = trigger::run(&samples, &m, p.as_mut(), &timing)?;
+        text.push_str(&summary_text(&frames, spec, duration));
+        all.push(frames);
+    }
+    let write = |w: &mut dyn Write| -> Result<()> {
+        trigger::write_frames(w, &[], true)?;
+        for f in &all {
+            trigger::write_frames(w, f, false)?;
+        }
+        Ok(())
+    };
+    match &a.out {
+        Some(p) => mmbm::output::write_atomic(p, |w| write(w))?,
+        None if !a.summary => {
+            let mut out = std::io::BufWriter::new(std::io::stdout().lock());
+            write(&mut out)?;
+            out.flush().map_err(|e| Error::io("<stdout>", e))?;
+        }
+        None => {}
+    }
+    if a.summary {
+        print!("{text}");
+    } else {
+        eprint!("{text}");
+    }
+    Ok(())
 }
