@@ -12,9 +12,10 @@ use std::time::Instant;
 #[command(after_help = "Examples:
   mmbm bench
   mmbm bench --what metric
-  mmbm bench --what gpu")]
+  mmbm bench --what gpu
+  mmbm bench --what trigger")]
 pub struct BenchArgs {
-    /// metric, gpu or all.
+    /// metric, gpu, trigger or all.
     #[arg(long, default_value = "all")]
     pub what: String,
 }

@@ -44,9 +44,8 @@ impl Observation<'_> {
 
     /// True when no frame was triggered yet or the minimum interval has passed.
     pub fn interval_passed(&self) -> bool {
-        self.last_trigger.map_or(true, |lt| {
-            self.now() - lt >= self.timing.min_interval - TIME_EPS
-        })
+        self.last_trigger
+            .is_none_or(|lt| self.now() - lt >= self.timing.min_interval - TIME_EPS)
     }
 }
 

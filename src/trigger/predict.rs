@@ -265,7 +265,7 @@ impl Policy for Forecast {
         (1..=Self::GRID).all(|q| {
             let tau = now + q as f64 * self.horizon / Self::GRID as f64;
             self.predict(tau, p, now, t0, timing)
-                .map_or(true, |e| e_now <= e)
+                .is_none_or(|e| e_now <= e)
         })
     }
 }
