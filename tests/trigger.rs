@@ -321,7 +321,7 @@ fn oracle_rule_sample_by_sample() {
             .map(|j| e[j])
             .fold(f64::INFINITY, f64::min);
         let ok = t[i] + tm.delay >= free
-            && last.map_or(true, |l| t[i] - l >= 0.2 - 1e-9)
+            && last.is_none_or(|l| t[i] - l >= 0.2 - 1e-9)
             && e[i] < 0.4
             && e[i] <= fut;
         assert_eq!(ok, fm.contains(&i), "sample {i}");
