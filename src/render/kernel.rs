@@ -99,13 +99,62 @@ fn coprime_near(n: u32, x: f64) -> u32 {
     1
 }
 
-/// Lattice generators `(g1, g2)` for `n` points.
-pub fn generators(n: u32) -> (u32, u32) {
+/// Squared minimum toroidal distance between points of the lattice
+/// `{(k g1, k g2, k) / n mod 1}` (the larger, the more evenly spread).
+fn min_dist2(n: u32, g1: u32, g2: u32) -> f64 {
     let nf = n as f64;
-    (
+    let wrap = |a: u64| {
+        let x = (a % n as u64) as f64 / nf;
+        x.min(1.0 - x)
+    };
+    let mut best = f64::INFINITY;
+    for k in 1..n as u64 {
+        let t = (k as f64 / nf).min(1.0 - k as f64 / nf);
+        let d = t * t;
+        if d >= best {
+            continue;
+        }
+        let x = wrap(k * g1 as u64);
+        let y = wrap(k * g2 as u64);
+        best = best.min(d + x * x + y * y);
+    }
+    best
+}
+
+/// Lattice generators `(g1, g2)` for `n` points: among integers coprime to
+/// `n` near `n * (0.75488, 0.56984)` (the R2 sequence's constants), the pair
+/// whose lattice has the largest minimum point distance (cached per `n`).
+pub fn generators(n: u32) -> (u32, u32) {
+    use std::collections::HashMap;
+    use std::sync::Mutex;
+    static CACHE: Mutex<Option<HashMap<u32, (u32, u32)>>> = Mutex::new(None);
+    if let Some(g) = CACHE.lock().ok().and_then(|c| c.as_ref()?.get(&n).copied()) {
+        return g;
+    }
+    let nf = n as f64;
+    let base = (
         coprime_near(n, nf * 0.754_877_666_2),
         coprime_near(n, nf * 0.569_840_291_0),
-    )
+    );
+    let mut best = (min_dist2(n, base.0, base.1), base);
+    if n > 16 {
+        // candidates: a window around the R2 generators, smaller for large n
+        let r = ((2.0e7 / nf).sqrt() / 2.0).clamp(0.0, 12.0) as i64;
+        for d1 in -r..=r {
+            for d2 in -r..=r {
+                let g1 = coprime_near(n, base.0 as f64 + 2.0 * d1 as f64);
+                let g2 = coprime_near(n, base.1 as f64 + 2.0 * d2 as f64);
+                let m = min_dist2(n, g1, g2);
+                if m > best.0 {
+                    best = (m, (g1, g2));
+                }
+            }
+        }
+    }
+    if let Ok(mut c) = CACHE.lock() {
+        c.get_or_insert_with(HashMap::new).insert(n, best.1);
+    }
+    best.1
 }
 
 /// PCG hash (same in WGSL).

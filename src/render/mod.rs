@@ -43,9 +43,9 @@ pub const MAX_SAMPLES: u32 = 1 << 22;
 /// Sampling quality.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Quality {
-    /// What `mmbm render` uses: >= 1024 samples, <= 0.25 px between time samples.
+    /// What `mmbm render` uses: >= 2048 samples, <= 0.25 px between time samples.
     Default,
-    /// Cheaper, for many frames: >= 128 samples, <= 0.5 px between time samples.
+    /// Cheaper, for many frames: >= 256 samples, <= 0.5 px between time samples.
     Fast,
     /// Explicit minimum sample count and maximum time-sample spacing (px).
     Custom {
@@ -66,8 +66,8 @@ impl Quality {
     /// Minimum samples per pixel.
     pub fn min_samples(&self) -> u32 {
         match *self {
-            Quality::Default => 1024,
-            Quality::Fast => 128,
+            Quality::Default => 2048,
+            Quality::Fast => 256,
             Quality::Custom { min_samples, .. } => min_samples.max(1),
         }
     }
