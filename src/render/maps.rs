@@ -115,7 +115,8 @@ fn path_disp(cam: &Camera, target: &Target, poses: &[(DMat3, DVec3)], x: f64, y:
 }
 
 /// Largest image path length (px) over the sensor: points on a 33 x 25 grid
-/// spanning the sensor edge to edge, 256 time steps, times 1.1 for safety.
+/// spanning the sensor edge to edge, 256 time steps, at least the rotation
+/// bound below, times 1.1 for safety.
 pub fn max_path_px(cam: &Camera, target: &Target, traj: &Trajectory) -> f64 {
     let poses = inv_poses(traj, 256);
     let (nx, ny) = (33, 25);
@@ -129,7 +130,15 @@ pub fn max_path_px(cam: &Camera, target: &Target, traj: &Trajectory) -> f64 {
             }
         }
     }
-    m * 1.1
+    // Points that leave the view still smear the pixels they cross: bound the
+    // image motion of rotation by the angle turned times the focal length in
+    // px at the sensor corner (where d(pixel)/d(angle) is largest).
+    let r = cam.sensor_rect();
+    let corner2 = r.u0.abs().max(r.u1.abs()).powi(2) + r.v0.abs().max(r.v1.abs()).powi(2);
+    let gain = cam.fx_px().max(cam.fy_px()) * (1.0 + corner2 / (cam.focal_mm * cam.focal_mm));
+    let table = traj.table(4096);
+    let angle: f64 = table.windows(2).map(|w| w[0].0.angle_between(w[1].0)).sum();
+    m.max(angle * gain) * 1.1
 }
 
 /// Computes the maps with `steps` time steps (chords of the track; choose
