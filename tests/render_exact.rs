@@ -17,6 +17,7 @@ fn tri(z: f64) -> f64 {
     }
 }
 
+#[allow(clippy::too_many_arguments)]
 /// Exact pixel value: checker of side `s` m at depth `d` m, camera moving with
 /// `v = (vx, vy, 0)` m/s for `te` s; pixel `(i, j)` of `cam` (no skew).
 /// Checker = (1 + sq(X/S) sq(Y/S)) / 2, X = vx t + d u / f.
@@ -83,7 +84,10 @@ fn render(cam: Camera, tw: Twist, te: f64, target: Target, q: Quality, seed: u32
     j.seed = seed;
     j.with_maps = false;
     let o = render_frame(&j).unwrap();
-    eprintln!("  N = {} samples/pixel, max path {:.1} px", o.samples_per_pixel, o.max_path_px);
+    eprintln!(
+        "  N = {} samples/pixel, max path {:.1} px",
+        o.samples_per_pixel, o.max_path_px
+    );
     o.rgb
 }
 
@@ -126,7 +130,14 @@ fn lateral_translation_equals_exact_box_integral() {
 fn fast_preset_error_is_bounded() {
     // The cheap preset is allowed 4x the default tolerances.
     check_translation(0.0, 0.0, 0.05, Quality::Fast, 4.0 * MEAN_TOL, 4.0 * P99_TOL);
-    check_translation(0.3, -0.2, 0.05, Quality::Fast, 4.0 * MEAN_TOL, 4.0 * P99_TOL);
+    check_translation(
+        0.3,
+        -0.2,
+        0.05,
+        Quality::Fast,
+        4.0 * MEAN_TOL,
+        4.0 * P99_TOL,
+    );
 }
 
 #[test]
@@ -175,7 +186,10 @@ fn exact_integral_sanity() {
 #[ignore]
 fn explore_n() {
     for n in [1024u32, 2048, 4096, 8192] {
-        let q = Quality::Custom { min_samples: n, max_spacing_px: 0.25 };
+        let q = Quality::Custom {
+            min_samples: n,
+            max_spacing_px: 0.25,
+        };
         check_translation(0.3, -0.2, 0.05, q, 1.0, 1.0);
         check_translation(0.0, 0.0, 0.05, q, 1.0, 1.0);
     }

@@ -58,7 +58,10 @@ fn mean_path_over_exposure_equals_time_averaged_mmbm() {
     // 1 % for a short exposure.
     let cases = [
         (Twist::rotation(0.0, 0.0, 2.0), 1e-3),
-        (Twist::new(DVec3::new(0.4, -0.3, 0.5), DVec3::new(0.2, 0.1, 0.3)), 1e-2),
+        (
+            Twist::new(DVec3::new(0.4, -0.3, 0.5), DVec3::new(0.2, 0.1, 0.3)),
+            1e-2,
+        ),
     ];
     for (tw, tol) in cases {
         let target = Target::checker(0.1, 1.5);
@@ -83,7 +86,10 @@ fn mean_path_over_exposure_equals_time_averaged_mmbm() {
             avg += mmbm(&s, &tw, Method::Exact { tol: 1e-9 }).unwrap().px_s / nt as f64;
         }
         let rel = (m.speed_px_s - avg).abs() / avg;
-        eprintln!("{tw:?}: mean path/te {:.4} px/s, time-averaged MMBM {avg:.4} px/s, rel {rel:.2e}", m.speed_px_s);
+        eprintln!(
+            "{tw:?}: mean path/te {:.4} px/s, time-averaged MMBM {avg:.4} px/s, rel {rel:.2e}",
+            m.speed_px_s
+        );
         assert!(rel < tol, "rel {rel}");
         assert!((m.valid - 1.0).abs() < 1e-12);
     }
@@ -108,11 +114,21 @@ fn doubling_samples_changes_image_less_than_the_error_bound() {
     ))
     .unwrap();
     assert_eq!(b.samples_per_pixel, n2);
-    let mut d: Vec<f32> = a.rgb.iter().zip(&b.rgb).map(|(x, y)| (x - y).abs()).collect();
+    let mut d: Vec<f32> = a
+        .rgb
+        .iter()
+        .zip(&b.rgb)
+        .map(|(x, y)| (x - y).abs())
+        .collect();
     let mean = d.iter().sum::<f32>() / d.len() as f32;
     d.sort_by(|x, y| x.partial_cmp(y).unwrap());
     let p99 = d[d.len() * 99 / 100];
-    eprintln!("N {} vs {n2}: mean |diff| {:.3}/255, p99 {:.3}/255", a.samples_per_pixel, mean * 255.0, p99 * 255.0);
+    eprintln!(
+        "N {} vs {n2}: mean |diff| {:.3}/255, p99 {:.3}/255",
+        a.samples_per_pixel,
+        mean * 255.0,
+        p99 * 255.0
+    );
     assert!(mean < 0.5 / 255.0 && p99 < 3.0 / 255.0);
 }
 
@@ -121,7 +137,8 @@ fn psf_sums_to_one_and_is_centred_on_the_mean_track() {
     // Pure lateral translation: the track is a straight line at constant speed,
     // so the PSF's centroid is half the displacement away from its centre.
     let cam = Camera::thesis().with_resolution(160, 120);
-    let tr = Trajectory::from_twist(Twist::new(DVec3::ZERO, DVec3::new(0.2, -0.1, 0.0)), 0.05).unwrap();
+    let tr =
+        Trajectory::from_twist(Twist::new(DVec3::ZERO, DVec3::new(0.2, -0.1, 0.0)), 0.05).unwrap();
     let t = Target::checker(0.1, 1.0);
     let k = render::psf(&cam, &t, &tr, 80.0, 60.0).unwrap();
     let s: f64 = k.weights.iter().map(|&w| w as f64).sum();
@@ -136,7 +153,10 @@ fn psf_sums_to_one_and_is_centred_on_the_mean_track() {
     // camera moves +x, -y: the image point moves -x, +y by v*te*f/(d*p) px
     let px = cam.focal_mm / cam.pitch_x_mm;
     let (ex, ey) = (-0.2 * 0.05 * px / 2.0, 0.1 * 0.05 * px / 2.0);
-    assert!((cx - half - ex).abs() < 0.02 && (cy - half - ey).abs() < 0.02, "{cx} {cy} {ex} {ey}");
+    assert!(
+        (cx - half - ex).abs() < 0.02 && (cy - half - ey).abs() < 0.02,
+        "{cx} {cy} {ex} {ey}"
+    );
     assert!(render::psf(&cam, &t, &tr, 500.0, 60.0).is_err());
 }
 
@@ -154,16 +174,38 @@ fn gyro_log_with_constant_rate_renders_like_the_twist() {
     let cam = Camera::thesis().with_resolution(64, 48);
     let t = Target::checker(0.05, 2.0);
     let q = Quality::Fast;
-    let a = render::render_frame(&cpu_job(cam, Trajectory::from_log(&s, 1.05, 0.05, false).unwrap(), t.clone(), q)).unwrap();
-    let b = render::render_frame(&cpu_job(cam, Trajectory::from_twist(Twist::rotation(w.x, w.y, w.z), 0.05).unwrap(), t, q)).unwrap();
-    let max = a.rgb.iter().zip(&b.rgb).map(|(x, y)| (x - y).abs()).fold(0.0f32, f32::max);
+    let a = render::render_frame(&cpu_job(
+        cam,
+        Trajectory::from_log(&s, 1.05, 0.05, false).unwrap(),
+        t.clone(),
+        q,
+    ))
+    .unwrap();
+    let b = render::render_frame(&cpu_job(
+        cam,
+        Trajectory::from_twist(Twist::rotation(w.x, w.y, w.z), 0.05).unwrap(),
+        t,
+        q,
+    ))
+    .unwrap();
+    let max = a
+        .rgb
+        .iter()
+        .zip(&b.rgb)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0f32, f32::max);
     assert!(max < 2e-2, "max diff {max}");
     let (ma, mb) = (a.maps.unwrap().means(), b.maps.unwrap().means());
     assert!((ma.path_px - mb.path_px).abs() < 1e-3 * mb.path_px);
     // window outside the log
-    let e = Trajectory::from_log(&s, 1.2, 0.1, false).unwrap_err().to_string();
+    let e = Trajectory::from_log(&s, 1.2, 0.1, false)
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("outside the gyro log"), "{e}");
-    assert!(Trajectory::from_log(&s, 1.05, 0.05, true).is_err(), "no velocity in the log");
+    assert!(
+        Trajectory::from_log(&s, 1.05, 0.05, true).is_err(),
+        "no velocity in the log"
+    );
 }
 
 #[test]
@@ -186,12 +228,19 @@ fn bad_input_is_rejected_with_clear_errors() {
     let d = tempfile::tempdir().unwrap();
     let bad = d.path().join("not_an_image.png");
     std::fs::write(&bad, b"hello").unwrap();
-    let e = Target::parse(&format!("image:{}:1.0", bad.display()), 1.0).unwrap_err().to_string();
+    let e = Target::parse(&format!("image:{}:1.0", bad.display()), 1.0)
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("not_an_image.png"), "{e}");
     assert!("fast".parse::<Quality>().is_ok() && "0:1".parse::<Quality>().is_err());
     // an absurd blur is refused instead of running forever
     let fast = Trajectory::from_twist(Twist::rotation(0.0, 5000.0, 0.0), 1.0).unwrap();
-    let e = match render::render_frame(&cpu_job(cam, fast, Target::checker(0.1, 1.0), Quality::Default)) {
+    let e = match render::render_frame(&cpu_job(
+        cam,
+        fast,
+        Target::checker(0.1, 1.0),
+        Quality::Default,
+    )) {
         Ok(o) => panic!("accepted an absurd blur: N = {}", o.samples_per_pixel),
         Err(e) => e.to_string(),
     };

@@ -12,15 +12,24 @@ use std::path::{Path, PathBuf};
 
 /// Render a ground-truth motion-blurred image of a planar target.
 #[derive(Args, Debug)]
-#[command(after_help = "Targets: checker:S (S = square side, m), blobs[:SCALE] (thesis 4x4 red board),
+#[command(
+    after_help = "Targets: checker:S (S = square side, m), blobs[:SCALE] (thesis 4x4 red board),
 image:PATH:WIDTH_M (PNG/JPEG, sRGB).
 Examples:
   mmbm render --omega 0.5,-0.3,0.2 --exposure 0.05 --target checker:0.05 --distance 2 --out blur.png
   mmbm render --omega 0,0,0 --velocity 0.3,0,0 --exposure 0.07 --target blobs --distance 3 \\
       --resolution 320x240 --out blobs.exr --maps maps.exr --sharp sharp.png --psf 160,120:psf.png
   mmbm render --gyro ../shared/data/running_phone/gyro.csv --at 2.0 --exposure 0.03 \\
-      --target checker:0.1 --distance 3 --out frame.png")]
+      --target checker:0.1 --distance 3 --out frame.png"
+)]
 pub struct RenderArgs {
+    #[command(flatten)]
+    pub opts: Box<RenderOpts>,
+}
+
+/// The options of `mmbm render` (boxed: the command enum stays small).
+#[derive(Args, Debug)]
+pub struct RenderOpts {
     /// Constant angular velocity WX,WY,WZ, rad/s (camera frame).
     #[arg(long, value_name = "WX,WY,WZ", value_parser = parse_vec3, allow_hyphen_values = true,
           required_unless_present = "gyro", conflicts_with = "gyro")]
@@ -87,20 +96,34 @@ pub struct RenderArgs {
 }
 
 fn pair(s: &str, what: &str) -> Result<[f64; 2]> {
-    let v: Vec<f64> = s.split(',').map(|x| x.trim().parse::<f64>()).collect::<std::result::Result<_, _>>()
-        .map_err(|_| Error::invalid(what, format!("'{s}': expected two comma-separated numbers")))?;
+    let v: Vec<f64> = s
+        .split(',')
+        .map(|x| x.trim().parse::<f64>())
+        .collect::<std::result::Result<_, _>>()
+        .map_err(|_| {
+            Error::invalid(what, format!("'{s}': expected two comma-separated numbers"))
+        })?;
     if v.len() != 2 || v.iter().any(|x| !x.is_finite()) {
-        return Err(Error::invalid(what, format!("'{s}': expected two finite numbers")));
+        return Err(Error::invalid(
+            what,
+            format!("'{s}': expected two finite numbers"),
+        ));
     }
     Ok([v[0], v[1]])
 }
 
 fn check_ext(p: &Path, allowed: &[&str], what: &str) -> Result<String> {
-    let e = p.extension().map(|e| e.to_string_lossy().to_lowercase()).unwrap_or_default();
+    let e = p
+        .extension()
+        .map(|e| e.to_string_lossy().to_lowercase())
+        .unwrap_or_default();
     if allowed.contains(&e.as_str()) {
         Ok(e)
     } else {
-        Err(Error::invalid(what, format!("{}: extension must be one of {allowed:?}", p.display())))
+        Err(Error::invalid(
+            what,
+            format!("{}: extension must be one of {allowed:?}", p.display()),
+        ))
     }
 }
 
@@ -109,13 +132,19 @@ fn write_image(p: &Path, o: &RenderOutput) -> Result<()> {
         let n = (o.width * o.height) as usize;
         let ch = |c: usize| (0..n).map(|i| o.rgb[3 * i + c]).collect::<Vec<f32>>();
         let (r, g, b) = (ch(0), ch(1), ch(2));
-        write_exr(p, o.width as usize, o.height as usize, &[("R", &r), ("G", &g), ("B", &b)])
+        write_exr(
+            p,
+            o.width as usize,
+            o.height as usize,
+            &[("R", &r), ("G", &g), ("B", &b)],
+        )
     } else {
         write_png_linear_rgb(p, o.width, o.height, &o.rgb)
     }
 }
 
-pub fn run(a: RenderArgs) -> Result<()> {
+pub fn run(args: RenderArgs) -> Result<()> {
+    let a = *args.opts;
     // Validate every output name before any work, so nothing is half-written.
     check_ext(&a.out, &["exr", "png"], "--out")?;
     if let Some(p) = &a.maps {
@@ -126,7 +155,9 @@ pub fn run(a: RenderArgs) -> Result<()> {
     }
     let psf = match &a.psf {
         Some(s) => {
-            let (xy, file) = s.split_once(':').ok_or_else(|| Error::invalid("--psf", format!("'{s}': expected X,Y:FILE")))?;
+            let (xy, file) = s
+                .split_once(':')
+                .ok_or_else(|| Error::invalid("--psf", format!("'{s}': expected X,Y:FILE")))?;
             let [x, y] = pair(xy, "--psf")?;
             let file = PathBuf::from(file);
             check_ext(&file, &["exr", "png"], "--psf")?;
@@ -139,14 +170,22 @@ pub fn run(a: RenderArgs) -> Result<()> {
         camera = camera.with_resolution(w, h);
     }
     let trajectory = match (&a.omega, &a.gyro) {
-        (Some(w), None) => Trajectory::from_twist(Twist::new(*w, a.velocity.unwrap_or_default()), a.exposure)?,
+        (Some(w), None) => {
+            Trajectory::from_twist(Twist::new(*w, a.velocity.unwrap_or_default()), a.exposure)?
+        }
         (None, Some(path)) => {
-            let at = a.at.ok_or_else(|| Error::invalid("--at", "required with --gyro"))?;
+            let at =
+                a.at.ok_or_else(|| Error::invalid("--at", "required with --gyro"))?;
             let samples = mmbm::gyro::read_log(path, a.gyro_opts.options()?)?;
             Trajectory::from_log(&samples, at, a.exposure, a.use_velocity)
                 .map_err(|e| Error::invalid("--gyro", format!("{}: {e}", path.display())))?
         }
-        _ => return Err(Error::invalid("motion", "give either --omega or --gyro with --at")),
+        _ => {
+            return Err(Error::invalid(
+                "motion",
+                "give either --omega or --gyro with --at",
+            ))
+        }
     };
     let mut target = Target::parse(&a.target, a.distance)?;
     if let Some(s) = &a.tilt {
@@ -163,7 +202,12 @@ pub fn run(a: RenderArgs) -> Result<()> {
         "auto" => Backend::Auto,
         "gpu" => Backend::Gpu,
         "cpu" => Backend::Cpu { threads: None },
-        b => return Err(Error::invalid("--backend", format!("'{b}': expected auto, gpu or cpu"))),
+        b => {
+            return Err(Error::invalid(
+                "--backend",
+                format!("'{b}': expected auto, gpu or cpu"),
+            ))
+        }
     };
     let job = RenderJob {
         camera,
@@ -177,7 +221,13 @@ pub fn run(a: RenderArgs) -> Result<()> {
     let t0 = std::time::Instant::now();
     let out = render::render_frame(&job)?;
     let psf_img = match &psf {
-        Some((x, y, _)) => Some(render::psf(&job.camera, &job.target, &job.trajectory, *x, *y)?),
+        Some((x, y, _)) => Some(render::psf(
+            &job.camera,
+            &job.target,
+            &job.trajectory,
+            *x,
+            *y,
+        )?),
         None => None,
     };
     let sharp = match &a.sharp {
@@ -186,11 +236,16 @@ pub fn run(a: RenderArgs) -> Result<()> {
     };
     write_image(&a.out, &out)?;
     if let (Some(p), Some(m)) = (&a.maps, &out.maps) {
-        write_exr(p, m.width as usize, m.height as usize, &[
-            ("path_px", &m.path_px),
-            ("disp_px", &m.disp_px),
-            ("speed_px_s", &m.speed_px_s),
-        ])?;
+        write_exr(
+            p,
+            m.width as usize,
+            m.height as usize,
+            &[
+                ("path_px", &m.path_px),
+                ("disp_px", &m.disp_px),
+                ("speed_px_s", &m.speed_px_s),
+            ],
+        )?;
         let mm = m.means();
         eprintln!(
             "exposure MMBM: mean path {:.3} px, mean displacement {:.3} px, mean speed {:.2} px/s = {:.4} mm/s ({:.1}% of pixels tracked)",
@@ -212,7 +267,12 @@ pub fn run(a: RenderArgs) -> Result<()> {
     }
     eprintln!(
         "{}x{}, {} samples/pixel (max path {:.1} px), {} in {:.2} s",
-        out.width, out.height, out.samples_per_pixel, out.max_path_px, out.backend_used, t0.elapsed().as_secs_f64()
+        out.width,
+        out.height,
+        out.samples_per_pixel,
+        out.max_path_px,
+        out.backend_used,
+        t0.elapsed().as_secs_f64()
     );
     Ok(())
 }

@@ -3,7 +3,7 @@
 //! with one thread and with all threads, at 320x240, 640x480 and 1920x1080;
 //! then the cost of a default-quality frame against blur length.
 
-use super::{kernel, maps, render_frame, Backend, Quality, RenderJob, Target, Trajectory};
+use super::{maps, render_frame, Backend, Quality, RenderJob, Target, Trajectory};
 use crate::camera::Camera;
 use crate::error::Result;
 use crate::motion::Twist;
@@ -12,8 +12,15 @@ use std::time::Instant;
 
 fn job(w: u32, h: u32, scale: f64, quality: Quality, backend: Backend) -> Result<RenderJob> {
     let cam = Camera::thesis().with_resolution(w, h);
-    let tw = Twist::new(DVec3::new(0.4, -0.6, 0.3) * scale, DVec3::new(0.05, 0.0, 0.1) * scale);
-    let mut j = RenderJob::new(cam, Trajectory::from_twist(tw, 0.05)?, Target::checker(0.05, 2.0));
+    let tw = Twist::new(
+        DVec3::new(0.4, -0.6, 0.3) * scale,
+        DVec3::new(0.05, 0.0, 0.1) * scale,
+    );
+    let mut j = RenderJob::new(
+        cam,
+        Trajectory::from_twist(tw, 0.05)?,
+        Target::checker(0.05, 2.0),
+    );
     j.quality = quality;
     j.backend = backend;
     j.with_maps = false;
@@ -40,7 +47,10 @@ pub fn bench() -> Result<()> {
         Err(e) => println!("render bench, no GPU ({e})"),
     }
     println!("  64 samples/pixel, checker, best of 2 (M pixel-samples/s):");
-    println!("  {:>10} {:>10} {:>10} {:>10}", "size", "gpu", "cpu x1", "cpu all");
+    println!(
+        "  {:>10} {:>10} {:>10} {:>10}",
+        "size", "gpu", "cpu x1", "cpu all"
+    );
     let q = Quality::Custom {
         min_samples: 64,
         max_spacing_px: 1e9,
@@ -64,12 +74,24 @@ pub fn bench() -> Result<()> {
         println!("{row}");
     }
     println!("  cost vs blur length, 320x240, default quality:");
-    println!("  {:>10} {:>8} {:>10} {:>10}", "max px", "N", "gpu ms", "cpu ms");
+    println!(
+        "  {:>10} {:>8} {:>10} {:>10}",
+        "max px", "N", "gpu ms", "cpu ms"
+    );
     for scale in [0.25, 1.0, 4.0, 16.0] {
-        let j = job(320, 240, scale, Quality::Default, Backend::Cpu { threads: None })?;
+        let j = job(
+            320,
+            240,
+            scale,
+            Quality::Default,
+            Backend::Cpu { threads: None },
+        )?;
         let l = maps::max_path_px(&j.camera, &j.target, &j.trajectory);
         let g = if gpu.is_ok() {
-            let jg = RenderJob { backend: Backend::Gpu, ..j.clone() };
+            let jg = RenderJob {
+                backend: Backend::Gpu,
+                ..j.clone()
+            };
             format!("{:>10.1}", time(&jg, 1)?.0 * 1e3)
         } else {
             format!("{:>10}", "-")
@@ -77,6 +99,15 @@ pub fn bench() -> Result<()> {
         let (tc, n) = time(&j, 1)?;
         println!("  {:>10.1} {:>8} {} {:>10.1}", l, n, g, tc * 1e3);
     }
-    let _ = kernel::LOD_SCALE;
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    /// `cargo test --release render::bench -- --ignored --nocapture` prints the numbers.
+    #[test]
+    #[ignore]
+    fn print_bench() {
+        super::bench().unwrap();
+    }
 }

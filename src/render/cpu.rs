@@ -34,7 +34,7 @@ fn shade(p: &RenderParams, tex: Option<&MipTexture>, q: Vec4, c: Vec3, px: f32, 
     let n = v3(p.normal);
     let den = n.dot(dw);
     let s = (p.origin[3] - n.dot(c)) / den;
-    if den.abs() < 1e-12 || !(s > 0.0) {
+    if den.abs() < 1e-12 || s.is_nan() || s <= 0.0 {
         return bg;
     }
     let d = c + dw * s - v3(p.origin);

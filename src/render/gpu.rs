@@ -60,7 +60,7 @@ pub fn render(
     let (w, h, n) = (p.dims[0], p.dims[1], p.dims[3]);
     let npix = w as u64 * h as u64;
     let out_bytes = npix * 16;
-    if out_bytes > ctx.device.limits().max_storage_buffer_binding_size as u64 {
+    if out_bytes > ctx.device.limits().max_storage_buffer_binding_size {
         return Err(Error::Gpu(format!(
             "{w}x{h} output ({out_bytes} bytes) exceeds the device's storage binding limit"
         )));

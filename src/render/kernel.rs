@@ -224,7 +224,12 @@ pub fn params(cam: &Camera, target: &Target, n: u32, segments: u32, seed: u32) -
     let bg = target.background;
     RenderParams {
         cam: [fx as f32, fy as f32, cam.cx as f32, cam.cy as f32],
-        cam2: [cam.skew as f32, (1.0 / (fx * fy).sqrt()) as f32, LOD_SCALE, 0.0],
+        cam2: [
+            cam.skew as f32,
+            (1.0 / (fx * fy).sqrt()) as f32,
+            LOD_SCALE,
+            0.0,
+        ],
         origin: v4(f.origin, f.normal.dot(f.origin)),
         e1: v4(f.e1, 0.0),
         e2: v4(f.e2, 0.0),

@@ -74,12 +74,7 @@ fn inv_poses(traj: &Trajectory, steps: usize) -> Vec<(DMat3, DVec3)> {
 
 fn proj(cam: &Camera, p: &(DMat3, DVec3), x: DVec3) -> Option<(f64, f64)> {
     let pc = p.0 * (x - p.1);
-    (pc.z > 1e-12).then(|| {
-        cam.mm_to_pixel(
-            cam.focal_mm * pc.x / pc.z,
-            cam.focal_mm * pc.y / pc.z,
-        )
-    })
+    (pc.z > 1e-12).then(|| cam.mm_to_pixel(cam.focal_mm * pc.x / pc.z, cam.focal_mm * pc.y / pc.z))
 }
 
 /// Image track (pixel coordinates) of the scene point seen at `(x, y)` at
@@ -100,7 +95,13 @@ pub fn track(
         .collect()
 }
 
-fn path_disp(cam: &Camera, target: &Target, poses: &[(DMat3, DVec3)], x: f64, y: f64) -> Option<(f64, f64)> {
+fn path_disp(
+    cam: &Camera,
+    target: &Target,
+    poses: &[(DMat3, DVec3)],
+    x: f64,
+    y: f64,
+) -> Option<(f64, f64)> {
     let id: Pose = (glam::DQuat::IDENTITY, DVec3::ZERO);
     let p0 = target.intersect(cam, &id, x, y)?;
     let first = proj(cam, &poses[0], p0)?;
@@ -111,7 +112,10 @@ fn path_disp(cam: &Camera, target: &Target, poses: &[(DMat3, DVec3)], x: f64, y:
         len += ((q.0 - prev.0).powi(2) + (q.1 - prev.1).powi(2)).sqrt();
         prev = q;
     }
-    Some((len, ((prev.0 - first.0).powi(2) + (prev.1 - first.1).powi(2)).sqrt()))
+    Some((
+        len,
+        ((prev.0 - first.0).powi(2) + (prev.1 - first.1).powi(2)).sqrt(),
+    ))
 }
 
 /// Largest image path length (px) over the sensor: points on a 33 x 25 grid

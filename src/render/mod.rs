@@ -41,9 +41,10 @@ use std::sync::atomic::{AtomicBool, Ordering};
 pub const MAX_SAMPLES: u32 = 1 << 22;
 
 /// Sampling quality.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub enum Quality {
     /// What `mmbm render` uses: >= 2048 samples, <= 0.25 px between time samples.
+    #[default]
     Default,
     /// Cheaper, for many frames: >= 256 samples, <= 0.5 px between time samples.
     Fast,
@@ -54,12 +55,6 @@ pub enum Quality {
         /// Maximum image distance between consecutive time samples, px.
         max_spacing_px: f64,
     },
-}
-
-impl Default for Quality {
-    fn default() -> Self {
-        Quality::Default
-    }
 }
 
 impl Quality {
@@ -84,11 +79,14 @@ impl Quality {
     /// Samples per pixel for a largest image path of `max_path_px`.
     pub fn samples_for(&self, max_path_px: f64) -> Result<u32> {
         let s = self.max_spacing_px();
-        if !(s > 0.0 && s.is_finite()) {
-            return Err(Error::invalid("quality", format!("spacing must be > 0 px, got {s}")));
+        if s.is_nan() || s <= 0.0 || s.is_infinite() {
+            return Err(Error::invalid(
+                "quality",
+                format!("spacing must be > 0 px, got {s}"),
+            ));
         }
         let n = (max_path_px / s).ceil().max(self.min_samples() as f64);
-        if !(n <= MAX_SAMPLES as f64) {
+        if n.is_nan() || n > MAX_SAMPLES as f64 {
             return Err(Error::invalid(
                 "blur",
                 format!(
@@ -225,16 +223,25 @@ pub fn render_frame(job: &RenderJob) -> Result<RenderOutput> {
     let tex = kernel::texture_of(&job.target);
     let cpu = |threads: Option<usize>| {
         let t = threads.unwrap_or_else(rayon::current_num_threads);
-        (cpu::render(&params, &poses, tex, threads), format!("cpu ({t} threads)"))
+        (
+            cpu::render(&params, &poses, tex, threads),
+            format!("cpu ({t} threads)"),
+        )
     };
     let (rgb, backend_used) = match job.backend {
         Backend::Cpu { threads } => cpu(threads),
         Backend::Gpu => {
             let ctx = crate::gpu::gpu()?;
-            (gpu::render(ctx, &params, &poses, tex)?, format!("gpu: {}", ctx.description))
+            (
+                gpu::render(ctx, &params, &poses, tex)?,
+                format!("gpu: {}", ctx.description),
+            )
         }
         Backend::Auto => match crate::gpu::gpu() {
-            Ok(ctx) => (gpu::render(ctx, &params, &poses, tex)?, format!("gpu: {}", ctx.description)),
+            Ok(ctx) => (
+                gpu::render(ctx, &params, &poses, tex)?,
+                format!("gpu: {}", ctx.description),
+            ),
             Err(e) => {
                 if !ANNOUNCED.swap(true, Ordering::Relaxed) {
                     eprintln!("render: {e}; using the CPU renderer");
@@ -261,7 +268,10 @@ pub fn render_frame(job: &RenderJob) -> Result<RenderOutput> {
 /// The sharp frame at exposure start (no motion), same quality and backend.
 pub fn render_sharp(job: &RenderJob) -> Result<RenderOutput> {
     let still = RenderJob {
-        trajectory: Trajectory::from_twist(crate::motion::Twist::default(), job.trajectory.duration())?,
+        trajectory: Trajectory::from_twist(
+            crate::motion::Twist::default(),
+            job.trajectory.duration(),
+        )?,
         with_maps: false,
         ..job.clone()
     };

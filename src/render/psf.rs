@@ -26,7 +26,10 @@ pub fn psf(cam: &Camera, target: &Target, traj: &Trajectory, x: f64, y: f64) -> 
     if !(x >= 0.0 && y >= 0.0 && x < cam.width as f64 && y < cam.height as f64) {
         return Err(Error::invalid(
             "--psf",
-            format!("pixel ({x}, {y}) is outside the {}x{} sensor", cam.width, cam.height),
+            format!(
+                "pixel ({x}, {y}) is outside the {}x{} sensor",
+                cam.width, cam.height
+            ),
         ));
     }
     let lmax = max_path_px(cam, target, traj);
@@ -44,7 +47,10 @@ pub fn psf(cam: &Camera, target: &Target, traj: &Trajectory, x: f64, y: f64) -> 
         .fold(0.0, f64::max);
     let half = ext.ceil() as i64 + 1;
     if half > 2048 {
-        return Err(Error::invalid("--psf", format!("blur too long for a PSF image ({ext:.0} px)")));
+        return Err(Error::invalid(
+            "--psf",
+            format!("blur too long for a PSF image ({ext:.0} px)"),
+        ));
     }
     let size = (2 * half + 1) as u32;
     let mut wts = vec![0.0f64; (size * size) as usize];

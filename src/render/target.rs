@@ -84,12 +84,10 @@ pub struct PlaneFrame {
 }
 
 fn num(spec: &str, s: &str, what: &str) -> Result<f64> {
-    let x: f64 = s.trim().parse().map_err(|_| {
-        Error::invalid(
-            "target",
-            format!("'{spec}': {what} '{s}' is not a number"),
-        )
-    })?;
+    let x: f64 = s
+        .trim()
+        .parse()
+        .map_err(|_| Error::invalid("target", format!("'{spec}': {what} '{s}' is not a number")))?;
     positive(&format!("target '{spec}' {what}"), x)
 }
 
@@ -108,10 +106,7 @@ impl Target {
             },
             "image" => {
                 let (path, w) = rest.rsplit_once(':').ok_or_else(|| {
-                    Error::invalid(
-                        "target",
-                        format!("'{spec}': expected image:PATH:WIDTH_M"),
-                    )
+                    Error::invalid("target", format!("'{spec}': expected image:PATH:WIDTH_M"))
                 })?;
                 let width_m = num(spec, w, "width (m)")?;
                 let path = PathBuf::from(path);
@@ -194,7 +189,9 @@ impl Target {
         match &self.kind {
             TargetKind::Checker { size } => positive("checker size (m)", *size).map(|_| ())?,
             TargetKind::Blobs { scale } => positive("blobs scale", *scale).map(|_| ())?,
-            TargetKind::Image { width_m, .. } => positive("image width (m)", *width_m).map(|_| ())?,
+            TargetKind::Image { width_m, .. } => {
+                positive("image width (m)", *width_m).map(|_| ())?
+            }
         }
         let f = self.frame();
         let dn = f.normal.dot(f.origin);
@@ -255,12 +252,7 @@ impl Target {
 /// `p` seen from `pose`, or `None` when it is behind the camera.
 pub fn project(cam: &Camera, pose: &Pose, p: DVec3) -> Option<(f64, f64)> {
     let pc = pose.0.inverse() * (p - pose.1);
-    (pc.z > 1e-12).then(|| {
-        cam.mm_to_pixel(
-            cam.focal_mm * pc.x / pc.z,
-            cam.focal_mm * pc.y / pc.z,
-        )
-    })
+    (pc.z > 1e-12).then(|| cam.mm_to_pixel(cam.focal_mm * pc.x / pc.z, cam.focal_mm * pc.y / pc.z))
 }
 
 #[cfg(test)]

@@ -40,8 +40,8 @@ fn halve(l: &MipLevel) -> MipLevel {
                 let (sx, sy) = (2 * x + dx, 2 * y + dy);
                 if sx < l.w && sy < l.h {
                     let i = ((sy * l.w + sx) * 3) as usize;
-                    for c in 0..3 {
-                        acc[c] += l.rgb[i + c];
+                    for (c, a) in acc.iter_mut().enumerate() {
+                        *a += l.rgb[i + c];
                     }
                     n += 1.0;
                 }
@@ -65,7 +65,10 @@ impl MipTexture {
             ));
         }
         let mut levels = vec![MipLevel { w, h, rgb }];
-        while levels.last().is_some_and(|l| l.w > MAX_TEXTURE_SIDE || l.h > MAX_TEXTURE_SIDE) {
+        while levels
+            .last()
+            .is_some_and(|l| l.w > MAX_TEXTURE_SIDE || l.h > MAX_TEXTURE_SIDE)
+        {
             let l = halve(levels.last().expect("non-empty"));
             levels = vec![l];
         }
@@ -151,7 +154,7 @@ mod tests {
         assert_eq!((t.levels[1].w, t.levels[1].h), (3, 2));
         // texel centre (i+0.5)/w returns the texel exactly
         let c = t.bilinear(0, 2.5 / 6.0, 1.5 / 3.0);
-        let i = ((1 * w + 2) * 3) as usize;
+        let i = ((w + 2) * 3) as usize; // texel (2, 1)
         assert_eq!(c, [rgb[i], rgb[i + 1], rgb[i + 2]]);
         assert!(MipTexture::from_linear(2, 2, vec![0.0; 3]).is_err());
         assert!(MipTexture::load(Path::new("/nonexistent/tex.png")).is_err());

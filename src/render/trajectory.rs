@@ -121,9 +121,7 @@ impl Trajectory {
         if t0 < first || t1 > last {
             return Err(Error::invalid(
                 "exposure window",
-                format!(
-                    "[{t0}, {t1}] s is outside the gyro log, which covers [{first}, {last}] s"
-                ),
+                format!("[{t0}, {t1}] s is outside the gyro log, which covers [{first}, {last}] s"),
             ));
         }
         if use_velocity {
@@ -144,7 +142,9 @@ impl Trajectory {
         let n = ((duration / dt_min * 16.0).ceil() as usize).clamp(512, 1 << 20);
         let h = duration / n as f64;
         let interp = |t: f64| -> (DVec3, DVec3) {
-            let i = samples.partition_point(|s| s.t <= t).clamp(1, samples.len() - 1);
+            let i = samples
+                .partition_point(|s| s.t <= t)
+                .clamp(1, samples.len() - 1);
             let (a, b) = (&samples[i - 1], &samples[i]);
             let f = ((t - a.t) / (b.t - a.t)).clamp(0.0, 1.0);
             let w = a.omega.lerp(b.omega, f);
