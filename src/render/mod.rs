@@ -1,1 +1,279 @@
-//! (being built)
+//! Ground-truth motion-blur renderer (SPEC section 4).
+//!
+//! A textured planar [`Target`] seen by a [`Camera`] moving along a
+//! [`Trajectory`] during one exposure (box shutter). Each pixel is the mean of
+//! `N` samples over its area and the exposure time (a 3-D rank-1 lattice with
+//! a per-pixel random shift, see [`kernel`]); each sample intersects the ray
+//! through its sensor point, from the pose at its instant, with the target
+//! plane and evaluates the target in linear light. `N` is chosen from the
+//! trajectory: at least `quality.min_samples()`, and enough that consecutive
+//! time samples of any pixel are at most `quality.max_spacing_px()` apart on
+//! the image (from the largest image path length over the sensor).
+//!
+//! The GPU kernel is `shaders/render.wgsl` ([`gpu`]); its CPU twin ([`cpu`]) is
+//! used when no adapter exists (announced once on stderr). [`maps`] gives the
+//! per-pixel blur ground truth (path length, displacement, speed), [`psf`] the
+//! point-spread function at a pixel.
+
+pub mod bench;
+pub mod cpu;
+pub mod gpu;
+pub mod kernel;
+pub mod maps;
+pub mod psf;
+pub mod target;
+pub mod texture;
+pub mod trajectory;
+
+pub use bench::bench;
+pub use maps::{blur_maps, BlurMaps, BlurMeans};
+pub use psf::{psf, Psf};
+pub use target::{project, Target, TargetKind};
+pub use trajectory::{Pose, Trajectory};
+
+use crate::camera::Camera;
+use crate::error::{Error, Result};
+use std::fmt;
+use std::str::FromStr;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+/// Largest sample count per pixel accepted (a longer blur is an error).
+pub const MAX_SAMPLES: u32 = 1 << 22;
+
+/// Sampling quality.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum Quality {
+    /// What `mmbm render` uses: >= 2048 samples, <= 0.25 px between time samples.
+    #[default]
+    Default,
+    /// Cheaper, for many frames: >= 256 samples, <= 0.5 px between time samples.
+    Fast,
+    /// Explicit minimum sample count and maximum time-sample spacing (px).
+    Custom {
+        /// Minimum samples per pixel.
+        min_samples: u32,
+        /// Maximum image distance between consecutive time samples, px.
+        max_spacing_px: f64,
+    },
+}
+
+impl Quality {
+    /// Minimum samples per pixel.
+    pub fn min_samples(&self) -> u32 {
+        match *self {
+            Quality::Default => 2048,
+            Quality::Fast => 256,
+            Quality::Custom { min_samples, .. } => min_samples.max(1),
+        }
+    }
+
+    /// Maximum image distance (px) between consecutive time samples.
+    pub fn max_spacing_px(&self) -> f64 {
+        match *self {
+            Quality::Default => 0.25,
+            Quality::Fast => 0.5,
+            Quality::Custom { max_spacing_px, .. } => max_spacing_px,
+        }
+    }
+
+    /// Samples per pixel for a largest image path of `max_path_px`.
+    pub fn samples_for(&self, max_path_px: f64) -> Result<u32> {
+        let s = self.max_spacing_px();
+        if s.is_nan() || s <= 0.0 || s.is_infinite() {
+            return Err(Error::invalid(
+                "quality",
+                format!("spacing must be > 0 px, got {s}"),
+            ));
+        }
+        let n = (max_path_px / s).ceil().max(self.min_samples() as f64);
+        if n.is_nan() || n > MAX_SAMPLES as f64 {
+            return Err(Error::invalid(
+                "blur",
+                format!(
+                    "the image path reaches {max_path_px:.0} px, which needs {n:.0} samples per \
+                     pixel (limit {MAX_SAMPLES}); shorten the exposure or the motion"
+                ),
+            ));
+        }
+        Ok(n as u32)
+    }
+}
+
+impl FromStr for Quality {
+    type Err = Error;
+    /// `default`, `fast`, or `MIN_SAMPLES:SPACING_PX` (e.g. `4096:0.1`).
+    fn from_str(s: &str) -> Result<Self> {
+        match s {
+            "default" => Ok(Quality::Default),
+            "fast" => Ok(Quality::Fast),
+            _ => {
+                let bad = || {
+                    Error::invalid(
+                        "quality",
+                        format!("'{s}': expected default, fast or MIN_SAMPLES:SPACING_PX"),
+                    )
+                };
+                let (a, b) = s.split_once(':').ok_or_else(bad)?;
+                let min_samples: u32 = a.trim().parse().map_err(|_| bad())?;
+                let max_spacing_px: f64 = b.trim().parse().map_err(|_| bad())?;
+                if min_samples == 0 || !(max_spacing_px > 0.0 && max_spacing_px.is_finite()) {
+                    return Err(bad());
+                }
+                Ok(Quality::Custom {
+                    min_samples,
+                    max_spacing_px,
+                })
+            }
+        }
+    }
+}
+
+impl fmt::Display for Quality {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Quality::Default => write!(f, "default"),
+            Quality::Fast => write!(f, "fast"),
+            Quality::Custom {
+                min_samples,
+                max_spacing_px,
+            } => write!(f, "{min_samples}:{max_spacing_px}"),
+        }
+    }
+}
+
+/// Where the kernel runs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Backend {
+    /// The GPU when an adapter exists, else the CPU twin (announced on stderr).
+    #[default]
+    Auto,
+    /// The GPU or an error.
+    Gpu,
+    /// The CPU twin; `threads = None` uses rayon's global pool.
+    Cpu {
+        /// Worker threads.
+        threads: Option<usize>,
+    },
+}
+
+/// One frame to render.
+#[derive(Debug, Clone)]
+pub struct RenderJob {
+    /// Camera intrinsics.
+    pub camera: Camera,
+    /// Camera motion during the exposure.
+    pub trajectory: Trajectory,
+    /// The target.
+    pub target: Target,
+    /// Sampling quality.
+    pub quality: Quality,
+    /// GPU or CPU.
+    pub backend: Backend,
+    /// Seed of the per-pixel sample shifts.
+    pub seed: u32,
+    /// Also compute the per-pixel blur maps.
+    pub with_maps: bool,
+}
+
+impl RenderJob {
+    /// Default quality, automatic backend, seed 0, with maps.
+    pub fn new(camera: Camera, trajectory: Trajectory, target: Target) -> Self {
+        RenderJob {
+            camera,
+            trajectory,
+            target,
+            quality: Quality::Default,
+            backend: Backend::Auto,
+            seed: 0,
+            with_maps: true,
+        }
+    }
+}
+
+/// A rendered frame.
+#[derive(Debug, Clone)]
+pub struct RenderOutput {
+    /// Width, px.
+    pub width: u32,
+    /// Height, px.
+    pub height: u32,
+    /// Linear RGB (0..1), interleaved, row-major, top row first.
+    pub rgb: Vec<f32>,
+    /// Blur maps (when requested).
+    pub maps: Option<BlurMaps>,
+    /// Samples per pixel used.
+    pub samples_per_pixel: u32,
+    /// Largest image path length over the sensor (px, with the 1.1 safety factor).
+    pub max_path_px: f64,
+    /// `gpu: <adapter>` or `cpu (N threads)`.
+    pub backend_used: String,
+}
+
+static ANNOUNCED: AtomicBool = AtomicBool::new(false);
+
+/// Renders one frame.
+pub fn render_frame(job: &RenderJob) -> Result<RenderOutput> {
+    let cam = &job.camera;
+    job.target.validate_for(cam)?;
+    let lmax = maps::max_path_px(cam, &job.target, &job.trajectory);
+    let n = job.quality.samples_for(lmax)?;
+    let segments = ((lmax / 0.02).ceil() as usize).clamp(256, 1 << 16);
+    let poses = kernel::gpu_poses(&job.trajectory.table(segments));
+    let params = kernel::params(cam, &job.target, n, segments as u32, job.seed);
+    let tex = kernel::texture_of(&job.target);
+    let cpu = |threads: Option<usize>| {
+        let t = threads.unwrap_or_else(rayon::current_num_threads);
+        (
+            cpu::render(&params, &poses, tex, threads),
+            format!("cpu ({t} threads)"),
+        )
+    };
+    let (rgb, backend_used) = match job.backend {
+        Backend::Cpu { threads } => cpu(threads),
+        Backend::Gpu => {
+            let ctx = crate::gpu::gpu()?;
+            (
+                gpu::render(ctx, &params, &poses, tex)?,
+                format!("gpu: {}", ctx.description),
+            )
+        }
+        Backend::Auto => match crate::gpu::gpu() {
+            Ok(ctx) => (
+                gpu::render(ctx, &params, &poses, tex)?,
+                format!("gpu: {}", ctx.description),
+            ),
+            Err(e) => {
+                if !ANNOUNCED.swap(true, Ordering::Relaxed) {
+                    eprintln!("render: {e}; using the CPU renderer");
+                }
+                cpu(None)
+            }
+        },
+    };
+    let maps = job.with_maps.then(|| {
+        let steps = ((lmax / 0.25).ceil() as usize).clamp(64, 4096);
+        maps::blur_maps(cam, &job.target, &job.trajectory, steps)
+    });
+    Ok(RenderOutput {
+        width: cam.width,
+        height: cam.height,
+        rgb,
+        maps,
+        samples_per_pixel: n,
+        max_path_px: lmax,
+        backend_used,
+    })
+}
+
+/// The sharp frame at exposure start (no motion), same quality and backend.
+pub fn render_sharp(job: &RenderJob) -> Result<RenderOutput> {
+    let still = RenderJob {
+        trajectory: Trajectory::from_twist(
+            crate::motion::Twist::default(),
+            job.trajectory.duration(),
+        )?,
+        with_maps: false,
+        ..job.clone()
+    };
+    render_frame(&still)
+}

@@ -1,0 +1,197 @@
+//! GPU path of the renderer: `shaders/render.wgsl` on the shared wgpu device.
+//! Big images and long sample sets are split into dispatches of at most
+//! [`SAMPLES_PER_DISPATCH`] pixel-samples (row tiles, then sample ranges
+//! accumulated in place), each submitted and waited for separately, so that no
+//! single dispatch runs long enough to trip a GPU watchdog.
+
+use super::kernel::{with_range, GpuPose, RenderParams};
+use super::texture::MipTexture;
+use crate::error::{Error, Result};
+use crate::gpu::GpuContext;
+use std::sync::OnceLock;
+use wgpu::util::DeviceExt;
+
+/// WGSL source of the kernel.
+pub const SHADER: &str = include_str!("../../shaders/render.wgsl");
+
+/// Upper bound of pixel-samples in one dispatch.
+pub const SAMPLES_PER_DISPATCH: u64 = 1 << 25;
+
+static PIPELINE: OnceLock<std::result::Result<wgpu::ComputePipeline, String>> = OnceLock::new();
+
+fn pipeline(ctx: &GpuContext) -> Result<&'static wgpu::ComputePipeline> {
+    PIPELINE
+        .get_or_init(|| {
+            let scope = ctx.device.push_error_scope(wgpu::ErrorFilter::Validation);
+            let module = ctx
+                .device
+                .create_shader_module(wgpu::ShaderModuleDescriptor {
+                    label: Some("render.wgsl"),
+                    source: wgpu::ShaderSource::Wgsl(SHADER.into()),
+                });
+            let p = ctx
+                .device
+                .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                    label: Some("render"),
+                    layout: None,
+                    module: &module,
+                    entry_point: Some("main"),
+                    compilation_options: Default::default(),
+                    cache: None,
+                });
+            match pollster::block_on(scope.pop()) {
+                Some(e) => Err(format!("render pipeline: {e}")),
+                None => Ok(p),
+            }
+        })
+        .as_ref()
+        .map_err(|e| Error::Gpu(e.clone()))
+}
+
+/// Renders on the GPU; returns linear RGB interleaved (mean over N samples).
+pub fn render(
+    ctx: &GpuContext,
+    p: &RenderParams,
+    poses: &[GpuPose],
+    tex: Option<&MipTexture>,
+) -> Result<Vec<f32>> {
+    let pipe = pipeline(ctx)?;
+    let dev = &ctx.device;
+    let (w, h, n) = (p.dims[0], p.dims[1], p.dims[3]);
+    let npix = w as u64 * h as u64;
+    let out_bytes = npix * 16;
+    if out_bytes > ctx.device.limits().max_storage_buffer_binding_size {
+        return Err(Error::Gpu(format!(
+            "{w}x{h} output ({out_bytes} bytes) exceeds the device's storage binding limit"
+        )));
+    }
+    let scope = dev.push_error_scope(wgpu::ErrorFilter::Validation);
+    let (texels, levels) = match tex {
+        Some(t) => t.packed(),
+        None => (vec![0.0f32; 4], vec![[0u32, 1, 1, 0]]),
+    };
+    let storage = |label: &str, bytes: &[u8]| {
+        dev.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some(label),
+            contents: bytes,
+            usage: wgpu::BufferUsages::STORAGE,
+        })
+    };
+    let b_poses = storage("poses", bytemuck::cast_slice(poses));
+    let b_tex = storage("texels", bytemuck::cast_slice(&texels));
+    let b_lev = storage("levels", bytemuck::cast_slice(&levels));
+    let b_out = dev.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("out"),
+        size: out_bytes,
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+        mapped_at_creation: false,
+    });
+    let b_par = dev.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("params"),
+        size: std::mem::size_of::<RenderParams>() as u64,
+        usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let bgl = pipe.get_bind_group_layout(0);
+    let bg = dev.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("render"),
+        layout: &bgl,
+        entries: &[
+            wgpu::BindGroupEntry {
+                binding: 0,
+                resource: b_par.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 1,
+                resource: b_poses.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 2,
+                resource: b_tex.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 3,
+                resource: b_lev.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 4,
+                resource: b_out.as_entire_binding(),
+            },
+        ],
+    });
+    // Tiling: rows per dispatch, and samples per dispatch when one row is too much.
+    let row_cost = w as u64 * n as u64;
+    let rows = (SAMPLES_PER_DISPATCH / row_cost.max(1)).clamp(1, h as u64) as u32;
+    let kstep = if rows == 1 {
+        (SAMPLES_PER_DISPATCH / w as u64).clamp(1, n as u64) as u32
+    } else {
+        n
+    };
+    let mut row0 = 0;
+    while row0 < h {
+        let nr = rows.min(h - row0);
+        let mut k0 = 0;
+        while k0 < n {
+            let k1 = (k0 + kstep).min(n);
+            let pr = with_range(p, row0, nr, k0, k1);
+            ctx.queue.write_buffer(&b_par, 0, bytemuck::bytes_of(&pr));
+            let mut enc = dev.create_command_encoder(&Default::default());
+            {
+                let mut pass = enc.begin_compute_pass(&Default::default());
+                pass.set_pipeline(pipe);
+                pass.set_bind_group(0, &bg, &[]);
+                pass.dispatch_workgroups(w.div_ceil(8), nr.div_ceil(8), 1);
+            }
+            ctx.queue.submit([enc.finish()]);
+            dev.poll(wgpu::PollType::wait_indefinitely())
+                .map_err(|e| Error::Gpu(format!("render dispatch: {e}")))?;
+            k0 = k1;
+        }
+        row0 += nr;
+    }
+    let b_read = dev.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("readback"),
+        size: out_bytes,
+        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let mut enc = dev.create_command_encoder(&Default::default());
+    enc.copy_buffer_to_buffer(&b_out, 0, &b_read, 0, out_bytes);
+    ctx.queue.submit([enc.finish()]);
+    if let Some(e) = pollster::block_on(scope.pop()) {
+        return Err(Error::Gpu(format!("render: {e}")));
+    }
+    let (tx, rx) = std::sync::mpsc::channel();
+    b_read.map_async(wgpu::MapMode::Read, .., move |r| {
+        let _ = tx.send(r);
+    });
+    dev.poll(wgpu::PollType::wait_indefinitely())
+        .map_err(|e| Error::Gpu(format!("render readback: {e}")))?;
+    rx.recv()
+        .map_err(|e| Error::Gpu(format!("render readback: {e}")))?
+        .map_err(|e| Error::Gpu(format!("render readback: {e}")))?;
+    let view = b_read
+        .get_mapped_range(..)
+        .map_err(|e| Error::Gpu(format!("render readback: {e}")))?;
+    let sums: &[[f32; 4]] = bytemuck::cast_slice(&view);
+    let inv = 1.0 / n as f32;
+    let mut out = Vec::with_capacity((npix * 3) as usize);
+    for s in sums {
+        out.extend_from_slice(&[s[0] * inv, s[1] * inv, s[2] * inv]);
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn shader_parses_and_validates() {
+        let m = naga::front::wgsl::parse_str(super::SHADER).expect("render.wgsl parses");
+        naga::valid::Validator::new(
+            naga::valid::ValidationFlags::all(),
+            naga::valid::Capabilities::default(),
+        )
+        .validate(&m)
+        .expect("render.wgsl validates");
+    }
+}

@@ -1,0 +1,172 @@
+//! Ground-truth blur maps (SPEC section 4): for every pixel, the scene point
+//! seen at its centre at exposure start is followed through the exposure;
+//! its image path length (px), end-to-start displacement (px) and
+//! time-averaged image speed (px/s = path / duration). Their sensor means are
+//! the "exposure MMBM". Pixels whose scene point is missing (ray misses the
+//! target, or the point goes behind the camera) are NaN and left out of the means.
+
+use super::target::Target;
+use super::trajectory::{Pose, Trajectory};
+use crate::camera::Camera;
+use glam::{DMat3, DVec3};
+use rayon::prelude::*;
+
+/// Per-pixel blur maps, row-major, top row first.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BlurMaps {
+    /// Width, px.
+    pub width: u32,
+    /// Height, px.
+    pub height: u32,
+    /// Exposure, s.
+    pub duration: f64,
+    /// Path length of the image point over the exposure, px.
+    pub path_px: Vec<f32>,
+    /// End-to-start displacement, px.
+    pub disp_px: Vec<f32>,
+    /// Time-averaged image speed, px/s.
+    pub speed_px_s: Vec<f32>,
+}
+
+/// Sensor means of [`BlurMaps`] (NaN pixels left out).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BlurMeans {
+    /// Mean path length, px (the exposure MMBM as a blur length).
+    pub path_px: f64,
+    /// Mean displacement, px.
+    pub disp_px: f64,
+    /// Mean speed, px/s (the exposure MMBM in px/s).
+    pub speed_px_s: f64,
+    /// Share of pixels with a valid track (0..1).
+    pub valid: f64,
+}
+
+impl BlurMaps {
+    /// Sensor means, f64 accumulation.
+    pub fn means(&self) -> BlurMeans {
+        let mut s = [0.0f64; 3];
+        let mut n = 0usize;
+        for i in 0..self.path_px.len() {
+            if self.path_px[i].is_finite() {
+                s[0] += self.path_px[i] as f64;
+                s[1] += self.disp_px[i] as f64;
+                s[2] += self.speed_px_s[i] as f64;
+                n += 1;
+            }
+        }
+        let d = n.max(1) as f64;
+        BlurMeans {
+            path_px: s[0] / d,
+            disp_px: s[1] / d,
+            speed_px_s: s[2] / d,
+            valid: n as f64 / self.path_px.len().max(1) as f64,
+        }
+    }
+}
+
+/// Poses at `steps + 1` uniform times, as (world-to-camera rotation, centre).
+fn inv_poses(traj: &Trajectory, steps: usize) -> Vec<(DMat3, DVec3)> {
+    traj.table(steps)
+        .iter()
+        .map(|(q, c)| (DMat3::from_quat(q.inverse()), *c))
+        .collect()
+}
+
+fn proj(cam: &Camera, p: &(DMat3, DVec3), x: DVec3) -> Option<(f64, f64)> {
+    let pc = p.0 * (x - p.1);
+    (pc.z > 1e-12).then(|| cam.mm_to_pixel(cam.focal_mm * pc.x / pc.z, cam.focal_mm * pc.y / pc.z))
+}
+
+/// Image track (pixel coordinates) of the scene point seen at `(x, y)` at
+/// exposure start, at `steps + 1` uniform times; `None` when it is lost.
+pub fn track(
+    cam: &Camera,
+    target: &Target,
+    traj: &Trajectory,
+    x: f64,
+    y: f64,
+    steps: usize,
+) -> Option<Vec<(f64, f64)>> {
+    let id: Pose = (glam::DQuat::IDENTITY, DVec3::ZERO);
+    let p0 = target.intersect(cam, &id, x, y)?;
+    inv_poses(traj, steps)
+        .iter()
+        .map(|p| proj(cam, p, p0))
+        .collect()
+}
+
+fn path_disp(
+    cam: &Camera,
+    target: &Target,
+    poses: &[(DMat3, DVec3)],
+    x: f64,
+    y: f64,
+) -> Option<(f64, f64)> {
+    let id: Pose = (glam::DQuat::IDENTITY, DVec3::ZERO);
+    let p0 = target.intersect(cam, &id, x, y)?;
+    let first = proj(cam, &poses[0], p0)?;
+    let mut prev = first;
+    let mut len = 0.0;
+    for p in &poses[1..] {
+        let q = proj(cam, p, p0)?;
+        len += ((q.0 - prev.0).powi(2) + (q.1 - prev.1).powi(2)).sqrt();
+        prev = q;
+    }
+    Some((
+        len,
+        ((prev.0 - first.0).powi(2) + (prev.1 - first.1).powi(2)).sqrt(),
+    ))
+}
+
+/// Largest image path length (px) over the sensor: points on a 33 x 25 grid
+/// spanning the sensor edge to edge, 256 time steps, at least the rotation
+/// bound below, times 1.1 for safety.
+pub fn max_path_px(cam: &Camera, target: &Target, traj: &Trajectory) -> f64 {
+    let poses = inv_poses(traj, 256);
+    let (nx, ny) = (33, 25);
+    let mut m: f64 = 0.0;
+    for j in 0..ny {
+        for i in 0..nx {
+            let x = cam.width as f64 * i as f64 / (nx - 1) as f64;
+            let y = cam.height as f64 * j as f64 / (ny - 1) as f64;
+            if let Some((l, _)) = path_disp(cam, target, &poses, x, y) {
+                m = m.max(l);
+            }
+        }
+    }
+    // Points that leave the view still smear the pixels they cross: bound the
+    // image motion of rotation by the angle turned times the focal length in
+    // px at the sensor corner (where d(pixel)/d(angle) is largest).
+    let r = cam.sensor_rect();
+    let corner2 = r.u0.abs().max(r.u1.abs()).powi(2) + r.v0.abs().max(r.v1.abs()).powi(2);
+    let gain = cam.fx_px().max(cam.fy_px()) * (1.0 + corner2 / (cam.focal_mm * cam.focal_mm));
+    let table = traj.table(4096);
+    let angle: f64 = table.windows(2).map(|w| w[0].0.angle_between(w[1].0)).sum();
+    m.max(angle * gain) * 1.1
+}
+
+/// Computes the maps with `steps` time steps (chords of the track; choose
+/// steps so that a chord is well under a pixel, e.g. `max_path_px / 0.25`).
+pub fn blur_maps(cam: &Camera, target: &Target, traj: &Trajectory, steps: usize) -> BlurMaps {
+    let poses = inv_poses(traj, steps.max(1));
+    let (w, h) = (cam.width as usize, cam.height as usize);
+    let dur = traj.duration();
+    let vals: Vec<(f32, f32)> = (0..w * h)
+        .into_par_iter()
+        .map(|idx| {
+            let (i, j) = (idx % w, idx / w);
+            match path_disp(cam, target, &poses, i as f64 + 0.5, j as f64 + 0.5) {
+                Some((l, d)) => (l as f32, d as f32),
+                None => (f32::NAN, f32::NAN),
+            }
+        })
+        .collect();
+    BlurMaps {
+        width: cam.width,
+        height: cam.height,
+        duration: dur,
+        path_px: vals.iter().map(|v| v.0).collect(),
+        disp_px: vals.iter().map(|v| v.1).collect(),
+        speed_px_s: vals.iter().map(|v| (v.0 as f64 / dur) as f32).collect(),
+    }
+}

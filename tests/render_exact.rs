@@ -1,0 +1,196 @@
+//! Renderer against exact integrals (SPEC section 4): a fronto-parallel
+//! checkerboard under pure lateral translation has a closed-form
+//! area-and-time integral per pixel (the integral of a square wave is a
+//! triangle wave), computed here independently of the renderer.
+
+use glam::DVec3;
+use mmbm::render::{render_frame, Backend, Quality, RenderJob, Target, Trajectory};
+use mmbm::{Camera, Twist};
+
+/// Integral of the +-1 square wave `sq(s) = (-1)^floor(s)` from 0 to `z`.
+fn tri(z: f64) -> f64 {
+    let m = z.rem_euclid(2.0);
+    if m <= 1.0 {
+        m
+    } else {
+        2.0 - m
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
+/// Exact pixel value: checker of side `s` m at depth `d` m, camera moving with
+/// `v = (vx, vy, 0)` m/s for `te` s; pixel `(i, j)` of `cam` (no skew).
+/// Checker = (1 + sq(X/S) sq(Y/S)) / 2, X = vx t + d u / f.
+fn exact_pixel(cam: &Camera, s: f64, d: f64, vx: f64, vy: f64, te: f64, i: u32, j: u32) -> f64 {
+    let kx = d * cam.pitch_x_mm / cam.focal_mm / s; // a per pixel
+    let ky = d * cam.pitch_y_mm / cam.focal_mm / s;
+    let ax = |x: f64, t: f64| (vx * t / s) + (x - cam.cx) * kx;
+    let ay = |y: f64, t: f64| (vy * t / s) + (y - cam.cy) * ky;
+    let (x0, x1) = (i as f64, i as f64 + 1.0);
+    let (y0, y1) = (j as f64, j as f64 + 1.0);
+    let gx = |t: f64| (tri(ax(x1, t)) - tri(ax(x0, t))) / (ax(x1, t) - ax(x0, t));
+    let gy = |t: f64| (tri(ay(y1, t)) - tri(ay(y0, t))) / (ay(y1, t) - ay(y0, t));
+    // breakpoints: where an edge coordinate crosses an integer
+    let mut bp = vec![0.0, te];
+    for (a0, rate) in [
+        (ax(x0, 0.0), vx / s),
+        (ax(x1, 0.0), vx / s),
+        (ay(y0, 0.0), vy / s),
+        (ay(y1, 0.0), vy / s),
+    ] {
+        if rate != 0.0 {
+            let a1 = a0 + rate * te;
+            let (lo, hi) = (a0.min(a1), a0.max(a1));
+            let mut m = lo.ceil();
+            while m <= hi {
+                bp.push((m - a0) / rate);
+                m += 1.0;
+            }
+        }
+    }
+    bp.sort_by(|a, b| a.partial_cmp(b).unwrap());
+    let f = |t: f64| 0.5 * (1.0 + gx(t) * gy(t));
+    let mut acc = 0.0;
+    for w in bp.windows(2) {
+        let (a, b) = (w[0], w[1]);
+        if b > a {
+            // piecewise quadratic: Simpson is exact
+            acc += (b - a) / 6.0 * (f(a) + 4.0 * f(0.5 * (a + b)) + f(b));
+        }
+    }
+    if te > 0.0 {
+        acc / te
+    } else {
+        f(0.0)
+    }
+}
+
+fn errors(img: &[f32], exact: &[f64]) -> (f64, f64, f64) {
+    let mut e: Vec<f64> = img
+        .chunks(3)
+        .zip(exact)
+        .map(|(p, x)| (p[0] as f64 - x).abs())
+        .collect();
+    let mean = e.iter().sum::<f64>() / e.len() as f64;
+    e.sort_by(|a, b| a.partial_cmp(b).unwrap());
+    let p99 = e[(e.len() as f64 * 0.99) as usize];
+    (mean, p99, *e.last().unwrap())
+}
+
+fn render(cam: Camera, tw: Twist, te: f64, target: Target, q: Quality, seed: u32) -> Vec<f32> {
+    let mut j = RenderJob::new(cam, Trajectory::from_twist(tw, te).unwrap(), target);
+    j.quality = q;
+    j.backend = Backend::Cpu { threads: None };
+    j.seed = seed;
+    j.with_maps = false;
+    let o = render_frame(&j).unwrap();
+    eprintln!(
+        "  N = {} samples/pixel, max path {:.1} px",
+        o.samples_per_pixel, o.max_path_px
+    );
+    o.rgb
+}
+
+const MEAN_TOL: f64 = 0.5 / 255.0;
+const P99_TOL: f64 = 3.0 / 255.0;
+
+fn check_translation(vx: f64, vy: f64, te: f64, q: Quality, mean_tol: f64, p99_tol: f64) {
+    let cam = Camera::thesis().with_resolution(128, 96);
+    let (s, d) = (0.01, 1.0);
+    let exact: Vec<f64> = (0..cam.height)
+        .flat_map(|j| (0..cam.width).map(move |i| (i, j)))
+        .map(|(i, j)| exact_pixel(&cam, s, d, vx, vy, te, i, j))
+        .collect();
+    let tw = Twist::new(DVec3::ZERO, DVec3::new(vx, vy, 0.0));
+    let img = render(cam, tw, te, Target::checker(s, d), q, 0);
+    let (mean, p99, max) = errors(&img, &exact);
+    eprintln!(
+        "translation ({vx}, {vy}) m/s x {te} s, quality {q}: mean |err| {:.3}/255, p99 {:.3}/255, max {:.3}/255",
+        mean * 255.0,
+        p99 * 255.0,
+        max * 255.0
+    );
+    assert!(mean <= mean_tol && p99 <= p99_tol, "mean {mean} p99 {p99}");
+}
+
+#[test]
+fn zero_motion_equals_exact_area_coverage() {
+    check_translation(0.0, 0.0, 0.05, Quality::Default, MEAN_TOL, P99_TOL);
+}
+
+#[test]
+fn lateral_translation_equals_exact_box_integral() {
+    // 0.3 m/s x 50 ms at 1 m: about 14 px of blur in x and 9 px in y
+    check_translation(0.3, -0.2, 0.05, Quality::Default, MEAN_TOL, P99_TOL);
+    // long horizontal blur (about 55 px)
+    check_translation(1.2, 0.0, 0.05, Quality::Default, MEAN_TOL, P99_TOL);
+}
+
+#[test]
+fn fast_preset_error_is_bounded() {
+    // The cheap preset is allowed 4x the default tolerances.
+    check_translation(0.0, 0.0, 0.05, Quality::Fast, 4.0 * MEAN_TOL, 4.0 * P99_TOL);
+    check_translation(
+        0.3,
+        -0.2,
+        0.05,
+        Quality::Fast,
+        4.0 * MEAN_TOL,
+        4.0 * P99_TOL,
+    );
+}
+
+#[test]
+fn six_dof_against_high_sample_reference() {
+    // No closed form: the reference is the CPU renderer with 32x the samples
+    // (and a different shift seed). Its own error is far below the tolerance.
+    let cam = Camera::thesis().with_resolution(96, 72);
+    let tw = Twist::new(DVec3::new(0.8, -0.6, 1.5), DVec3::new(0.2, 0.1, 0.4));
+    let mut t = Target::checker(0.02, 1.0);
+    t.tilt_deg = [15.0, -20.0];
+    let img = render(cam, tw, 0.04, t.clone(), Quality::Default, 0);
+    let refq = Quality::Custom {
+        min_samples: 32 * 1024,
+        max_spacing_px: 0.25 / 32.0,
+    };
+    let reference: Vec<f64> = render(cam, tw, 0.04, t, refq, 7)
+        .chunks(3)
+        .map(|p| p[0] as f64)
+        .collect();
+    let (mean, p99, max) = errors(&img, &reference);
+    eprintln!(
+        "6-DoF vs reference: mean |err| {:.3}/255, p99 {:.3}/255, max {:.3}/255",
+        mean * 255.0,
+        p99 * 255.0,
+        max * 255.0
+    );
+    assert!(mean <= MEAN_TOL && p99 <= P99_TOL, "mean {mean} p99 {p99}");
+}
+
+#[test]
+fn exact_integral_sanity() {
+    // Independent checks of the reference itself: a pixel inside one square is 0 or 1,
+    // a pixel straddling one vertical edge at its middle is 0.5.
+    let cam = Camera::new(4.0, 0.004, 100, 100);
+    // d/f*p = 1 mm per pixel at 1 m; S = 10 mm -> squares of 10 px, edges at pixel borders of x = 50 +- 10k
+    let v = exact_pixel(&cam, 0.01, 1.0, 0.0, 0.0, 0.05, 52, 52);
+    assert!((v - 1.0).abs() < 1e-12, "{v}");
+    let v = exact_pixel(&cam, 0.01, 1.0, 0.0, 0.0, 0.05, 42, 52);
+    assert!(v.abs() < 1e-12, "{v}");
+    // move by exactly one period (20 mm) in x over the exposure: average of white/black ramps = 0.5
+    let v = exact_pixel(&cam, 0.01, 1.0, 0.4, 0.0, 0.05, 52, 52);
+    assert!((v - 0.5).abs() < 1e-9, "{v}");
+}
+
+#[test]
+#[ignore]
+fn explore_n() {
+    for n in [1024u32, 2048, 4096, 8192] {
+        let q = Quality::Custom {
+            min_samples: n,
+            max_spacing_px: 0.25,
+        };
+        check_translation(0.3, -0.2, 0.05, q, 1.0, 1.0);
+        check_translation(0.0, 0.0, 0.05, q, 1.0, 1.0);
+    }
+}
