@@ -181,16 +181,3 @@ fn exact_integral_sanity() {
     let v = exact_pixel(&cam, 0.01, 1.0, 0.4, 0.0, 0.05, 52, 52);
     assert!((v - 0.5).abs() < 1e-9, "{v}");
 }
-
-#[test]
-#[ignore]
-fn explore_n() {
-    for n in [1024u32, 2048, 4096, 8192] {
-        let q = Quality::Custom {
-            min_samples: n,
-            max_spacing_px: 0.25,
-        };
-        check_translation(0.3, -0.2, 0.05, q, 1.0, 1.0);
-        check_translation(0.0, 0.0, 0.05, q, 1.0, 1.0);
-    }
-}

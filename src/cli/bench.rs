@@ -13,9 +13,10 @@ use std::time::Instant;
   mmbm bench
   mmbm bench --what metric
   mmbm bench --what gpu
-  mmbm bench --what trigger")]
+  mmbm bench --what trigger
+  mmbm bench --what render")]
 pub struct BenchArgs {
-    /// metric, gpu, trigger or all.
+    /// metric, gpu, trigger, render or all.
     #[arg(long, default_value = "all")]
     pub what: String,
 }

@@ -108,13 +108,19 @@ impl ExperimentConfig {
         positive("min_distance_m", self.min_distance_m)?;
         crate::error::finite("speed_m_s", self.speed_m_s)?;
         if self.min_distance_m > self.start_distance_m {
-            return Err(Error::invalid("min_distance_m", "must not exceed start_distance_m"));
+            return Err(Error::invalid(
+                "min_distance_m",
+                "must not exceed start_distance_m",
+            ));
         }
         if self.policies.is_empty() {
             return Err(Error::invalid("policies", "at least one policy is needed"));
         }
         if self.gyro.is_none() && self.walks.is_empty() {
-            return Err(Error::invalid("walks", "at least one walk mode (or a gyro log) is needed"));
+            return Err(Error::invalid(
+                "walks",
+                "at least one walk mode (or a gyro log) is needed",
+            ));
         }
         if self.resolution[0] == 0 || self.resolution[1] == 0 {
             return Err(Error::invalid("resolution", "must be positive"));

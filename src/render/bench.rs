@@ -101,13 +101,3 @@ pub fn bench() -> Result<()> {
     }
     Ok(())
 }
-
-#[cfg(test)]
-mod tests {
-    /// `cargo test --release render::bench -- --ignored --nocapture` prints the numbers.
-    #[test]
-    #[ignore]
-    fn print_bench() {
-        super::bench().unwrap();
-    }
-}
