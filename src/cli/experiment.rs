@@ -1,12 +1,54 @@
-//! `mmbm experiment` (being built).
+//! `mmbm experiment`: the thesis experiment from a configuration file.
 
 use clap::Args;
-use mmbm::error::{Error, Result};
+use mmbm::error::Result;
+use mmbm::experiment::{self, ExperimentConfig};
+use std::path::PathBuf;
 
-/// (being built)
+/// The thesis experiment: walk -> triggers -> rendered frames -> report.
 #[derive(Args, Debug)]
-pub struct ExperimentArgs {}
+#[command(after_help = "Examples:
+  mmbm experiment --config examples/experiment.toml --out report/
+  mmbm experiment --print-config > my.toml     # the defaults, to edit
 
-pub fn run(_a: ExperimentArgs) -> Result<()> {
-    Err(Error::invalid("experiment", "not implemented yet"))
+Writes DIR/frames.csv, DIR/report.md and PNG figures.")]
+pub struct ExperimentArgs {
+    /// TOML configuration (missing keys take the defaults; see --print-config).
+    #[arg(long, value_name = "FILE", required_unless_present = "print_config")]
+    pub config: Option<PathBuf>,
+    /// Output directory.
+    #[arg(long, value_name = "DIR", required_unless_present = "print_config")]
+    pub out: Option<PathBuf>,
+    /// Print the default configuration as TOML and exit.
+    #[arg(long)]
+    pub print_config: bool,
+    /// No progress bar.
+    #[arg(long)]
+    pub quiet: bool,
+}
+
+pub fn run(a: ExperimentArgs) -> Result<()> {
+    if a.print_config {
+        print!("{}", ExperimentConfig::default().to_toml());
+        return Ok(());
+    }
+    let (Some(config), Some(out)) = (a.config, a.out) else {
+        return Err(mmbm::Error::invalid("experiment", "--config FILE and --out DIR are required"));
+    };
+    let cfg = ExperimentConfig::load(&config)?;
+    run_and_print(&cfg, &out, !a.quiet)
+}
+
+/// Runs the experiment and prints where the report is and its headline table.
+pub fn run_and_print(cfg: &ExperimentConfig, out: &std::path::Path, progress: bool) -> Result<()> {
+    let o = experiment::run(cfg, out, progress)?;
+    eprintln!(
+        "{} frames rendered in {:.1} s; wrote {}/frames.csv and {}/report.md",
+        o.rendered,
+        o.seconds,
+        out.display(),
+        out.display()
+    );
+    println!("{}", experiment::report::table_6(&o.stats));
+    Ok(())
 }

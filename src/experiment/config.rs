@@ -84,6 +84,18 @@ impl Default for ExperimentConfig {
 }
 
 impl ExperimentConfig {
+    /// The `mmbm demo` configuration: the defaults with at most 24 rendered
+    /// frames per policy and the `64:0.5` render preset (64 samples per
+    /// pixel minimum, time samples at most 0.5 px apart), sized to finish in
+    /// a few minutes on 2 cores with lavapipe.
+    pub fn demo() -> Self {
+        ExperimentConfig {
+            max_frames_per_policy: 24,
+            quality: "64:0.5".into(),
+            ..Self::default()
+        }
+    }
+
     /// Loads a TOML file; missing fields take the defaults.
     pub fn load(path: &Path) -> Result<Self> {
         let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
