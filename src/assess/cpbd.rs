@@ -16,8 +16,8 @@
 //! 1 (sharp). With no measured edge at all the authors' code returns 0, and
 //! so do we.
 
-use super::edges::EdgeData;
 use super::check_blocks;
+use super::edges::EdgeData;
 use crate::error::Result;
 use image::GrayImage;
 

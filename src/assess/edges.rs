@@ -107,7 +107,11 @@ pub fn sobel_vertical_edges(a: &[f64], w: usize, h: usize) -> Vec<bool> {
         for x in 0..w {
             let v = b[y * w + x];
             let left = if x > 0 { b[y * w + x - 1] } else { v };
-            let right = if x + 1 < w { b[y * w + x + 1] } else { f64::NEG_INFINITY };
+            let right = if x + 1 < w {
+                b[y * w + x + 1]
+            } else {
+                f64::NEG_INFINITY
+            };
             e[y * w + x] = v > cutoff && left <= v && v > right;
         }
     }
@@ -255,7 +259,12 @@ mod tests {
         let e = sobel_vertical_edges(&a, w, h);
         let wd = edge_widths(&a, w, h, &e);
         let row: Vec<u32> = wd[2 * w..3 * w].to_vec();
-        let found: Vec<(usize, u32)> = row.iter().copied().enumerate().filter(|p| p.1 > 0).collect();
+        let found: Vec<(usize, u32)> = row
+            .iter()
+            .copied()
+            .enumerate()
+            .filter(|p| p.1 > 0)
+            .collect();
         assert_eq!(found.len(), 1, "{found:?}");
         assert_eq!(found[0].1, 2);
 
@@ -268,7 +277,11 @@ mod tests {
         }
         let e = sobel_vertical_edges(&a, w, h);
         let wd = edge_widths(&a, w, h, &e);
-        let widths: Vec<u32> = wd[2 * w..3 * w].iter().copied().filter(|&v| v > 0).collect();
+        let widths: Vec<u32> = wd[2 * w..3 * w]
+            .iter()
+            .copied()
+            .filter(|&v| v > 0)
+            .collect();
         assert!(!widths.is_empty());
         // whichever ramp pixel is the edge, the two walks cover the 6 ramp steps
         assert!(widths.iter().all(|&v| v == 6), "{widths:?}");

@@ -21,8 +21,8 @@
 //! report the metric as undefined instead: [`jnbm`] returns an error and
 //! [`jnbm_report`] a `None` value (never NaN or infinity).
 
-use super::edges::EdgeData;
 use super::check_blocks;
+use super::edges::EdgeData;
 use crate::error::{Error, Result};
 use image::GrayImage;
 use serde::Serialize;

@@ -7,14 +7,16 @@ use std::path::PathBuf;
 
 /// Image blur metrics of one or more images.
 #[derive(Args, Debug)]
-#[command(after_help = "Colour images are reduced to Rec. 601 luma of the sRGB values.
+#[command(
+    after_help = "Colour images are reduced to Rec. 601 luma of the sRGB values.
 JNBM: higher = sharper (null/n/a when the image has no edge block);
 CPBD: 0 blurred .. 1 sharp; blur_effect: 0 sharp .. 1 blurred;
 laplacian_var: grey levels^2, higher = sharper.
 
 Examples:
   mmbm assess frame.png
-  mmbm assess a.png b.png --json")]
+  mmbm assess a.png b.png --json"
+)]
 pub struct AssessArgs {
     /// Images (PNG/JPEG), each at least 64x64 px.
     #[arg(required = true, value_name = "IMAGE")]
