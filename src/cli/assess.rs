@@ -3,7 +3,7 @@
 use clap::Args;
 use mmbm::assess::{assess, load_grey, Assessment};
 use mmbm::error::{Error, Result};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// Image blur metrics of one or more images.
 #[derive(Args, Debug)]
@@ -26,11 +26,11 @@ pub struct AssessArgs {
     pub json: bool,
 }
 
-fn one(path: &PathBuf) -> Result<Assessment> {
+fn one(path: &Path) -> Result<Assessment> {
     let g = load_grey(path)?;
     assess(&g).map_err(|e| match e {
         Error::Invalid { what, message } => Error::Image {
-            path: path.clone(),
+            path: path.into(),
             message: format!("{what}: {message}"),
         },
         e => e,
@@ -39,7 +39,11 @@ fn one(path: &PathBuf) -> Result<Assessment> {
 
 pub fn run(a: AssessArgs) -> Result<()> {
     // compute everything first: nothing is printed when one image fails
-    let results = a.images.iter().map(one).collect::<Result<Vec<_>>>()?;
+    let results = a
+        .images
+        .iter()
+        .map(|p| one(p))
+        .collect::<Result<Vec<_>>>()?;
     if a.json {
         let arr: Vec<serde_json::Value> = a
             .images
