@@ -41,7 +41,11 @@ pub fn p_blur(w: f64, w_jnb: f64) -> f64 {
 /// CPBD of a grey image, 0..1. Errors when the image has no whole 64x64 block.
 pub fn cpbd(img: &GrayImage) -> Result<f64> {
     let (nbx, nby) = check_blocks("CPBD", img)?;
-    let ed = EdgeData::new(img);
+    Ok(cpbd_from(&EdgeData::new(img), nbx, nby))
+}
+
+/// CPBD from precomputed edge data and block counts.
+pub(crate) fn cpbd_from(ed: &EdgeData, nbx: u32, nby: u32) -> f64 {
     let (mut total, mut below) = (0usize, 0usize);
     for by in 0..nby {
         for bx in 0..nbx {
@@ -57,11 +61,11 @@ pub fn cpbd(img: &GrayImage) -> Result<f64> {
             }
         }
     }
-    Ok(if total == 0 {
+    if total == 0 {
         0.0
     } else {
         below as f64 / total as f64
-    })
+    }
 }
 
 #[cfg(test)]

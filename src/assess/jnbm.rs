@@ -57,7 +57,11 @@ pub struct JnbmReport {
 /// JNBM with counts. Errors only when the image has no whole 64x64 block.
 pub fn jnbm_report(img: &GrayImage) -> Result<JnbmReport> {
     let (nbx, nby) = check_blocks("JNBM", img)?;
-    let ed = EdgeData::new(img);
+    Ok(report_from(&EdgeData::new(img), nbx, nby))
+}
+
+/// JNBM from precomputed edge data and block counts.
+pub(crate) fn report_from(ed: &EdgeData, nbx: u32, nby: u32) -> JnbmReport {
     let mut total = 0.0;
     let (mut edge_blocks, mut edges, mut wsum) = (0usize, 0usize, 0.0);
     for by in 0..nby {
@@ -80,13 +84,13 @@ pub fn jnbm_report(img: &GrayImage) -> Result<JnbmReport> {
     let blocks = (nbx * nby) as usize;
     let distortion = total.powf(1.0 / BETA);
     let jnbm = (distortion > 0.0).then(|| blocks as f64 / distortion);
-    Ok(JnbmReport {
+    JnbmReport {
         jnbm,
         blocks,
         edge_blocks,
         edges,
         mean_width: if edges > 0 { wsum / edges as f64 } else { 0.0 },
-    })
+    }
 }
 
 /// JNBM (higher = sharper). Errors when the image has no whole 64x64 block or

@@ -88,10 +88,11 @@ pub struct Assessment {
 /// All four metrics. Errors when the image is smaller than one 64x64 block
 /// (JNBM and CPBD need at least one whole block).
 pub fn assess(img: &GrayImage) -> Result<Assessment> {
-    let rep = jnbm_report(img)?;
+    let (nbx, nby) = check_blocks("image", img)?;
+    let ed = edges::EdgeData::new(img);
     Ok(Assessment {
-        jnbm: rep.jnbm,
-        cpbd: cpbd(img)?,
+        jnbm: jnbm::report_from(&ed, nbx, nby).jnbm,
+        cpbd: cpbd::cpbd_from(&ed, nbx, nby),
         blur_effect: blur_effect(img)?,
         laplacian_var: laplacian_var(img)?,
     })
