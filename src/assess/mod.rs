@@ -1,1 +1,139 @@
-//! (being built)
+//! No-reference image blur metrics on grey images.
+//!
+//! All metrics work on an 8-bit grey image ([`image::GrayImage`], values
+//! 0..255). Colour images are reduced to grey with [`luma`]: the integer
+//! Rec. 601 luma of the *sRGB-encoded* 8-bit values (no linearisation, as
+//! MATLAB's `rgb2gray` and OpenCV do, which is what the metrics were designed
+//! and tuned on): `Y = (299 R + 587 G + 114 B + 500) div 1000`. Grey files are
+//! used as they are (16-bit grey is scaled to 8 bits).
+//!
+//! - [`jnbm()`]: Just Noticeable Blur Metric (Ferzli & Karam 2009); higher = sharper.
+//! - [`cpbd()`]: Cumulative Probability of Blur Detection (Narvekar & Karam 2011),
+//!   0 (blurred) .. 1 (sharp).
+//! - [`blur_effect()`]: Crete et al. 2007 blur effect exactly as scikit-image's
+//!   `skimage.measure.blur_effect` (0 sharp .. 1 blurred).
+//! - [`laplacian_var()`]: variance of the 4-neighbour Laplacian (higher = sharper).
+//!
+//! [`assess`] computes all four; JNBM is `None` when it is undefined (no edge
+//! block, see [`jnbm()`]).
+
+pub mod blur_effect;
+pub mod cpbd;
+pub mod edges;
+pub mod jnbm;
+pub mod laplacian;
+
+pub use blur_effect::{blur_effect, blur_effect_axes};
+pub use cpbd::cpbd;
+pub use jnbm::{jnbm, jnbm_report, JnbmReport};
+pub use laplacian::laplacian_var;
+
+use crate::error::{Error, Result};
+use image::{DynamicImage, GrayImage, RgbImage};
+use serde::Serialize;
+use std::path::Path;
+
+/// Side of the square blocks used by JNBM and CPBD, pixels.
+pub const BLOCK: u32 = 64;
+
+/// Integer Rec. 601 luma of an 8-bit sRGB image:
+/// `Y = (299 R + 587 G + 114 B + 500) div 1000` (rounded half up, exact).
+pub fn luma(img: &RgbImage) -> GrayImage {
+    let mut out = GrayImage::new(img.width(), img.height());
+    for (o, p) in out.pixels_mut().zip(img.pixels()) {
+        let [r, g, b] = p.0;
+        let y = (299 * r as u32 + 587 * g as u32 + 114 * b as u32 + 500) / 1000;
+        o.0[0] = y as u8;
+    }
+    out
+}
+
+/// Grey version of a decoded image: grey formats as they are (16-bit scaled
+/// to 8), colour through [`luma`]; alpha is ignored.
+pub fn to_grey(img: &DynamicImage) -> GrayImage {
+    match img {
+        DynamicImage::ImageLuma8(g) => g.clone(),
+        DynamicImage::ImageLuma16(_)
+        | DynamicImage::ImageLumaA8(_)
+        | DynamicImage::ImageLumaA16(_) => img.to_luma8(),
+        _ => luma(&img.to_rgb8()),
+    }
+}
+
+/// Reads a PNG/JPEG (format guessed from the content) as a grey image,
+/// naming the file in errors.
+pub fn load_grey(path: &Path) -> Result<GrayImage> {
+    let r = image::ImageReader::open(path).map_err(|e| Error::io(path, e))?;
+    let r = r.with_guessed_format().map_err(|e| Error::io(path, e))?;
+    let img = r.decode().map_err(|e| Error::Image {
+        path: path.into(),
+        message: e.to_string(),
+    })?;
+    Ok(to_grey(&img))
+}
+
+/// The four metrics of one image.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Assessment {
+    /// JNBM (higher = sharper); `None` when the image has no edge block.
+    pub jnbm: Option<f64>,
+    /// CPBD, 0 (blurred) .. 1 (sharp).
+    pub cpbd: f64,
+    /// Crete et al. blur effect, 0 (sharp) .. 1 (blurred).
+    pub blur_effect: f64,
+    /// Variance of the 4-neighbour Laplacian, (grey levels)^2.
+    pub laplacian_var: f64,
+}
+
+/// All four metrics. Errors when the image is smaller than one 64x64 block
+/// (JNBM and CPBD need at least one whole block).
+pub fn assess(img: &GrayImage) -> Result<Assessment> {
+    let (nbx, nby) = check_blocks("image", img)?;
+    let ed = edges::EdgeData::new(img);
+    Ok(Assessment {
+        jnbm: jnbm::report_from(&ed, nbx, nby).jnbm,
+        cpbd: cpbd::cpbd_from(&ed, nbx, nby),
+        blur_effect: blur_effect(img)?,
+        laplacian_var: laplacian_var(img)?,
+    })
+}
+
+/// Checks that an image holds at least one whole `BLOCK x BLOCK` block.
+pub(crate) fn check_blocks(what: &str, img: &GrayImage) -> Result<(u32, u32)> {
+    let (bx, by) = (img.width() / BLOCK, img.height() / BLOCK);
+    if bx == 0 || by == 0 {
+        return Err(Error::invalid(
+            what,
+            format!(
+                "image is {}x{} px; at least one whole {BLOCK}x{BLOCK} block is needed",
+                img.width(),
+                img.height()
+            ),
+        ));
+    }
+    Ok((bx, by))
+}
+
+/// Grey values as `f64` (0..255), row-major.
+pub(crate) fn to_f64(img: &GrayImage) -> Vec<f64> {
+    img.as_raw().iter().map(|&v| v as f64).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn luma_weights_and_rounding() {
+        let img = RgbImage::from_raw(3, 1, vec![255, 255, 255, 255, 0, 0, 10, 20, 30]).unwrap();
+        let g = luma(&img);
+        assert_eq!(g.as_raw(), &vec![255, 76, 18]); // 76.245; 18.15 (2990+11740+3420)/1000
+    }
+
+    #[test]
+    fn small_image_is_rejected() {
+        let g = GrayImage::new(63, 200);
+        let e = assess(&g).unwrap_err().to_string();
+        assert!(e.contains("64x64"), "{e}");
+    }
+}
