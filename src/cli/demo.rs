@@ -26,6 +26,9 @@ pub struct DemoArgs {
 }
 
 pub fn run(a: DemoArgs) -> Result<()> {
-    let cfg = ExperimentConfig { seed: a.seed, ..ExperimentConfig::demo() };
+    let cfg = ExperimentConfig {
+        seed: a.seed,
+        ..ExperimentConfig::demo()
+    };
     run_and_print(&cfg, &a.out, !a.quiet)
 }

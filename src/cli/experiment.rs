@@ -33,7 +33,10 @@ pub fn run(a: ExperimentArgs) -> Result<()> {
         return Ok(());
     }
     let (Some(config), Some(out)) = (a.config, a.out) else {
-        return Err(mmbm::Error::invalid("experiment", "--config FILE and --out DIR are required"));
+        return Err(mmbm::Error::invalid(
+            "experiment",
+            "--config FILE and --out DIR are required",
+        ));
     };
     let cfg = ExperimentConfig::load(&config)?;
     run_and_print(&cfg, &out, !a.quiet)

@@ -9,8 +9,12 @@ use crate::imageio::linear_to_srgb8;
 /// Linear RGB (interleaved) to an 8-bit sRGB image.
 pub fn to_rgb8(width: u32, height: u32, rgb: &[f32]) -> Result<image::RgbImage> {
     let bytes: Vec<u8> = rgb.iter().map(|&x| linear_to_srgb8(x)).collect();
-    image::RgbImage::from_raw(width, height, bytes)
-        .ok_or_else(|| Error::invalid("frame", format!("{} values are not a {width}x{height} RGB image", rgb.len())))
+    image::RgbImage::from_raw(width, height, bytes).ok_or_else(|| {
+        Error::invalid(
+            "frame",
+            format!("{} values are not a {width}x{height} RGB image", rgb.len()),
+        )
+    })
 }
 
 /// 2x2 box downsampling of linear RGB (for the montage).
@@ -22,8 +26,11 @@ pub fn half(width: u32, height: u32, rgb: &[f32]) -> Vec<f32> {
         for x in 0..w2 {
             for c in 0..3 {
                 let at = |xx: usize, yy: usize| rgb[(yy * w + xx) * 3 + c];
-                out[(y * w2 + x) * 3 + c] =
-                    0.25 * (at(2 * x, 2 * y) + at(2 * x + 1, 2 * y) + at(2 * x, 2 * y + 1) + at(2 * x + 1, 2 * y + 1));
+                out[(y * w2 + x) * 3 + c] = 0.25
+                    * (at(2 * x, 2 * y)
+                        + at(2 * x + 1, 2 * y)
+                        + at(2 * x, 2 * y + 1)
+                        + at(2 * x + 1, 2 * y + 1));
             }
         }
     }
@@ -39,7 +46,12 @@ pub fn pattern_crop(img: &image::RgbImage, expected: &[(f64, f64)]) -> image::Rg
         return img.clone();
     }
     let p = pitch_px(expected);
-    let (mut x0, mut y0, mut x1, mut y1) = (f64::INFINITY, f64::INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY);
+    let (mut x0, mut y0, mut x1, mut y1) = (
+        f64::INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::NEG_INFINITY,
+    );
     for &(x, y) in expected {
         x0 = x0.min(x - p);
         y0 = y0.min(y - p);
@@ -97,9 +109,21 @@ pub struct BlobOutcome {
 /// Extracts the red blobs and matches them against the expected centres (px).
 pub fn blob_metrics(img: &image::RgbImage, expected: &[(f64, f64)]) -> BlobOutcome {
     let pitch = pitch_px(expected);
-    let blobs = crate::blobs::extract(img, &crate::blobs::BlobParams::default());
-    let r = crate::blobs::evaluate(&blobs, expected, pitch);
-    BlobOutcome { found: r.found, matched: r.matched, ok: r.ok }
+    let r = crate::blobs::extract(img, &crate::blobs::BlobParams::default())
+        .and_then(|blobs| crate::blobs::evaluate(&blobs, expected, pitch));
+    match r {
+        Ok(r) => BlobOutcome {
+            found: r.found,
+            matched: r.matched,
+            ok: r.ok,
+        },
+        // An extraction error (e.g. an image too small) counts as a failure.
+        Err(_) => BlobOutcome {
+            found: 0,
+            matched: 0,
+            ok: false,
+        },
+    }
 }
 
 /// Blob pitch (px): the smallest distance between two expected centres.
@@ -134,7 +158,11 @@ pub fn quality_note(cfg: &ExperimentConfig, check: Option<(f64, f64, f64)>) -> S
 
 /// Mean and 99th percentile of the per-value |difference| of two images.
 pub fn image_difference(a: &[f32], b: &[f32]) -> (f64, f64) {
-    let mut d: Vec<f64> = a.iter().zip(b).map(|(x, y)| (*x as f64 - *y as f64).abs()).collect();
+    let mut d: Vec<f64> = a
+        .iter()
+        .zip(b)
+        .map(|(x, y)| (*x as f64 - *y as f64).abs())
+        .collect();
     if d.is_empty() {
         return (0.0, 0.0);
     }
@@ -148,8 +176,17 @@ pub fn image_difference(a: &[f32], b: &[f32]) -> (f64, f64) {
 pub fn findings(stats: &[PolicyStats]) -> String {
     let mut s = String::from("## Findings\n\n");
     for st in stats.iter().filter(|x| x.policy.starts_with("fixed")) {
-        let others: Vec<&PolicyStats> = stats.iter().filter(|x| x.walk == st.walk && !x.policy.starts_with("fixed")).collect();
-        let succ = |x: &PolicyStats| if x.rendered > 0 { 100.0 * x.blobs_ok as f64 / x.rendered as f64 } else { f64::NAN };
+        let others: Vec<&PolicyStats> = stats
+            .iter()
+            .filter(|x| x.walk == st.walk && !x.policy.starts_with("fixed"))
+            .collect();
+        let succ = |x: &PolicyStats| {
+            if x.rendered > 0 {
+                100.0 * x.blobs_ok as f64 / x.rendered as f64
+            } else {
+                f64::NAN
+            }
+        };
         s += &format!(
             "- {} walk, baseline `{}`: {} frames, blob success {:.0} %, mean JNBM {:.3}, mean blur {:.1} px (p95 {:.1}).\n",
             st.walk, st.policy, st.kept, succ(st), st.mean_jnbm, st.mean_blur, st.p95_blur

@@ -49,9 +49,19 @@ pub fn run(cfg: &ExperimentConfig, out: &Path, progress: bool) -> Result<Outcome
     let t_start = Instant::now();
     std::fs::create_dir_all(out).map_err(|e| Error::io(out, e))?;
     let quality = Quality::from_str(&cfg.quality)?;
-    let scene = Scene { camera: run::camera(cfg), plane: None };
-    let names: Vec<String> = if cfg.gyro.is_some() { vec!["log".into()] } else { cfg.walks.clone() };
-    let walks: Vec<Walk> = names.iter().map(|w| run::make_walk(cfg, w, &scene)).collect::<Result<_>>()?;
+    let scene = Scene {
+        camera: run::camera(cfg),
+        plane: None,
+    };
+    let names: Vec<String> = if cfg.gyro.is_some() {
+        vec!["log".into()]
+    } else {
+        cfg.walks.clone()
+    };
+    let walks: Vec<Walk> = names
+        .iter()
+        .map(|w| run::make_walk(cfg, w, &scene))
+        .collect::<Result<_>>()?;
 
     // Plan the renders.
     let mut plan = Vec::new();
@@ -62,10 +72,16 @@ pub fn run(cfg: &ExperimentConfig, out: &Path, progress: bool) -> Result<Outcome
             }
         }
     }
-    let bar = if progress { ProgressBar::new(plan.len() as u64) } else { ProgressBar::hidden() };
+    let bar = if progress {
+        ProgressBar::new(plan.len() as u64)
+    } else {
+        ProgressBar::hidden()
+    };
     bar.set_style(
-        ProgressStyle::with_template("rendering {pos}/{len} frames [{elapsed_precise} < {eta_precise}] {msg}")
-            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+        ProgressStyle::with_template(
+            "rendering {pos}/{len} frames [{elapsed_precise} < {eta_precise}] {msg}",
+        )
+        .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
     let check = quality_check(cfg, &walks, &plan, quality)?;
     let mut measures = std::collections::HashMap::new();
@@ -112,7 +128,10 @@ pub fn run(cfg: &ExperimentConfig, out: &Path, progress: bool) -> Result<Outcome
     }
     let stats = report::policy_stats(&walks, &records);
     let csv = report::frames_csv(&records);
-    write_atomic(&out.join("frames.csv"), |w| w.write_all(csv.as_bytes()).map_err(|e| Error::io(out.join("frames.csv"), e)))?;
+    write_atomic(&out.join("frames.csv"), |w| {
+        w.write_all(csv.as_bytes())
+            .map_err(|e| Error::io(out.join("frames.csv"), e))
+    })?;
 
     // Figures.
     let cam = run::camera(cfg);
@@ -120,15 +139,41 @@ pub fn run(cfg: &ExperimentConfig, out: &Path, progress: bool) -> Result<Outcome
     for (wi, w) in walks.iter().enumerate() {
         let t: Vec<f64> = w.samples.iter().map(|s| s.t).collect();
         let t0 = t.first().copied().unwrap_or(0.0);
-        let window = (t0 + 2.0, (t0 + 8.0).min(t.last().copied().unwrap_or(t0 + 8.0)));
+        let window = (
+            t0 + 2.0,
+            (t0 + 8.0).min(t.last().copied().unwrap_or(t0 + 8.0)),
+        );
         for (p, frames) in &w.runs {
-            if !(p.starts_with("fixed") || p == "threshold:0.4" || p.starts_with("oracle") || p.starts_with("forecast")) {
+            if !(p.starts_with("fixed")
+                || p == "threshold:0.4"
+                || p.starts_with("oracle")
+                || p.starts_with("forecast"))
+            {
                 continue;
             }
-            let ex: Vec<figures::Exposure> = frames.iter().filter(|f| f.kept).map(|f| (f.trigger_t, f.exposure_start, f.exposure_end)).collect();
-            let th = p.split(':').nth(1).and_then(|x| x.parse::<f64>().ok()).filter(|_| !p.starts_with("fixed"));
+            let ex: Vec<figures::Exposure> = frames
+                .iter()
+                .filter(|f| f.kept)
+                .map(|f| (f.trigger_t, f.exposure_start, f.exposure_end))
+                .collect();
+            let th = p
+                .split(':')
+                .nth(1)
+                .and_then(|x| x.parse::<f64>().ok())
+                .filter(|_| !p.starts_with("fixed"));
             let name = format!("trace_{}_{}.png", w.name, p.replace([':', '.', '@'], "_"));
-            figures::mmbm_trace(&out.join(&name), &format!("{} walk, {p}: MMBM, triggers (x), exposures (shaded)", w.name), &t, &w.mmbm, window, &ex, th)?;
+            figures::mmbm_trace(
+                &out.join(&name),
+                &format!(
+                    "{} walk, {p}: MMBM, triggers (x), exposures (shaded)",
+                    w.name
+                ),
+                &t,
+                &w.mmbm,
+                window,
+                &ex,
+                th,
+            )?;
             figs.push(name);
         }
         let series: Vec<(String, Vec<f64>)> = w
@@ -165,18 +210,50 @@ pub fn run(cfg: &ExperimentConfig, out: &Path, progress: bool) -> Result<Outcome
         // Flow quiver at the sample of highest MMBM.
         if let Some((k, _)) = w.mmbm.iter().enumerate().max_by(|a, b| a.1.total_cmp(b.1)) {
             let tw = crate::motion::Twist::new(w.samples[k].omega, glam::DVec3::ZERO);
-            let field = crate::gpu::flow::flow_field_gpu(&Scene { camera: cam, plane: None }, &tw, 0, 0);
+            let field = crate::gpu::flow::flow_field_gpu(
+                &Scene {
+                    camera: cam,
+                    plane: None,
+                },
+                &tw,
+                0,
+                0,
+            );
             if let Ok(field) = field {
                 let name = format!("quiver_{}.png", w.name);
-                crate::quiver::quiver_png(&cam, &field.u, &field.v, cfg.exposure_s, &out.join(&name))?;
+                crate::quiver::quiver_png(
+                    &cam,
+                    &field.u,
+                    &field.v,
+                    cfg.exposure_s,
+                    &out.join(&name),
+                )?;
                 figs.push(name);
             }
         }
     }
     let seconds = t_start.elapsed().as_secs_f64();
-    let md = report_md(cfg, &walks, &stats, &figs, seconds, plan.len(), &records, check);
-    write_atomic(&out.join("report.md"), |w| w.write_all(md.as_bytes()).map_err(|e| Error::io(out.join("report.md"), e)))?;
-    Ok(Outcome { walks, records, stats, seconds, rendered: plan.len() })
+    let md = report_md(
+        cfg,
+        &walks,
+        &stats,
+        &figs,
+        seconds,
+        plan.len(),
+        &records,
+        check,
+    );
+    write_atomic(&out.join("report.md"), |w| {
+        w.write_all(md.as_bytes())
+            .map_err(|e| Error::io(out.join("report.md"), e))
+    })?;
+    Ok(Outcome {
+        walks,
+        records,
+        stats,
+        seconds,
+        rendered: plan.len(),
+    })
 }
 
 /// Renders the central 160 x 120 window of the most blurred planned frame of
@@ -187,15 +264,14 @@ fn quality_check(
     plan: &[(usize, usize, usize)],
     quality: Quality,
 ) -> Result<Option<(f64, f64, f64)>> {
-    let worst = plan
-        .iter()
-        .filter(|&&(_, pi, _)| pi == 0)
-        .max_by(|a, b| {
-            let fa = &walks[a.0].runs[a.1].1[a.2];
-            let fb = &walks[b.0].runs[b.1].1[b.2];
-            fa.mmbm_exposure_mm_s.total_cmp(&fb.mmbm_exposure_mm_s)
-        });
-    let Some(&(wi, pi, fi)) = worst else { return Ok(None) };
+    let worst = plan.iter().filter(|&&(_, pi, _)| pi == 0).max_by(|a, b| {
+        let fa = &walks[a.0].runs[a.1].1[a.2];
+        let fb = &walks[b.0].runs[b.1].1[b.2];
+        fa.mmbm_exposure_mm_s.total_cmp(&fb.mmbm_exposure_mm_s)
+    });
+    let Some(&(wi, pi, fi)) = worst else {
+        return Ok(None);
+    };
     if quality == Quality::Default {
         return Ok(None);
     }
@@ -219,7 +295,10 @@ fn report_md(
     records: &[FrameRecord],
     check: Option<(f64, f64, f64)>,
 ) -> String {
-    let render_ms: Vec<f64> = records.iter().filter_map(|r| r.measure.as_ref().map(|m| m.render_ms)).collect();
+    let render_ms: Vec<f64> = records
+        .iter()
+        .filter_map(|r| r.measure.as_ref().map(|m| m.render_ms))
+        .collect();
     let mean_ms = render_ms.iter().sum::<f64>() / render_ms.len().max(1) as f64;
     let mut s = String::new();
     s += "# mmbm experiment report\n\n";

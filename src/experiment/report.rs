@@ -117,8 +117,16 @@ pub fn policy_stats(walks: &[Walk], records: &[FrameRecord]) -> Vec<PolicyStats>
                 .filter_map(|r| r.measure.as_ref())
                 .collect();
             let blur: Vec<f64> = rs.iter().map(|m| m.blur_px).collect();
-            let jnbm: Vec<f64> = rs.iter().map(|m| m.jnbm).filter(|x| x.is_finite()).collect();
-            let cpbd: Vec<f64> = rs.iter().map(|m| m.cpbd).filter(|x| x.is_finite()).collect();
+            let jnbm: Vec<f64> = rs
+                .iter()
+                .map(|m| m.jnbm)
+                .filter(|x| x.is_finite())
+                .collect();
+            let cpbd: Vec<f64> = rs
+                .iter()
+                .map(|m| m.cpbd)
+                .filter(|x| x.is_finite())
+                .collect();
             let sm = summary_over(frames, dur);
             out.push(PolicyStats {
                 walk: w.name.clone(),
@@ -192,7 +200,11 @@ pub fn table_6(stats: &[PolicyStats]) -> String {
             .find(|x| x.walk == st.walk && x.policy.starts_with("fixed"))
             .map(|x| x.kept as i64);
         let lost = fixed.map_or("-".into(), |k| (k - st.kept as i64).to_string());
-        let succ = if st.rendered > 0 { 100.0 * st.blobs_ok as f64 / st.rendered as f64 } else { f64::NAN };
+        let succ = if st.rendered > 0 {
+            100.0 * st.blobs_ok as f64 / st.rendered as f64
+        } else {
+            f64::NAN
+        };
         let _ = writeln!(
             s,
             "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",

@@ -73,13 +73,17 @@ pub struct FrameRecord {
 pub fn make_walk(cfg: &ExperimentConfig, walk: &str, scene: &Scene) -> Result<Walk> {
     let (name, samples) = match &cfg.gyro {
         Some(p) => (
-            p.file_name().map_or("log".into(), |s| s.to_string_lossy().into_owned()),
+            p.file_name()
+                .map_or("log".into(), |s| s.to_string_lossy().into_owned()),
             read_log(p, GyroOptions::default())?,
         ),
         None => {
             let gait = Gait::from_str(walk)?;
             let g = GaitConfig::preset(gait);
-            (walk.to_string(), simulate(&g, cfg.duration_s, cfg.rate_hz, cfg.seed)?)
+            (
+                walk.to_string(),
+                simulate(&g, cfg.duration_s, cfg.rate_hz, cfg.seed)?,
+            )
         }
     };
     let mmbm = trigger::mmbm_series(&samples, scene, Method::default())?;
@@ -102,7 +106,13 @@ pub fn make_walk(cfg: &ExperimentConfig, walk: &str, scene: &Scene) -> Result<Wa
         let frames = trigger::run(&samples, &mmbm, policy.as_mut(), &timing)?;
         runs.push((p.clone(), frames));
     }
-    Ok(Walk { name, samples, mmbm, distance, runs })
+    Ok(Walk {
+        name,
+        samples,
+        mmbm,
+        distance,
+        runs,
+    })
 }
 
 /// The camera timing of the configuration.
@@ -147,10 +157,18 @@ pub fn render_and_measure(
     quality: Quality,
     seed: u32,
 ) -> Result<Rendered> {
-    let i = walk.samples.partition_point(|s| s.t < frame.exposure_start).min(walk.samples.len() - 1);
+    let i = walk
+        .samples
+        .partition_point(|s| s.t < frame.exposure_start)
+        .min(walk.samples.len() - 1);
     let distance = walk.distance[i];
     let use_velocity = walk.samples[i].velocity.is_some();
-    let traj = Trajectory::from_log(&walk.samples, frame.exposure_start, cfg.exposure_s, use_velocity)?;
+    let traj = Trajectory::from_log(
+        &walk.samples,
+        frame.exposure_start,
+        cfg.exposure_s,
+        use_velocity,
+    )?;
     let target = Target::parse(&cfg.target, distance)?;
     let mut job = RenderJob::new(cam, traj.clone(), target.clone());
     job.quality = quality;
@@ -159,7 +177,10 @@ pub fn render_and_measure(
     let t0 = Instant::now();
     let out = render::render_frame(&job)?;
     let render_ms = t0.elapsed().as_secs_f64() * 1e3;
-    let maps = out.maps.as_ref().ok_or_else(|| Error::invalid("render", "no blur maps"))?;
+    let maps = out
+        .maps
+        .as_ref()
+        .ok_or_else(|| Error::invalid("render", "no blur maps"))?;
     let means = maps.means();
     let rgb8 = super::measure::to_rgb8(cam.width, cam.height, &out.rgb)?;
     // True blob centres at mid-exposure (the centroid of a smear).
