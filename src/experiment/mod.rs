@@ -25,9 +25,16 @@ use crate::output::write_atomic;
 use crate::render::Quality;
 use indicatif::{ProgressBar, ProgressStyle};
 use run::{FrameRecord, Walk};
+use std::collections::HashMap;
 use std::path::Path;
 use std::str::FromStr;
 use std::time::Instant;
+
+/// The sharpest and the most blurred rendered frame of one run: `(blur px, linear RGB)`.
+struct Extremes {
+    sharpest: (f64, Vec<f32>),
+    blurriest: (f64, Vec<f32>),
+}
 
 /// What the experiment produced.
 pub struct Outcome {
@@ -84,30 +91,24 @@ pub fn run(cfg: &ExperimentConfig, out: &Path, progress: bool) -> Result<Outcome
         .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
     let check = quality_check(cfg, &walks, &plan, quality)?;
-    let mut measures = std::collections::HashMap::new();
-    let mut extremes: Vec<Option<(f64, Vec<f32>, f64, Vec<f32>)>> = vec![None; plan.len().max(1)];
-    let mut extreme_key = std::collections::HashMap::new();
+    let mut measures = HashMap::new();
+    let mut extremes: HashMap<(usize, usize), Extremes> = HashMap::new();
     for (k, &(wi, pi, fi)) in plan.iter().enumerate() {
         let w = &walks[wi];
         let frame = &w.runs[pi].1[fi];
         bar.set_message(format!("{} {}", w.name, frame.policy));
         let r = run::render_and_measure(cfg, w, frame, run::camera(cfg), quality, k as u32)?;
         // Keep the sharpest and the most blurred frame of each (walk, policy).
-        let slot = *extreme_key.entry((wi, pi)).or_insert(k);
         let b = r.measure.blur_px;
-        let e = &mut extremes[slot];
-        match e {
-            None => *e = Some((b, r.rgb.clone(), b, r.rgb.clone())),
-            Some((lo, lo_img, hi, hi_img)) => {
-                if b < *lo {
-                    *lo = b;
-                    *lo_img = r.rgb.clone();
-                }
-                if b > *hi {
-                    *hi = b;
-                    *hi_img = r.rgb.clone();
-                }
-            }
+        let e = extremes.entry((wi, pi)).or_insert_with(|| Extremes {
+            sharpest: (f64::INFINITY, Vec::new()),
+            blurriest: (f64::NEG_INFINITY, Vec::new()),
+        });
+        if b < e.sharpest.0 {
+            e.sharpest = (b, r.rgb.clone());
+        }
+        if b > e.blurriest.0 {
+            e.blurriest = (b, r.rgb.clone());
         }
         measures.insert((wi, pi, fi), r.measure);
         bar.inc(1);
@@ -194,11 +195,9 @@ pub fn run(cfg: &ExperimentConfig, out: &Path, progress: bool) -> Result<Outcome
         // Sharpest and most blurred frame per policy, half resolution.
         let mut imgs = Vec::new();
         for pi in 0..w.runs.len() {
-            if let Some(&slot) = extreme_key.get(&(wi, pi)) {
-                if let Some((_, lo, _, hi)) = &extremes[slot] {
-                    imgs.push(measure::half(cam.width, cam.height, lo));
-                    imgs.push(measure::half(cam.width, cam.height, hi));
-                }
+            if let Some(e) = extremes.get(&(wi, pi)) {
+                imgs.push(measure::half(cam.width, cam.height, &e.sharpest.1));
+                imgs.push(measure::half(cam.width, cam.height, &e.blurriest.1));
             }
         }
         if !imgs.is_empty() {
@@ -232,28 +231,19 @@ pub fn run(cfg: &ExperimentConfig, out: &Path, progress: bool) -> Result<Outcome
             }
         }
     }
-    let seconds = t_start.elapsed().as_secs_f64();
-    let md = report_md(
-        cfg,
-        &walks,
-        &stats,
-        &figs,
-        seconds,
-        plan.len(),
-        &records,
-        check,
-    );
+    let outcome = Outcome {
+        walks,
+        records,
+        stats,
+        seconds: t_start.elapsed().as_secs_f64(),
+        rendered: plan.len(),
+    };
+    let md = report_md(cfg, &outcome, &figs, check);
     write_atomic(&out.join("report.md"), |w| {
         w.write_all(md.as_bytes())
             .map_err(|e| Error::io(out.join("report.md"), e))
     })?;
-    Ok(Outcome {
-        walks,
-        records,
-        stats,
-        seconds,
-        rendered: plan.len(),
-    })
+    Ok(outcome)
 }
 
 /// Renders the central 160 x 120 window of the most blurred planned frame of
@@ -287,14 +277,12 @@ fn quality_check(
 
 fn report_md(
     cfg: &ExperimentConfig,
-    walks: &[Walk],
-    stats: &[report::PolicyStats],
+    o: &Outcome,
     figs: &[String],
-    seconds: f64,
-    rendered: usize,
-    records: &[FrameRecord],
     check: Option<(f64, f64, f64)>,
 ) -> String {
+    let (walks, stats, records, seconds, rendered) =
+        (&o.walks, &o.stats, &o.records, o.seconds, o.rendered);
     let render_ms: Vec<f64> = records
         .iter()
         .filter_map(|r| r.measure.as_ref().map(|m| m.render_ms))
@@ -313,7 +301,9 @@ fn report_md(
     s += "\n## Tables 6.1 and 6.2: frames, blob extraction, JNBM and ground-truth blur\n\n";
     s += "Blur = sensor mean of each pixel's image path length over the exposure (px), from the renderer's blur maps. \
           Success = all 16 blobs found, each within half a blob pitch of its true centre (projected at mid-exposure). \
-          JNBM and CPBD: higher = sharper.\n\n";
+          JNBM and CPBD: higher = sharper; blur effect: 0 sharp .. 1 blurred. JNBM and CPBD measure edge \
+          widths along image rows only (as their authors' code does), so they are blind to vertical smear, \
+          which dominates a walking robot's pitching; the blur effect and the ground-truth blur see both directions.\n\n";
     s += &report::table_6(stats);
     s += "\n## Figures\n\n";
     for f in figs {

@@ -76,6 +76,8 @@ pub struct PolicyStats {
     pub mean_jnbm: f64,
     /// Mean CPBD.
     pub mean_cpbd: f64,
+    /// Mean Crete blur effect (0 sharp .. 1 blurred).
+    pub mean_blur_effect: f64,
     /// Mean ground-truth blur, px.
     pub mean_blur: f64,
     /// 95th percentile of the ground-truth blur, px.
@@ -127,6 +129,11 @@ pub fn policy_stats(walks: &[Walk], records: &[FrameRecord]) -> Vec<PolicyStats>
                 .map(|m| m.cpbd)
                 .filter(|x| x.is_finite())
                 .collect();
+            let be: Vec<f64> = rs
+                .iter()
+                .map(|m| m.blur_effect)
+                .filter(|x| x.is_finite())
+                .collect();
             let sm = summary_over(frames, dur);
             out.push(PolicyStats {
                 walk: w.name.clone(),
@@ -138,6 +145,7 @@ pub fn policy_stats(walks: &[Walk], records: &[FrameRecord]) -> Vec<PolicyStats>
                 blobs_ok: rs.iter().filter(|m| m.blobs_ok).count(),
                 mean_jnbm: mean(&jnbm),
                 mean_cpbd: mean(&cpbd),
+                mean_blur_effect: mean(&be),
                 mean_blur: mean(&blur),
                 p95_blur: percentile(&blur, 95.0),
                 max_blur: blur.iter().copied().fold(f64::NAN, f64::max),
@@ -192,7 +200,7 @@ pub fn table_5_1(walks: &[Walk]) -> String {
 /// policy, blob success, JNBM and blur.
 pub fn table_6(stats: &[PolicyStats]) -> String {
     let mut s = String::from(
-        "| walk | policy | frames kept | fps | frames lost vs fixed | rendered | all 16 blobs | success % | mean JNBM | mean CPBD | mean blur px | p95 blur px | max blur px | mean exposure MMBM mm/s |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+        "| walk | policy | frames kept | fps | frames lost vs fixed | rendered | all 16 blobs | success % | mean JNBM | mean CPBD | mean blur effect | mean blur px | p95 blur px | max blur px | mean exposure MMBM mm/s |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     for st in stats {
         let fixed = stats
@@ -207,7 +215,7 @@ pub fn table_6(stats: &[PolicyStats]) -> String {
         };
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
             st.walk,
             st.policy,
             st.kept,
@@ -218,6 +226,7 @@ pub fn table_6(stats: &[PolicyStats]) -> String {
             f(succ, 1),
             f(st.mean_jnbm, 3),
             f(st.mean_cpbd, 3),
+            f(st.mean_blur_effect, 3),
             f(st.mean_blur, 2),
             f(st.p95_blur, 2),
             f(st.max_blur, 2),
