@@ -204,9 +204,47 @@ pub fn findings(stats: &[PolicyStats]) -> String {
             );
         }
     }
-    s += "\nThe thesis (real SensoRHex, chapter 6) found MMBM triggering raised the blob success rate from about 50 % \
-          (5 fps) to 62-82 % and the mean JNBM from 0.36 to 0.49. Compare the rows above; the causes of any \
-          difference are discussed in the README (simulated gait, ideal rendering: no noise, defocus or rolling \
-          shutter, a colour threshold tuned to the rendered board).\n";
+    // The headline comparison of the thesis: fixed 5 fps against MMBM triggering at 0.4.
+    for base in stats.iter().filter(|x| x.policy.starts_with("fixed")) {
+        let Some(th) = stats
+            .iter()
+            .find(|x| x.walk == base.walk && x.policy == "threshold:0.4")
+        else {
+            continue;
+        };
+        let succ = |x: &PolicyStats| {
+            if x.rendered > 0 {
+                100.0 * x.blobs_ok as f64 / x.rendered as f64
+            } else {
+                f64::NAN
+            }
+        };
+        s += &format!(
+            "\nOn the {} walk, MMBM triggering at 0.4 mm/s (`threshold:0.4`, the thesis rule) against `{}`: \
+             blob success {:.0} % -> {:.0} %, mean ground-truth blur {:.1} -> {:.1} px (p95 {:.1} -> {:.1}), \
+             mean blur effect {:.3} -> {:.3} (lower = sharper), mean JNBM {:.3} -> {:.3}, with {} instead of {} frames. \
+             The thesis (real SensoRHex, chapter 6) found blob success rising from about 50 % to 62-82 % and mean \
+             JNBM from 0.36 to 0.49.\n",
+            base.walk,
+            base.policy,
+            succ(base),
+            succ(th),
+            base.mean_blur,
+            th.mean_blur,
+            base.p95_blur,
+            th.p95_blur,
+            base.mean_blur_effect,
+            th.mean_blur_effect,
+            base.mean_jnbm,
+            th.mean_jnbm,
+            th.kept,
+            base.kept
+        );
+    }
+    s += "\nWhy the numbers differ from the thesis: the rendered frames are ideal (no sensor noise, defocus, \
+          rolling shutter or lighting changes) and the blob detector's red threshold adapts to each frame, so \
+          moderate blur rarely breaks extraction; JNBM and CPBD measure edge widths along rows only (as the \
+          authors' code does) and so miss the vertical smear of the gait's pitching, which is most of the blur \
+          here; the gait is simulated, calibrated only to the thesis's MMBM range and trigger rates.\n";
     s
 }
