@@ -51,15 +51,7 @@ impl FlowPoly {
     /// rotation only (the translation part is dropped).
     pub fn new(f: f64, tw: &Twist, plane: Option<&Plane>) -> Self {
         let w = tw.omega;
-        // inverse depth = a + b u + c v
-        let (a, b, c) = match plane {
-            Some(p) => (
-                p.normal.z / p.d,
-                p.normal.x / (f * p.d),
-                p.normal.y / (f * p.d),
-            ),
-            None => (0.0, 0.0, 0.0),
-        };
+        let (a, b, c) = plane.map_or((0.0, 0.0, 0.0), |p| p.inverse_depth_coeffs(f));
         let t = tw.velocity;
         FlowPoly {
             du: [

@@ -73,6 +73,16 @@ impl Plane {
         (self.normal.x * u / f + self.normal.y * v / f + self.normal.z) / self.d
     }
 
+    /// The inverse depth as an affine function of the sensor point:
+    /// `1/z = a + b u + c v` (1/m, with `u, v` in mm), returned as `(a, b, c)`.
+    pub fn inverse_depth_coeffs(&self, f: f64) -> (f64, f64, f64) {
+        (
+            self.normal.z / self.d,
+            self.normal.x / (f * self.d),
+            self.normal.y / (f * self.d),
+        )
+    }
+
     /// Checks that the plane is finite and lies in front of the camera at
     /// every point of the sensor (depth strictly positive at the four corners;
     /// inverse depth is affine in `(u, v)`, so that covers the whole sensor).

@@ -76,14 +76,7 @@ impl TwistGpu {
     /// The twist for focal length `f` mm; `plane = None` drops the translation
     /// (rotation only, like [`crate::flow::flow_at`]).
     pub fn new(f: f64, tw: &Twist, plane: Option<&Plane>) -> Self {
-        let (a, b, c) = match plane {
-            Some(p) => (
-                p.normal.z / p.d,
-                p.normal.x / (f * p.d),
-                p.normal.y / (f * p.d),
-            ),
-            None => (0.0, 0.0, 0.0),
-        };
+        let (a, b, c) = plane.map_or((0.0, 0.0, 0.0), |p| p.inverse_depth_coeffs(f));
         let w = tw.omega.as_vec3();
         let v = if plane.is_some() {
             tw.velocity.as_vec3()
