@@ -114,13 +114,17 @@ pub fn run(a: BenchArgs) -> Result<()> {
     match a.what.as_str() {
         "metric" => metric(),
         "gpu" => mmbm::gpu::flow::bench(),
+        "trigger" => mmbm::trigger::bench(),
+        "render" => mmbm::render::bench(),
         "all" => {
             metric()?;
-            mmbm::gpu::flow::bench()
+            mmbm::gpu::flow::bench()?;
+            mmbm::trigger::bench()?;
+            mmbm::render::bench()
         }
         w => Err(mmbm::Error::invalid(
             "--what",
-            format!("'{w}': expected metric, gpu or all"),
+            format!("'{w}': expected metric, gpu, trigger, render or all"),
         )),
     }
 }
