@@ -96,7 +96,10 @@ fn metric() -> Result<()> {
             black_box(ev.mean_speed(black_box(p)));
         }
     }) / kinks.len() as f64;
-    println!("  exact:1e-8, flow zero inside the sensor (roll-dominated): {:.1} us/sample", per * 1e6);
+    println!(
+        "  exact:1e-8, flow zero inside the sensor (roll-dominated): {:.1} us/sample",
+        per * 1e6
+    );
     let ev = Evaluator::new(&s.camera, Method::default())?;
     let per = time_per_call(1.0, || {
         for t in &tws {
