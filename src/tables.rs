@@ -122,8 +122,8 @@ fn sensitivity_table(name: &str, title: &str, rows: Vec<SensitivityRow>) -> Tabl
                 vec![
                     fmt_motion(&r.motion),
                     r.perturbation.clone(),
-                    format!("{:.4}", r.grid),
-                    format!("{:.4}", r.grid_perturbed),
+                    format!("{:.6}", r.grid),
+                    format!("{:.6}", r.grid_perturbed),
                     format!("{:.4}%", r.change_pct),
                     format!("{:.6}", r.exact),
                     format!("{:.6}", r.exact_perturbed),
@@ -180,13 +180,16 @@ pub fn table_4_2() -> Result<Table> {
             })?);
         }
     }
-    // Noise on one axis only when both are present: vectors add or cancel.
-    let m = [1., 1., 0., 0., 0., 0., 0.5];
-    for (k, l) in NOISES {
-        rows.push(sensitivity(m, &format!("wx {l}"), |f, mut m| {
-            m[0] *= 1.0 + k;
-            (f, m)
-        })?);
+    // Noise on one axis only when other axes move too: vectors add or cancel.
+    for m in [[1., 1., 0., 0., 0., 0., 0.5], [1., 1., 1., 0., 0., 0., 0.5]] {
+        for (axis, name) in [(0, "wx"), (1, "wy")] {
+            for (k, l) in NOISES {
+                rows.push(sensitivity(m, &format!("{name} {l}"), |f, mut m| {
+                    m[axis] *= 1.0 + k;
+                    (f, m)
+                })?);
+            }
+        }
     }
     Ok(sensitivity_table(
         "Table 4.2",
@@ -243,14 +246,14 @@ fn depth_table(name: &str, title: &str, m: [f64; 6], depths: &[f64], split: bool
         let mut row = vec![
             fmt_motion(&m),
             format!("{z}"),
-            format!("{g:.4}"),
+            format!("{g:.6}"),
             format!("{e:.6}"),
         ];
         if split {
             let rot = Twist::rotation(m[0], m[1], m[2]);
             let (gr, er) = both(&scene(f0, z), &rot)?;
             row.extend([
-                format!("{gr:.4}"),
+                format!("{gr:.6}"),
                 format!("{er:.6}"),
                 format!("{:.2}", 100.0 * (e - er) / e),
             ]);
