@@ -22,6 +22,7 @@ pub mod metric;
 pub mod motion;
 pub mod output;
 pub mod plot;
+pub mod pose;
 pub mod quiver;
 pub mod render;
 pub mod series;

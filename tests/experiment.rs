@@ -62,6 +62,14 @@ fn tiny_experiment_end_to_end() {
             "blur {blur} vs MMBM {predicted}"
         );
     }
+    // Where all 16 blobs were found, the pose from them is close to the truth
+    // (3 m away: within 15 cm and 3 degrees even with blur).
+    let ok: Vec<&&Vec<&str>> = rendered.iter().filter(|r| r[5] == "1").collect();
+    assert!(!ok.is_empty(), "no frame with all 16 blobs");
+    for r in ok {
+        let (e_m, e_deg): (f64, f64) = (r[21].parse().unwrap(), r[22].parse().unwrap());
+        assert!(e_m < 0.15 && e_deg < 3.0, "pose error {e_m} m, {e_deg} deg");
+    }
     let md = std::fs::read_to_string(d.path().join("report.md")).unwrap();
     for needle in [
         "Table 5.1",

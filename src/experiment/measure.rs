@@ -96,7 +96,7 @@ pub fn image_metrics(img: &image::RgbImage) -> ImageMetrics {
 }
 
 /// Blob extraction outcome.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 pub struct BlobOutcome {
     /// Components found.
     pub found: usize,
@@ -104,24 +104,32 @@ pub struct BlobOutcome {
     pub matched: usize,
     /// Success (exactly 16, all matched).
     pub ok: bool,
+    /// For each expected centre, the centre of its matched blob (px).
+    pub matches: Vec<Option<(f64, f64)>>,
 }
 
 /// Extracts the red blobs and matches them against the expected centres (px).
 pub fn blob_metrics(img: &image::RgbImage, expected: &[(f64, f64)]) -> BlobOutcome {
     let pitch = pitch_px(expected);
     let r = crate::blobs::extract(img, &crate::blobs::BlobParams::default())
-        .and_then(|blobs| crate::blobs::evaluate(&blobs, expected, pitch));
+        .and_then(|blobs| crate::blobs::evaluate(&blobs, expected, pitch).map(|r| (blobs, r)));
     match r {
-        Ok(r) => BlobOutcome {
+        Ok((blobs, r)) => BlobOutcome {
             found: r.found,
             matched: r.matched,
             ok: r.ok,
+            matches: r
+                .assignment
+                .iter()
+                .map(|a| a.map(|i| blobs[i].centre))
+                .collect(),
         },
         // An extraction error (e.g. an image too small) counts as a failure.
         Err(_) => BlobOutcome {
             found: 0,
             matched: 0,
             ok: false,
+            matches: vec![None; expected.len()],
         },
     }
 }

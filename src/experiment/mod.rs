@@ -300,7 +300,8 @@ fn report_md(
     s += "\n## Tables 6.1 and 6.2: frames, blob extraction, JNBM and ground-truth blur\n\n";
     s += "Blur = sensor mean of each pixel's image path length over the exposure (px), from the renderer's blur maps. \
           Success = all 16 blobs found, each within half a blob pitch of its true centre (projected at mid-exposure). \
-          JNBM and CPBD: higher = sharper; blur effect: 0 sharp .. 1 blurred. JNBM and CPBD measure edge \
+          Pose error: camera position and orientation estimated from the 16 blob centres (planar homography) \
+          against the true mid-exposure pose, over frames with all 16 blobs. JNBM and CPBD: higher = sharper; blur effect: 0 sharp .. 1 blurred. JNBM and CPBD measure edge \
           widths along image rows only (as their authors' code does), so they are blind to vertical smear, \
           which dominates a walking robot's pitching; the blur effect and the ground-truth blur see both directions.\n\n";
     s += &report::table_6(stats);

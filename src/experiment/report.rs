@@ -8,7 +8,7 @@ use std::fmt::Write as _;
 /// Columns of `frames.csv` (the first six are the contract).
 pub const FRAMES_HEADER: &str = "policy,trigger_t,blur_px,jnbm,blobs_found,blobs_ok,walk,exposure_start,exposure_end,\
 mmbm_trigger_mm_s,mmbm_exposure_mm_s,kept,rendered,distance_m,disp_px,cpbd,blur_effect,laplacian_var,\
-blobs_matched,samples_per_pixel,render_ms";
+blobs_matched,samples_per_pixel,render_ms,pose_err_m,pose_err_deg";
 
 fn num(x: f64) -> String {
     if x.is_finite() {
@@ -28,7 +28,7 @@ pub fn frames_csv(records: &[FrameRecord]) -> String {
         let g = |x: Option<f64>| x.map_or(String::new(), num);
         let _ = writeln!(
             s,
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
             f.policy,
             f.trigger_t,
             g(m.map(|m| m.blur_px)),
@@ -50,6 +50,8 @@ pub fn frames_csv(records: &[FrameRecord]) -> String {
             m.map_or(String::new(), |m| m.blobs_matched.to_string()),
             m.map_or(String::new(), |m| m.samples_per_pixel.to_string()),
             g(m.map(|m| m.render_ms)),
+            g(m.map(|m| m.pose_err_m)),
+            g(m.map(|m| m.pose_err_deg)),
         );
     }
     s
@@ -86,6 +88,10 @@ pub struct PolicyStats {
     pub max_blur: f64,
     /// Mean exposure MMBM of kept frames, mm/s.
     pub mean_exposure_mmbm: f64,
+    /// Mean camera-position error of the pose from the 16 blobs (frames with all 16), m.
+    pub mean_pose_err_m: f64,
+    /// Mean orientation error of that pose, degrees.
+    pub mean_pose_err_deg: f64,
 }
 
 fn mean(v: &[f64]) -> f64 {
@@ -134,6 +140,16 @@ pub fn policy_stats(walks: &[Walk], records: &[FrameRecord]) -> Vec<PolicyStats>
                 .map(|m| m.blur_effect)
                 .filter(|x| x.is_finite())
                 .collect();
+            let pe: Vec<f64> = rs
+                .iter()
+                .map(|m| m.pose_err_m)
+                .filter(|x| x.is_finite())
+                .collect();
+            let pd: Vec<f64> = rs
+                .iter()
+                .map(|m| m.pose_err_deg)
+                .filter(|x| x.is_finite())
+                .collect();
             let sm = summary_over(frames, dur);
             out.push(PolicyStats {
                 walk: w.name.clone(),
@@ -150,6 +166,8 @@ pub fn policy_stats(walks: &[Walk], records: &[FrameRecord]) -> Vec<PolicyStats>
                 p95_blur: percentile(&blur, 95.0),
                 max_blur: blur.iter().copied().fold(f64::NAN, f64::max),
                 mean_exposure_mmbm: sm.mean_mm_s,
+                mean_pose_err_m: mean(&pe),
+                mean_pose_err_deg: mean(&pd),
             });
         }
     }
@@ -200,7 +218,7 @@ pub fn table_5_1(walks: &[Walk]) -> String {
 /// policy, blob success, JNBM and blur.
 pub fn table_6(stats: &[PolicyStats]) -> String {
     let mut s = String::from(
-        "| walk | policy | frames kept | fps | frames lost vs fixed | rendered | all 16 blobs | success % | mean JNBM | mean CPBD | mean blur effect | mean blur px | p95 blur px | max blur px | mean exposure MMBM mm/s |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+        "| walk | policy | frames kept | fps | frames lost vs fixed | rendered | all 16 blobs | success % | mean JNBM | mean CPBD | mean blur effect | mean blur px | p95 blur px | max blur px | mean exposure MMBM mm/s | pose error cm | pose error deg |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     for st in stats {
         let fixed = stats
@@ -215,7 +233,7 @@ pub fn table_6(stats: &[PolicyStats]) -> String {
         };
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
             st.walk,
             st.policy,
             st.kept,
@@ -230,7 +248,9 @@ pub fn table_6(stats: &[PolicyStats]) -> String {
             f(st.mean_blur, 2),
             f(st.p95_blur, 2),
             f(st.max_blur, 2),
-            f(st.mean_exposure_mmbm, 3)
+            f(st.mean_exposure_mmbm, 3),
+            f(100.0 * st.mean_pose_err_m, 1),
+            f(st.mean_pose_err_deg, 2)
         );
     }
     s

@@ -51,6 +51,11 @@ pub struct FrameMeasure {
     pub blobs_matched: usize,
     /// All 16 found, each near its true centre.
     pub blobs_ok: bool,
+    /// When all 16 blobs were extracted: error of the camera position estimated
+    /// from them (planar homography) against the true mid-exposure pose, m.
+    pub pose_err_m: f64,
+    /// The same for the orientation, degrees.
+    pub pose_err_deg: f64,
     /// Samples per pixel used by the renderer.
     pub samples_per_pixel: u32,
     /// Render time, ms.
@@ -185,16 +190,25 @@ pub fn render_and_measure(
     let rgb8 = super::measure::to_rgb8(cam.width, cam.height, &out.rgb)?;
     // True blob centres at mid-exposure (the centroid of a smear).
     let mid = traj.pose_at(0.5 * cfg.exposure_s);
-    let expected: Vec<(f64, f64)> = target
+    let frame_pl = target.frame();
+    let (board, expected): (Vec<(f64, f64)>, Vec<(f64, f64)>) = target
         .blob_centres()
         .unwrap_or_default()
         .iter()
-        .filter_map(|&p| render::project(&cam, &mid, p))
-        .collect();
+        .filter_map(|&p| {
+            let d = p - frame_pl.origin;
+            render::project(&cam, &mid, p).map(|px| ((d.dot(frame_pl.e1), d.dot(frame_pl.e2)), px))
+        })
+        .unzip();
     // Like the thesis, judge sharpness on the pattern cropped from the frame.
     let crop = super::measure::pattern_crop(&rgb8, &expected);
     let img = super::measure::image_metrics(&crop);
     let blobs = super::measure::blob_metrics(&rgb8, &expected);
+    let (pose_err_m, pose_err_deg) = if blobs.ok {
+        pose_error(&cam, &board, &blobs.matches, &frame_pl, &mid)
+    } else {
+        (f64::NAN, f64::NAN)
+    };
     Ok(Rendered {
         measure: FrameMeasure {
             distance_m: distance,
@@ -207,9 +221,43 @@ pub fn render_and_measure(
             blobs_found: blobs.found,
             blobs_matched: blobs.matched,
             blobs_ok: blobs.ok,
+            pose_err_m,
+            pose_err_deg,
             samples_per_pixel: out.samples_per_pixel,
             render_ms,
         },
         rgb: out.rgb,
     })
+}
+
+/// Pose from the matched blob centres against the true camera pose `mid`
+/// (world = camera at exposure start): `(position error m, angle error deg)`,
+/// NaN when the pose cannot be estimated.
+fn pose_error(
+    cam: &Camera,
+    board: &[(f64, f64)],
+    matches: &[Option<(f64, f64)>],
+    plane: &crate::render::target::PlaneFrame,
+    mid: &crate::render::Pose,
+) -> (f64, f64) {
+    let (b, px): (Vec<(f64, f64)>, Vec<(f64, f64)>) = board
+        .iter()
+        .zip(matches)
+        .filter_map(|(b, m)| m.map(|m| (*b, m)))
+        .unzip();
+    let Ok(est) = crate::pose::planar_pose(cam, &b, &px) else {
+        return (f64::NAN, f64::NAN);
+    };
+    // True camera-from-board transform: X_cam = R_q^T (O + B x - c).
+    let rq_t = glam::DMat3::from_quat(mid.0).transpose();
+    let board_axes = glam::DMat3::from_cols(plane.e1, plane.e2, plane.e1.cross(plane.e2));
+    let truth = crate::pose::PlanarPose {
+        rotation: rq_t * board_axes,
+        translation: rq_t * (plane.origin - mid.1),
+        rms_px: 0.0,
+    };
+    (
+        (est.camera_centre() - truth.camera_centre()).length(),
+        crate::pose::rotation_angle_deg(&est.rotation, &truth.rotation),
+    )
 }
