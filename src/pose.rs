@@ -36,12 +36,13 @@ fn solve(mut a: Vec<[f64; 8]>, mut b: Vec<f64>) -> Option<[f64; 8]> {
         }
         a.swap(col, piv);
         b.swap(col, piv);
-        for r in col + 1..n {
-            let k = a[r][col] / a[col][col];
-            for c in col..n {
-                a[r][c] -= k * a[col][c];
+        let (pivot_row, pivot_b) = (a[col], b[col]);
+        for (row, br) in a.iter_mut().zip(b.iter_mut()).skip(col + 1) {
+            let k = row[col] / pivot_row[col];
+            for (x, p) in row.iter_mut().zip(pivot_row.iter()).skip(col) {
+                *x -= k * p;
             }
-            b[r] -= k * b[col];
+            *br -= k * pivot_b;
         }
     }
     let mut x = [0.0; 8];

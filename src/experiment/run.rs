@@ -13,6 +13,9 @@ use crate::trigger::{self, parse_policy, CameraTiming, Frame};
 use std::str::FromStr;
 use std::time::Instant;
 
+/// A 2-D point: board coordinates (m) or pixel coordinates (px).
+type Point2 = (f64, f64);
+
 /// One walk (simulated or a real log) with its MMBM series and every policy's frames.
 #[derive(Debug, Clone)]
 pub struct Walk {
@@ -191,7 +194,7 @@ pub fn render_and_measure(
     // True blob centres at mid-exposure (the centroid of a smear).
     let mid = traj.pose_at(0.5 * cfg.exposure_s);
     let frame_pl = target.frame();
-    let (board, expected): (Vec<(f64, f64)>, Vec<(f64, f64)>) = target
+    let (board, expected): (Vec<Point2>, Vec<Point2>) = target
         .blob_centres()
         .unwrap_or_default()
         .iter()
@@ -240,7 +243,7 @@ fn pose_error(
     plane: &crate::render::target::PlaneFrame,
     mid: &crate::render::Pose,
 ) -> (f64, f64) {
-    let (b, px): (Vec<(f64, f64)>, Vec<(f64, f64)>) = board
+    let (b, px): (Vec<Point2>, Vec<Point2>) = board
         .iter()
         .zip(matches)
         .filter_map(|(b, m)| m.map(|m| (*b, m)))
