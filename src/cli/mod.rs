@@ -27,10 +27,14 @@ pub struct Cli {
 }
 
 const EXAMPLES: &str = "Examples:
+  mmbm demo                                   # the thesis experiment on defaults, report in mmbm-report/
   mmbm eval --omega 1,1,1 --method exact --json
   mmbm eval --omega 0,0,0 --velocity 0.25,0.125,-1 --depth 1
   mmbm series --gyro ../shared/data/running_phone/gyro.csv --out mmbm.csv
   mmbm tables --plot fig46.png
+  mmbm simulate --gait moderate --duration 30 --out walk.csv
+  mmbm trigger --gyro walk.csv --policy threshold:0.4 --exposure 0.07 --summary
+  mmbm render --omega 0.3,-0.2,0.5 --exposure 0.05 --target checker:0.02 --distance 1 --out blur.png
   mmbm info";
 
 #[derive(Subcommand)]
@@ -43,7 +47,7 @@ enum Command {
     Tables(tables::TablesArgs),
     /// List GPU adapters and show which one mmbm uses.
     Info,
-    /// Measure throughput of the metric methods (and GPU kernels).
+    /// Measure throughput: metric methods, GPU flow kernels, trigger policies, renderer.
     Bench(bench::BenchArgs),
     /// Per-pixel flow field at sensor resolution on the GPU (EXR, optional quiver PNG).
     Flow(flow::FlowArgs),
