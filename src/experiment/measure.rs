@@ -188,16 +188,9 @@ pub fn findings(stats: &[PolicyStats]) -> String {
             .iter()
             .filter(|x| x.walk == st.walk && !x.policy.starts_with("fixed"))
             .collect();
-        let succ = |x: &PolicyStats| {
-            if x.rendered > 0 {
-                100.0 * x.blobs_ok as f64 / x.rendered as f64
-            } else {
-                f64::NAN
-            }
-        };
         s += &format!(
             "- {} walk, baseline `{}`: {} frames, blob success {:.0} %, mean JNBM {:.3}, mean blur {:.1} px (p95 {:.1}).\n",
-            st.walk, st.policy, st.kept, succ(st), st.mean_jnbm, st.mean_blur, st.p95_blur
+            st.walk, st.policy, st.kept, st.success_pct(), st.mean_jnbm, st.mean_blur, st.p95_blur
         );
         for o in others {
             s += &format!(
@@ -205,7 +198,7 @@ pub fn findings(stats: &[PolicyStats]) -> String {
                 o.policy,
                 o.kept,
                 o.kept as i64 - st.kept as i64,
-                succ(o),
+                o.success_pct(),
                 o.mean_jnbm,
                 o.mean_blur,
                 o.p95_blur
@@ -220,13 +213,6 @@ pub fn findings(stats: &[PolicyStats]) -> String {
         else {
             continue;
         };
-        let succ = |x: &PolicyStats| {
-            if x.rendered > 0 {
-                100.0 * x.blobs_ok as f64 / x.rendered as f64
-            } else {
-                f64::NAN
-            }
-        };
         s += &format!(
             "\nOn the {} walk, MMBM triggering at 0.4 mm/s (`threshold:0.4`, the thesis rule) against `{}`: \
              blob success {:.0} % -> {:.0} %, mean ground-truth blur {:.1} -> {:.1} px (p95 {:.1} -> {:.1}), \
@@ -235,8 +221,8 @@ pub fn findings(stats: &[PolicyStats]) -> String {
              JNBM from 0.36 to 0.49.\n",
             base.walk,
             base.policy,
-            succ(base),
-            succ(th),
+            base.success_pct(),
+            th.success_pct(),
             base.mean_blur,
             th.mean_blur,
             base.p95_blur,

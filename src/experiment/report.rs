@@ -1,7 +1,7 @@
 //! `frames.csv` and `report.md`: the thesis's Tables 5.1, 6.1 and 6.2
 //! recomputed per walk and policy.
 
-use super::run::{FrameRecord, Walk};
+use super::run::{FrameMeasure, FrameRecord, Walk};
 use crate::trigger::{prediction_error, summary_over};
 use std::fmt::Write as _;
 
@@ -55,6 +55,17 @@ pub fn frames_csv(records: &[FrameRecord]) -> String {
         );
     }
     s
+}
+
+impl PolicyStats {
+    /// Share of rendered frames with all 16 blobs, %; NaN when none was rendered.
+    pub fn success_pct(&self) -> f64 {
+        if self.rendered > 0 {
+            100.0 * self.blobs_ok as f64 / self.rendered as f64
+        } else {
+            f64::NAN
+        }
+    }
 }
 
 /// Per (walk, policy) statistics over the rendered frames.
@@ -125,31 +136,15 @@ pub fn policy_stats(walks: &[Walk], records: &[FrameRecord]) -> Vec<PolicyStats>
                 .filter_map(|r| r.measure.as_ref())
                 .collect();
             let blur: Vec<f64> = rs.iter().map(|m| m.blur_px).collect();
-            let jnbm: Vec<f64> = rs
-                .iter()
-                .map(|m| m.jnbm)
-                .filter(|x| x.is_finite())
-                .collect();
-            let cpbd: Vec<f64> = rs
-                .iter()
-                .map(|m| m.cpbd)
-                .filter(|x| x.is_finite())
-                .collect();
-            let be: Vec<f64> = rs
-                .iter()
-                .map(|m| m.blur_effect)
-                .filter(|x| x.is_finite())
-                .collect();
-            let pe: Vec<f64> = rs
-                .iter()
-                .map(|m| m.pose_err_m)
-                .filter(|x| x.is_finite())
-                .collect();
-            let pd: Vec<f64> = rs
-                .iter()
-                .map(|m| m.pose_err_deg)
-                .filter(|x| x.is_finite())
-                .collect();
+            // Mean of one measurement over the frames where it is defined.
+            let mean_of = |get: fn(&FrameMeasure) -> f64| {
+                let v: Vec<f64> = rs
+                    .iter()
+                    .map(|m| get(m))
+                    .filter(|x| x.is_finite())
+                    .collect();
+                mean(&v)
+            };
             let sm = summary_over(frames, dur);
             out.push(PolicyStats {
                 walk: w.name.clone(),
@@ -159,15 +154,15 @@ pub fn policy_stats(walks: &[Walk], records: &[FrameRecord]) -> Vec<PolicyStats>
                 rendered: rs.len(),
                 fps: sm.effective_fps,
                 blobs_ok: rs.iter().filter(|m| m.blobs_ok).count(),
-                mean_jnbm: mean(&jnbm),
-                mean_cpbd: mean(&cpbd),
-                mean_blur_effect: mean(&be),
+                mean_jnbm: mean_of(|m| m.jnbm),
+                mean_cpbd: mean_of(|m| m.cpbd),
+                mean_blur_effect: mean_of(|m| m.blur_effect),
                 mean_blur: mean(&blur),
                 p95_blur: percentile(&blur, 95.0),
                 max_blur: blur.iter().copied().fold(f64::NAN, f64::max),
                 mean_exposure_mmbm: sm.mean_mm_s,
-                mean_pose_err_m: mean(&pe),
-                mean_pose_err_deg: mean(&pd),
+                mean_pose_err_m: mean_of(|m| m.pose_err_m),
+                mean_pose_err_deg: mean_of(|m| m.pose_err_deg),
             });
         }
     }
@@ -226,11 +221,7 @@ pub fn table_6(stats: &[PolicyStats]) -> String {
             .find(|x| x.walk == st.walk && x.policy.starts_with("fixed"))
             .map(|x| x.kept as i64);
         let lost = fixed.map_or("-".into(), |k| (k - st.kept as i64).to_string());
-        let succ = if st.rendered > 0 {
-            100.0 * st.blobs_ok as f64 / st.rendered as f64
-        } else {
-            f64::NAN
-        };
+        let succ = st.success_pct();
         let _ = writeln!(
             s,
             "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
