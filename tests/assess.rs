@@ -163,7 +163,7 @@ fn jnbm_falls_with_gaussian_blur() {
 #[test]
 fn colour_image_uses_rec601_luma() {
     // the RGB fixture's reference values were computed on the same integer luma
-    let rgb = mmbm::imageio::read_rgb8(&fixture("astronaut.png")).unwrap();
+    let rgb = mmbm::io::images::read_rgb8(&fixture("astronaut.png")).unwrap();
     let g = mmbm::assess::luma(&rgb);
     assert_eq!(g, load_grey(&fixture("astronaut.png")).unwrap());
     let p = rgb.get_pixel(100, 100).0;

@@ -2,8 +2,9 @@
 //! OK, heavy motion blur -> failure.
 
 use image::RgbImage;
-use mmbm::blobs::{board_centres_px, evaluate, extract, BlobParams, Board};
-use mmbm::imageio::{linear_to_srgb8, srgb8_to_linear};
+use mmbm::board::blobs::{evaluate, extract, BlobParams};
+use mmbm::board::{board_centres_px, Board};
+use mmbm::io::images::{linear_to_srgb8, srgb8_to_linear};
 use mmbm::Camera;
 
 const RED: [u8; 3] = [200, 25, 30];
@@ -76,7 +77,7 @@ fn run(
     shift: (f64, f64),
     blur: usize,
     noise: f64,
-) -> mmbm::blobs::BlobResult {
+) -> mmbm::board::blobs::BlobResult {
     let c = cam();
     let img = draw(&c, board, d, shift, blur, noise);
     let blobs = extract(&img, &BlobParams::default()).unwrap();

@@ -3,7 +3,8 @@
 //! `blobs::board_centres_px` from the board geometry), heavy blur fails.
 
 use glam::DVec3;
-use mmbm::blobs::{board_centres_px, evaluate, extract, BlobParams, Board};
+use mmbm::board::blobs::{evaluate, extract, BlobParams};
+use mmbm::board::{board_centres_px, Board};
 use mmbm::render::{render_frame, Quality, RenderJob, Target, Trajectory};
 use mmbm::{Camera, Twist};
 
@@ -20,7 +21,7 @@ fn frame(tw: Twist, distance: f64) -> image::RgbImage {
     let bytes = out
         .rgb
         .iter()
-        .map(|&x| mmbm::imageio::linear_to_srgb8(x))
+        .map(|&x| mmbm::io::images::linear_to_srgb8(x))
         .collect();
     image::RgbImage::from_raw(320, 240, bytes).unwrap()
 }

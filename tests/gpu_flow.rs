@@ -3,10 +3,11 @@
 //! unless MMBM_REQUIRE_GPU=1.
 
 use glam::DVec3;
+use mmbm::field::cpu as flow_cpu;
+use mmbm::field::{flow_field_gpu, mmbm_gpu, FlowRunner, Grid, TwistGpu};
 use mmbm::gpu::context::gpu_or_skip;
-use mmbm::gpu::flow::{flow_field_gpu, mmbm_gpu, series_evaluator, FlowRunner, Grid, TwistGpu};
-use mmbm::gpu::flow_cpu;
-use mmbm::gyro::GyroSample;
+use mmbm::io::gyro::GyroSample;
+use mmbm::series::gpu::series_evaluator;
 use mmbm::series::{eval_batch_cpu, SeriesOptions};
 use mmbm::{mmbm, Camera, Method, Plane, Scene, Twist};
 use std::process::Command;
@@ -345,7 +346,7 @@ fn flow_command_writes_exr_and_quiver() {
         .output()
         .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let (w, h, ch) = mmbm::imageio::read_exr(&exr).unwrap();
+    let (w, h, ch) = mmbm::io::images::read_exr(&exr).unwrap();
     assert_eq!((w, h), (160, 120));
     let get = |n: &str| {
         &ch.iter()
@@ -365,7 +366,7 @@ fn flow_command_writes_exr_and_quiver() {
         assert!((v[k] as f64 - r[1]).abs() <= 1e-5 * max);
         assert!((sp[k] as f64 - r[0].hypot(r[1])).abs() <= 1e-5 * max);
     }
-    let img = mmbm::imageio::read_rgb8(&png).unwrap();
+    let img = mmbm::io::images::read_rgb8(&png).unwrap();
     assert!(img.width() >= 640 && img.height() >= 300);
     // Bad input: exposure must be positive; nothing written.
     let exr2 = d.path().join("g.exr");

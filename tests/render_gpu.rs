@@ -2,7 +2,7 @@
 
 use glam::DVec3;
 use mmbm::gpu::context::gpu_or_skip;
-use mmbm::imageio::{read_rgb8, save_rgb8, write_png_linear_rgb};
+use mmbm::io::images::{read_rgb8, save_rgb8, write_png_linear_rgb};
 use mmbm::render::{self, Backend, Quality, RenderJob, Target, Trajectory};
 use mmbm::{Camera, Twist};
 use std::path::PathBuf;
@@ -129,7 +129,7 @@ fn golden_renders() {
         let actual: Vec<u8> = out
             .rgb
             .iter()
-            .map(|&x| mmbm::imageio::linear_to_srgb8(x))
+            .map(|&x| mmbm::io::images::linear_to_srgb8(x))
             .collect();
         let mut d: Vec<i32> = gold
             .as_raw()

@@ -2,9 +2,9 @@
 //! the metric, sample-count convergence, PSF, gyro-log trajectories, bad input.
 
 use glam::{DQuat, DVec3};
-use mmbm::flow::flow_mm;
-use mmbm::gyro::GyroSample;
+use mmbm::io::gyro::GyroSample;
 use mmbm::metric::{mmbm, Method};
+use mmbm::model::flow::flow_mm;
 use mmbm::render::{self, project, Backend, Quality, RenderJob, Target, Trajectory};
 use mmbm::{Camera, Plane, Scene, Twist};
 

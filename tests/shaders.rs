@@ -31,7 +31,7 @@ fn all_shaders_validate() {
     files.sort();
     assert!(
         files.iter().any(|p| p.ends_with("flow.wgsl")),
-        "shaders/flow.wgsl not found in {files:?}"
+        "shaders/field.wgsl not found in {files:?}"
     );
     let errors: Vec<String> = files.iter().filter_map(|p| validate(p).err()).collect();
     assert!(errors.is_empty(), "{}", errors.join("\n\n"));

@@ -1,9 +1,9 @@
 //! Gait simulator: determinism per seed, prefix property, calibration targets,
 //! config loading, log round trip.
 
-use mmbm::gyro::{read_log, GyroOptions};
+use mmbm::io::gyro::{read_log, GyroOptions};
+use mmbm::series::mmbm_series;
 use mmbm::sim::{simulate, write_log, Gait, GaitConfig};
-use mmbm::trigger::mmbm_series;
 use mmbm::{Method, Scene};
 use std::path::Path;
 

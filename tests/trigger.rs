@@ -2,7 +2,8 @@
 //! causality invariants, quality ordering on the simulated gaits.
 
 use glam::DVec3;
-use mmbm::gyro::GyroSample;
+use mmbm::io::gyro::GyroSample;
+use mmbm::series::mmbm_series;
 use mmbm::sim::{simulate, Gait, GaitConfig};
 use mmbm::trigger::*;
 use mmbm::{Method, Scene};

@@ -2,9 +2,8 @@
 
 use super::args::CameraArgs;
 use clap::{Args, ValueEnum};
-use mmbm::blobs::{
-    board_centres_px, components, evaluate, red_mask, Blob, BlobParams, BlobResult, Board,
-};
+use mmbm::board::blobs::{components, evaluate, red_mask, Blob, BlobParams, BlobResult};
+use mmbm::board::{board_centres_px, Board};
 use mmbm::error::{Error, Result};
 use std::path::{Path, PathBuf};
 
@@ -75,7 +74,7 @@ fn read_expected(path: &Path) -> Result<(Vec<(f64, f64)>, f64)> {
 }
 
 pub fn run(a: BlobsArgs) -> Result<()> {
-    let img = mmbm::imageio::read_rgb8(&a.image)?;
+    let img = mmbm::io::images::read_rgb8(&a.image)?;
     let params = BlobParams {
         threshold: a.threshold,
         min_area: a.min_area,
@@ -113,7 +112,7 @@ pub fn run(a: BlobsArgs) -> Result<()> {
         None => None,
     };
     if let Some(p) = &a.mask {
-        mmbm::output::write_atomic_path(p, |tmp| {
+        mmbm::io::atomic::write_atomic_path(p, |tmp| {
             mask.save_with_format(tmp, image::ImageFormat::Png)
                 .map_err(|e| Error::Image {
                     path: p.clone(),

@@ -42,7 +42,7 @@ pub fn run(a: EvalArgs) -> Result<()> {
     let m = match method {
         Method::Gpu { width, height } => {
             scene.validate_for(&tw)?;
-            mmbm::gpu::flow::mmbm_gpu(&scene, &tw, width, height)?
+            mmbm::field::mmbm_gpu(&scene, &tw, width, height)?
         }
         _ => mmbm::mmbm(&scene, &tw, method)?,
     };

@@ -48,9 +48,9 @@ pub fn run(a: FlowArgs) -> Result<()> {
     };
     let tw = Twist::new(a.omega, a.velocity.unwrap_or(DVec3::ZERO));
     scene.validate_for(&tw)?;
-    let f = mmbm::gpu::flow::flow_field_gpu(&scene, &tw, 0, 0)?;
+    let f = mmbm::field::flow_field_gpu(&scene, &tw, 0, 0)?;
     let speed = f.speed();
-    mmbm::imageio::write_exr(
+    mmbm::io::images::write_exr(
         &a.out,
         f.width as usize,
         f.height as usize,
@@ -65,7 +65,7 @@ pub fn run(a: FlowArgs) -> Result<()> {
     );
     println!("wrote {}", a.out.display());
     if let Some(q) = &a.quiver {
-        mmbm::quiver::quiver_png(&scene.camera, &f.u, &f.v, a.exposure, q)?;
+        mmbm::plot::quiver::quiver_png(&scene.camera, &f.u, &f.v, a.exposure, q)?;
         println!("wrote {}", q.display());
     }
     Ok(())

@@ -5,7 +5,7 @@ use super::series::GyroArgs;
 use clap::Args;
 use glam::DVec3;
 use mmbm::error::{Error, Result};
-use mmbm::imageio::{write_exr, write_png_linear_rgb};
+use mmbm::io::images::{write_exr, write_png_linear_rgb};
 use mmbm::render::{self, Backend, Quality, RenderJob, RenderOutput, Target, Trajectory};
 use mmbm::Twist;
 use std::path::{Path, PathBuf};
@@ -176,7 +176,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
         (None, Some(path)) => {
             let at =
                 a.at.ok_or_else(|| Error::invalid("--at", "required with --gyro"))?;
-            let samples = mmbm::gyro::read_log(path, a.gyro_opts.options()?)?;
+            let samples = mmbm::io::gyro::read_log(path, a.gyro_opts.options()?)?;
             Trajectory::from_log(&samples, at, a.exposure, a.use_velocity)
                 .map_err(|e| Error::invalid("--gyro", format!("{}: {e}", path.display())))?
         }

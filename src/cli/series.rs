@@ -3,7 +3,7 @@
 use super::args::{CameraArgs, SceneArgs};
 use clap::Args;
 use mmbm::error::Result;
-use mmbm::gyro::{parse_rotation, AngleUnit, GyroOptions, GyroReader, TimeUnit};
+use mmbm::io::gyro::{parse_rotation, AngleUnit, GyroOptions, GyroReader, TimeUnit};
 use mmbm::series::{self, SeriesOptions};
 use mmbm::{Method, Scene};
 use std::path::PathBuf;
@@ -81,14 +81,14 @@ pub fn run(a: SeriesArgs) -> Result<()> {
     }
     let reader = GyroReader::open(&a.gyro, a.gyro_opts.options()?)?;
     let mut eval: Box<series::BatchFn> = match method {
-        Method::Gpu { width, height } => mmbm::gpu::flow::series_evaluator(opts, width, height)?,
-        _ => Box::new(move |b: &[mmbm::gyro::GyroSample]| series::eval_batch_cpu(b, &opts)),
+        Method::Gpu { width, height } => mmbm::series::gpu::series_evaluator(opts, width, height)?,
+        _ => Box::new(move |b: &[mmbm::io::gyro::GyroSample]| series::eval_batch_cpu(b, &opts)),
     };
     let pitch = opts.scene.camera.pitch_x_mm;
     let n = match &a.out {
         Some(p) => {
             let mut n = 0;
-            mmbm::output::write_atomic(p, |w| {
+            mmbm::io::atomic::write_atomic(p, |w| {
                 n = series::run(reader, &mut eval, pitch, w)?;
                 Ok(())
             })?;

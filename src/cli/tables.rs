@@ -48,7 +48,7 @@ pub fn run(a: TablesArgs) -> Result<()> {
         }
     }
     if let Some(p) = &a.plot {
-        mmbm::plot::grid_error_plot(&grid, p)?;
+        mmbm::tables::grid_error_plot(&grid, p)?;
         eprintln!("wrote {}", p.display());
     }
     Ok(())

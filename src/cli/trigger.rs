@@ -4,7 +4,7 @@ use super::args::{CameraArgs, SceneArgs};
 use super::series::GyroArgs;
 use clap::Args;
 use mmbm::error::{Error, Result};
-use mmbm::gyro::read_log;
+use mmbm::io::gyro::read_log;
 use mmbm::series::SeriesOptions;
 use mmbm::trigger::{self, CameraTiming, Frame};
 use mmbm::{Method, Scene};
@@ -101,7 +101,7 @@ pub fn run(a: TriggerArgs) -> Result<()> {
         use_velocity: a.use_velocity,
     };
     let samples = read_log(&a.gyro, a.gyro_opts.options()?)?;
-    let m = trigger::mmbm_series_with(&samples, &opts)?;
+    let m = mmbm::series::mmbm_series_with(&samples, &opts)?;
     let duration = samples[samples.len() - 1].t - samples[0].t;
     let mut all = Vec::new();
     let mut text = String::new();
@@ -118,7 +118,7 @@ pub fn run(a: TriggerArgs) -> Result<()> {
         Ok(())
     };
     match &a.out {
-        Some(p) => mmbm::output::write_atomic(p, |w| write(w))?,
+        Some(p) => mmbm::io::atomic::write_atomic(p, |w| write(w))?,
         None if !a.summary => {
             let mut out = std::io::BufWriter::new(std::io::stdout().lock());
             write(&mut out)?;

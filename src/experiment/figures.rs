@@ -3,8 +3,8 @@
 //! montage of frames.
 
 use crate::error::Result;
-use crate::imageio::{linear_to_srgb8, save_rgb8};
-use crate::output::write_atomic_path;
+use crate::io::atomic::write_atomic_path;
+use crate::io::images::{linear_to_srgb8, save_rgb8};
 use crate::plot::{ensure_font, plot_error};
 use plotters::prelude::*;
 use std::path::Path;

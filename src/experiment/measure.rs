@@ -4,7 +4,7 @@
 use super::config::ExperimentConfig;
 use super::report::PolicyStats;
 use crate::error::{Error, Result};
-use crate::imageio::linear_to_srgb8;
+use crate::io::images::linear_to_srgb8;
 
 /// Linear RGB (interleaved) to an 8-bit sRGB image.
 pub fn to_rgb8(width: u32, height: u32, rgb: &[f32]) -> Result<image::RgbImage> {
@@ -111,8 +111,10 @@ pub struct BlobOutcome {
 /// Extracts the red blobs and matches them against the expected centres (px).
 pub fn blob_metrics(img: &image::RgbImage, expected: &[(f64, f64)]) -> BlobOutcome {
     let pitch = pitch_px(expected);
-    let r = crate::blobs::extract(img, &crate::blobs::BlobParams::default())
-        .and_then(|blobs| crate::blobs::evaluate(&blobs, expected, pitch).map(|r| (blobs, r)));
+    let r = crate::board::blobs::extract(img, &crate::board::blobs::BlobParams::default())
+        .and_then(|blobs| {
+            crate::board::blobs::evaluate(&blobs, expected, pitch).map(|r| (blobs, r))
+        });
     match r {
         Ok((blobs, r)) => BlobOutcome {
             found: r.found,

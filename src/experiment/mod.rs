@@ -20,8 +20,8 @@ pub mod run;
 pub use config::ExperimentConfig;
 
 use crate::error::{Error, Result};
+use crate::io::atomic::write_atomic;
 use crate::metric::Scene;
-use crate::output::write_atomic;
 use crate::render::Quality;
 use indicatif::{ProgressBar, ProgressStyle};
 use run::{FrameRecord, Walk};
@@ -208,24 +208,24 @@ pub fn run(cfg: &ExperimentConfig, out: &Path, progress: bool) -> Result<Outcome
         }
         // Flow quiver at the sample of highest MMBM.
         if let Some((k, _)) = w.mmbm.iter().enumerate().max_by(|a, b| a.1.total_cmp(b.1)) {
-            let tw = crate::motion::Twist::new(w.samples[k].omega, glam::DVec3::ZERO);
+            let tw = crate::model::motion::Twist::new(w.samples[k].omega, glam::DVec3::ZERO);
             // The field on the GPU, or its CPU twin when there is no adapter.
             let scene = Scene {
                 camera: cam,
                 plane: None,
             };
-            let (u, v) = match crate::gpu::flow::flow_field_gpu(&scene, &tw, 0, 0) {
+            let (u, v) = match crate::field::flow_field_gpu(&scene, &tw, 0, 0) {
                 Ok(f) => (f.u, f.v),
                 Err(_) => {
-                    let grid = crate::gpu::flow_params::Grid::new(&cam, 0, 0)?;
-                    let g = crate::gpu::flow_params::TwistGpu::new(cam.focal_mm, &tw, None);
-                    let f = crate::gpu::flow_cpu::flow_tiles(&grid, &g, true);
+                    let grid = crate::field::kernel::Grid::new(&cam, 0, 0)?;
+                    let g = crate::field::kernel::TwistGpu::new(cam.focal_mm, &tw, None);
+                    let f = crate::field::cpu::flow_tiles(&grid, &g, true);
                     f.field.iter().map(|x| (x[0], x[1])).unzip()
                 }
             };
             {
                 let name = format!("quiver_{}.png", w.name);
-                crate::quiver::quiver_png(&cam, &u, &v, cfg.exposure_s, &out.join(&name))?;
+                crate::plot::quiver::quiver_png(&cam, &u, &v, cfg.exposure_s, &out.join(&name))?;
                 figs.push(name);
             }
         }

@@ -3,10 +3,10 @@
 //! metrics and blob extraction per frame.
 
 use super::config::ExperimentConfig;
-use crate::camera::Camera;
 use crate::error::{Error, Result};
-use crate::gyro::{read_log, GyroOptions, GyroSample};
+use crate::io::gyro::{read_log, GyroOptions, GyroSample};
 use crate::metric::{Method, Scene};
+use crate::model::camera::Camera;
 use crate::render::{self, Backend, Quality, RenderJob, Target, Trajectory};
 use crate::sim::{simulate, Gait, GaitConfig};
 use crate::trigger::{self, parse_policy, CameraTiming, Frame};
@@ -94,7 +94,7 @@ pub fn make_walk(cfg: &ExperimentConfig, walk: &str, scene: &Scene) -> Result<Wa
             )
         }
     };
-    let mmbm = trigger::mmbm_series(&samples, scene, Method::default())?;
+    let mmbm = crate::series::mmbm_series(&samples, scene, Method::default())?;
     // Distance to the target: integrate the forward velocity (or the
     // configured speed), starting at start_distance, never closer than min_distance.
     let mut distance = Vec::with_capacity(samples.len());
@@ -248,19 +248,19 @@ fn pose_error(
         .zip(matches)
         .filter_map(|(b, m)| m.map(|m| (*b, m)))
         .unzip();
-    let Ok(est) = crate::pose::planar_pose(cam, &b, &px) else {
+    let Ok(est) = crate::board::pose::planar_pose(cam, &b, &px) else {
         return (f64::NAN, f64::NAN);
     };
     // True camera-from-board transform: X_cam = R_q^T (O + B x - c).
     let rq_t = glam::DMat3::from_quat(mid.0).transpose();
     let board_axes = glam::DMat3::from_cols(plane.e1, plane.e2, plane.e1.cross(plane.e2));
-    let truth = crate::pose::PlanarPose {
+    let truth = crate::board::pose::PlanarPose {
         rotation: rq_t * board_axes,
         translation: rq_t * (plane.origin - mid.1),
         rms_px: 0.0,
     };
     (
         (est.camera_centre() - truth.camera_centre()).length(),
-        crate::pose::rotation_angle_deg(&est.rotation, &truth.rotation),
+        crate::board::pose::rotation_angle_deg(&est.rotation, &truth.rotation),
     )
 }

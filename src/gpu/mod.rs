@@ -1,11 +1,58 @@
-//! GPU support through wgpu: the shared device ([`context`]) and the kernels.
-//! Every kernel has a CPU twin beside it in the source tree.
+//! GPU support through wgpu: the process-wide device ([`context`]), the
+//! compute plumbing every kernel shares ([`compute`]: shader build under an
+//! error scope, buffers, read-back) and the [`Backend`] choice. The kernels
+//! themselves live with their features (`field`, `render`), each beside its
+//! CPU twin.
 
+pub mod compute;
 pub mod context;
-pub mod flow;
-pub mod flow_bench;
-pub mod flow_cpu;
-pub mod flow_params;
-pub mod flow_runner;
 
 pub use context::{gpu, GpuContext};
+
+use crate::error::Result;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+/// Where a kernel runs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Backend {
+    /// The GPU when an adapter exists, else the CPU twin (announced on stderr).
+    #[default]
+    Auto,
+    /// The GPU or an error.
+    Gpu,
+    /// The CPU twin; `threads = None` uses rayon's global pool.
+    Cpu {
+        /// Worker threads.
+        threads: Option<usize>,
+    },
+}
+
+/// A [`Backend`] resolved against the machine: the device, or the CPU twin.
+#[derive(Clone, Copy)]
+pub enum Resolved {
+    /// Run on this device.
+    Gpu(&'static GpuContext),
+    /// Run the CPU twin with this many threads (`None`: rayon's global pool).
+    Cpu(Option<usize>),
+}
+
+impl Backend {
+    /// The device for `Gpu` (or an error) and `Auto` (when one exists), else
+    /// the CPU twin. `Auto` without an adapter prints `"{what}: {error}; using
+    /// the CPU {twin}"` on stderr, once per `announced` flag.
+    pub fn resolve(self, what: &str, twin: &str, announced: &AtomicBool) -> Result<Resolved> {
+        match self {
+            Backend::Cpu { threads } => Ok(Resolved::Cpu(threads)),
+            Backend::Gpu => Ok(Resolved::Gpu(gpu()?)),
+            Backend::Auto => match gpu() {
+                Ok(ctx) => Ok(Resolved::Gpu(ctx)),
+                Err(e) => {
+                    if !announced.swap(true, Ordering::Relaxed) {
+                        eprintln!("{what}: {e}; using the CPU {twin}");
+                    }
+                    Ok(Resolved::Cpu(None))
+                }
+            },
+        }
+    }
+}

@@ -8,8 +8,8 @@
 //! The per-region error estimate is `|K15xK15 - G7xG7|`, which is pessimistic
 //! for smooth regions (it is the error of the lower-order rule).
 
-use crate::camera::SensorRect;
-use crate::flow::FlowPoly;
+use crate::model::camera::SensorRect;
+use crate::model::flow::FlowPoly;
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 

@@ -1,31 +1,17 @@
 //! Fixed real-time rules: the thesis's midpoint (Riemann) grid and tensor Gauss-Legendre.
 
-use crate::camera::SensorRect;
-use crate::flow::FlowPoly;
+use crate::model::camera::SensorRect;
+use crate::model::flow::FlowPoly;
 
 /// MMBM* (thesis eq. 4.1): the mean of the flow speed at the centres of an
 /// `nu x nv` grid of equal cells covering the sensor, mm/s.
 pub fn riemann(poly: &FlowPoly, r: &SensorRect, nu: u32, nv: u32) -> f64 {
-    #[cfg(target_arch = "x86_64")]
-    {
-        if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")
-        {
-            // SAFETY: the CPU supports AVX2 and FMA (checked just above).
-            return unsafe { riemann_avx2(poly, r, nu, nv) };
-        }
-    }
-    riemann_impl(poly, r, nu, nv)
+    super::avx2::riemann(poly, r, nu, nv).unwrap_or_else(|| riemann_impl(poly, r, nu, nv))
 }
 
-/// [`riemann_impl`] compiled for AVX2 + FMA (4-wide f64 square roots).
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma")]
-unsafe fn riemann_avx2(poly: &FlowPoly, r: &SensorRect, nu: u32, nv: u32) -> f64 {
-    riemann_impl(poly, r, nu, nv)
-}
-
+/// The body of [`riemann`], also compiled for AVX2 + FMA in [`super::avx2`].
 #[inline(always)]
-fn riemann_impl(poly: &FlowPoly, r: &SensorRect, nu: u32, nv: u32) -> f64 {
+pub(super) fn riemann_impl(poly: &FlowPoly, r: &SensorRect, nu: u32, nv: u32) -> f64 {
     let du = (r.u1 - r.u0) / nu as f64;
     let dv = (r.v1 - r.v0) / nv as f64;
     let (p, q) = (&poly.du, &poly.dv);
@@ -176,26 +162,13 @@ impl GridRule {
 
     /// The rule's estimate of the mean flow speed, mm/s.
     pub fn mean_speed(&self, poly: &FlowPoly) -> f64 {
-        #[cfg(target_arch = "x86_64")]
-        {
-            if std::arch::is_x86_feature_detected!("avx2")
-                && std::arch::is_x86_feature_detected!("fma")
-            {
-                // SAFETY: the CPU supports AVX2 and FMA (checked just above).
-                return unsafe { self.mean_speed_avx2(poly) };
-            }
-        }
-        self.mean_speed_impl(poly)
+        super::avx2::rule_mean(self, poly).unwrap_or_else(|| self.mean_speed_impl(poly))
     }
 
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2,fma")]
-    unsafe fn mean_speed_avx2(&self, poly: &FlowPoly) -> f64 {
-        self.mean_speed_impl(poly)
-    }
-
+    /// The body of [`GridRule::mean_speed`], also compiled for AVX2 + FMA in
+    /// [`super::avx2`].
     #[inline(always)]
-    fn mean_speed_impl(&self, poly: &FlowPoly) -> f64 {
+    pub(super) fn mean_speed_impl(&self, poly: &FlowPoly) -> f64 {
         let (p, q) = (&poly.du, &poly.dv);
         let mut acc = [0.0f64; 8];
         let chunks = self.m[0]

@@ -8,16 +8,17 @@
 //!   with an error estimate;
 //! - [`Method::Gpu`]: full-resolution per-pixel field on the GPU (see `crate::gpu`).
 
+mod avx2;
 mod exact;
 mod grid;
 
 pub use exact::{exact, roll_mean_closed_form, ExactResult};
 pub use grid::{gauss, gauss_legendre, riemann, GridRule};
 
-use crate::camera::Camera;
 use crate::error::{Error, Result};
-use crate::flow::FlowPoly;
-use crate::motion::{Plane, Twist};
+use crate::model::camera::Camera;
+use crate::model::flow::FlowPoly;
+use crate::model::motion::{Plane, Twist};
 use std::fmt;
 use std::str::FromStr;
 
@@ -25,13 +26,31 @@ use std::str::FromStr;
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Method {
     /// Midpoint grid of `nu x nv` cells (`riemann[:NUxNV]`, default 8x6).
-    Riemann { nu: u32, nv: u32 },
+    Riemann {
+        /// Cells across the sensor.
+        nu: u32,
+        /// Cells down the sensor.
+        nv: u32,
+    },
     /// Tensor Gauss-Legendre with `nu x nv` nodes (`gauss[:N]` = N x N, or `gauss:NUxNV`).
-    Gauss { nu: u32, nv: u32 },
+    Gauss {
+        /// Nodes across the sensor.
+        nu: u32,
+        /// Nodes down the sensor.
+        nv: u32,
+    },
     /// Adaptive cubature to relative tolerance `tol` (`exact[:TOL]`, default 1e-9).
-    Exact { tol: f64 },
+    Exact {
+        /// Relative tolerance of the adaptive cubature.
+        tol: f64,
+    },
     /// Full field on the GPU at `width x height` samples (`gpu` = sensor resolution, or `gpu:WxH`).
-    Gpu { width: u32, height: u32 },
+    Gpu {
+        /// Samples per row (0: the sensor's width).
+        width: u32,
+        /// Rows (0: the sensor's height).
+        height: u32,
+    },
 }
 
 impl Default for Method {
@@ -181,7 +200,7 @@ impl Scene {
 }
 
 /// Computes MMBM with a CPU method. Validates inputs first. `Method::Gpu` is
-/// rejected here: use [`crate::gpu::flow::mmbm_gpu`].
+/// rejected here: use [`crate::field::mmbm_gpu`].
 pub fn mmbm(scene: &Scene, tw: &Twist, method: Method) -> Result<Mmbm> {
     scene.validate_for(tw)?;
     let poly = scene.flow_poly(tw);

@@ -2,7 +2,7 @@
 //! values, the roll closed form and properties.
 
 use super::*;
-use crate::motion::Plane;
+use crate::model::motion::Plane;
 use glam::DVec3;
 
 fn twist(a: [f64; 6]) -> Twist {

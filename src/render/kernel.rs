@@ -12,7 +12,7 @@
 use super::target::{Target, TargetKind, BLOB_GAP_M, BLOB_RED, BLOB_SIZE_M, BOARD_WHITE};
 use super::texture::MipTexture;
 use super::trajectory::Pose;
-use crate::camera::Camera;
+use crate::model::camera::Camera;
 use bytemuck::{Pod, Zeroable};
 
 /// Target kind codes in [`RenderParams::dims`].

@@ -15,7 +15,6 @@
 //! per-pixel blur ground truth (path length, displacement, speed), [`psf`] the
 //! point-spread function at a pixel.
 
-pub mod bench;
 pub mod cpu;
 pub mod gpu;
 pub mod kernel;
@@ -25,14 +24,13 @@ pub mod target;
 pub mod texture;
 pub mod trajectory;
 
-pub use bench::bench;
 pub use maps::{blur_maps, BlurMaps, BlurMeans};
 pub use psf::{psf, Psf};
 pub use target::{project, Target, TargetKind};
 pub use trajectory::{Pose, Trajectory};
 
-use crate::camera::Camera;
 use crate::error::{Error, Result};
+use crate::model::camera::Camera;
 use std::fmt;
 use std::str::FromStr;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -269,7 +267,7 @@ pub fn render_frame(job: &RenderJob) -> Result<RenderOutput> {
 pub fn render_sharp(job: &RenderJob) -> Result<RenderOutput> {
     let still = RenderJob {
         trajectory: Trajectory::from_twist(
-            crate::motion::Twist::default(),
+            crate::model::motion::Twist::default(),
             job.trajectory.duration(),
         )?,
         with_maps: false,

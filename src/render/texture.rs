@@ -5,7 +5,7 @@
 //! `shaders/render.wgsl`.
 
 use crate::error::{Error, Result};
-use crate::imageio::{read_rgb8, srgb8_to_linear};
+use crate::io::images::{read_rgb8, srgb8_to_linear};
 use std::path::Path;
 
 /// Largest base level, texels per side; larger images are area-downsampled at load.

@@ -7,8 +7,8 @@
 //! `dR/dt = R [w]x`, `dc/dt = R v` (w rad/s, v m/s, t s).
 
 use crate::error::{positive, Error, Result};
-use crate::gyro::GyroSample;
-use crate::motion::Twist;
+use crate::io::gyro::GyroSample;
+use crate::model::motion::Twist;
 use glam::{DMat3, DQuat, DVec3};
 
 /// A pose: rotation camera-to-world and camera centre (m), both relative to exposure start.

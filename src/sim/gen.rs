@@ -2,7 +2,7 @@
 
 use super::GaitConfig;
 use crate::error::{Error, Result};
-use crate::gyro::GyroSample;
+use crate::io::gyro::GyroSample;
 use glam::DVec3;
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
@@ -204,7 +204,7 @@ pub fn write_log(path: &Path, samples: &[GyroSample]) -> Result<()> {
             "some samples have a depth and some do not",
         ));
     }
-    crate::output::write_atomic(path, |w| {
+    crate::io::atomic::write_atomic(path, |w| {
         let e = |e: std::io::Error| Error::io(path, e);
         let mut header = String::from("t,wx,wy,wz");
         if with_v {

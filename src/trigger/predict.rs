@@ -2,7 +2,7 @@
 //! knowledge of the future, and a blind forecast of the quasi-periodic gait.
 
 use super::policy::{thesis_rule, Level, LogView, Observation, Policy};
-use super::{exposure_means, CameraTiming, Integral};
+use super::timing::{exposure_means, CameraTiming, Integral};
 use crate::error::Result;
 use std::collections::VecDeque;
 

@@ -2,7 +2,7 @@
 //! version, the fixed-rate quality gate and the deadline schedule.
 
 use super::policy::{thesis_rule, Level, LogView, Observation, Policy};
-use super::{CameraTiming, Frame};
+use super::timing::{CameraTiming, Frame};
 use crate::error::Result;
 use std::collections::VecDeque;
 

@@ -1,8 +1,8 @@
 //! Summaries of a run, the thesis Table 5.1 analysis, and the frames CSV.
 
-use super::policy::percentile;
-use super::Frame;
+use super::timing::Frame;
 use crate::error::{Error, Result};
+use crate::stats::percentile;
 use std::io::Write;
 
 /// Header of the frames CSV written by [`write_frames`].

@@ -1,4 +1,10 @@
-//! `mmbm bench`: throughput measurements (printed, never asserted).
+//! `mmbm bench`: throughput measurements (printed, never asserted): the
+//! metric rules here, the flow-field kernels ([`field`]), the renderer
+//! ([`render`]) and the trigger policies ([`trigger`]).
+
+mod field;
+mod render;
+mod trigger;
 
 use clap::Args;
 use mmbm::error::Result;
@@ -116,14 +122,14 @@ fn metric() -> Result<()> {
 pub fn run(a: BenchArgs) -> Result<()> {
     match a.what.as_str() {
         "metric" => metric(),
-        "gpu" => mmbm::gpu::flow::bench(),
-        "trigger" => mmbm::trigger::bench(),
-        "render" => mmbm::render::bench(),
+        "gpu" => field::run(),
+        "trigger" => trigger::bench(),
+        "render" => render::bench(),
         "all" => {
             metric()?;
-            mmbm::gpu::flow::bench()?;
-            mmbm::trigger::bench()?;
-            mmbm::render::bench()
+            field::run()?;
+            trigger::bench()?;
+            render::bench()
         }
         w => Err(mmbm::Error::invalid(
             "--what",

@@ -1,13 +1,16 @@
-//! The compiled `shaders/flow.wgsl` kernels and a runner that owns reusable
-//! buffers and dispatches them. CPU twins: [`super::flow_cpu`].
+//! The compiled `shaders/field.wgsl` kernels and a runner that owns reusable
+//! buffers and dispatches them. CPU twins: [`super::cpu`].
 
-use super::context::{gpu, GpuContext};
-use super::flow_params::{FlowParams, Grid, TwistGpu, MAX_DISPATCH, WG};
+use super::kernel::{FlowParams, Grid, TwistGpu, MAX_DISPATCH, WG};
 use crate::error::{Error, Result};
+use crate::gpu::compute::{
+    self, ensure, read_back, storage_entry, uniform_entry, Buf, READ, STORAGE_DST, STORAGE_SRC,
+};
+use crate::gpu::{gpu, GpuContext};
 use std::sync::OnceLock;
 
 /// The WGSL source of the flow kernels.
-pub const FLOW_WGSL: &str = include_str!("../../shaders/flow.wgsl");
+pub const FIELD_WGSL: &str = include_str!("../../shaders/field.wgsl");
 
 /// Grids of at most this many samples use `rows_per_twist` (one thread per
 /// twist) for batches; larger ones use `flow_tiles` (one workgroup per tile).
@@ -20,65 +23,29 @@ pub struct Kernels {
     rows: wgpu::ComputePipeline,
 }
 
-fn storage(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::COMPUTE,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Storage { read_only },
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
-    }
-}
-
 fn build(ctx: &GpuContext) -> Result<Kernels> {
-    let d = &ctx.device;
-    let scope = d.push_error_scope(wgpu::ErrorFilter::Validation);
-    let module = d.create_shader_module(wgpu::ShaderModuleDescriptor {
-        label: Some("flow.wgsl"),
-        source: wgpu::ShaderSource::Wgsl(FLOW_WGSL.into()),
-    });
-    let bgl = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-        label: Some("flow"),
-        entries: &[
-            wgpu::BindGroupLayoutEntry {
-                binding: 0,
-                visibility: wgpu::ShaderStages::COMPUTE,
-                ty: wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Uniform,
-                    has_dynamic_offset: false,
-                    min_binding_size: None,
-                },
-                count: None,
-            },
-            storage(1, true),
-            storage(2, false),
-            storage(3, false),
-        ],
-    });
-    let layout = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-        label: Some("flow"),
-        bind_group_layouts: &[Some(&bgl)],
-        immediate_size: 0,
-    });
-    let pipe = |entry: &str| {
-        d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some(entry),
-            layout: Some(&layout),
-            module: &module,
-            entry_point: Some(entry),
-            compilation_options: Default::default(),
-            cache: None,
-        })
-    };
-    let tiles = pipe("flow_tiles");
-    let rows = pipe("rows_per_twist");
-    if let Some(e) = pollster::block_on(scope.pop()) {
-        return Err(Error::Gpu(format!("building shaders/flow.wgsl: {e}")));
+    let layout = [
+        uniform_entry(0),
+        storage_entry(1, true),
+        storage_entry(2, false),
+        storage_entry(3, false),
+    ];
+    let p = compute::build(
+        ctx,
+        "field.wgsl",
+        FIELD_WGSL,
+        Some(&layout),
+        &["flow_tiles", "rows_per_twist"],
+    )?;
+    let mut it = p.pipelines.into_iter();
+    match (it.next(), it.next()) {
+        (Some(tiles), Some(rows)) => Ok(Kernels {
+            bgl: p.bgl,
+            tiles,
+            rows,
+        }),
+        _ => Err(Error::Gpu("shaders/field.wgsl: pipelines missing".into())),
     }
-    Ok(Kernels { bgl, tiles, rows })
 }
 
 static KERNELS: OnceLock<std::result::Result<Kernels, String>> = OnceLock::new();
@@ -93,11 +60,6 @@ pub fn kernels() -> Result<(&'static GpuContext, &'static Kernels)> {
     Ok((ctx, k))
 }
 
-struct Buf {
-    buf: wgpu::Buffer,
-    size: u64,
-}
-
 /// Dispatches the flow kernels, reusing its buffers between calls (they grow as needed).
 pub struct FlowRunner {
     ctx: &'static GpuContext,
@@ -109,73 +71,6 @@ pub struct FlowRunner {
     field_read: Option<Buf>,
     partials_read: Option<Buf>,
 }
-
-fn ensure<'a>(
-    ctx: &GpuContext,
-    slot: &'a mut Option<Buf>,
-    size: u64,
-    usage: wgpu::BufferUsages,
-    label: &str,
-) -> Result<&'a wgpu::Buffer> {
-    let size = size.max(16).next_multiple_of(16);
-    let lim = ctx.device.limits();
-    let storage = usage.contains(wgpu::BufferUsages::STORAGE);
-    if size > lim.max_buffer_size || (storage && size > lim.max_storage_buffer_binding_size) {
-        return Err(Error::Gpu(format!(
-            "{label} needs a {:.1} MiB buffer; {} allows at most {:.1} MiB per storage buffer \
-             (use a smaller sensor or grid)",
-            size as f64 / 1048576.0,
-            ctx.description,
-            lim.max_storage_buffer_binding_size.min(lim.max_buffer_size) as f64 / 1048576.0
-        )));
-    }
-    if !matches!(slot, Some(b) if b.size >= size) {
-        *slot = None;
-        let scope = ctx.device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
-        let buf = ctx.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some(label),
-            size,
-            usage,
-            mapped_at_creation: false,
-        });
-        if let Some(e) = pollster::block_on(scope.pop()) {
-            return Err(Error::Gpu(format!(
-                "allocating {label} ({size} bytes): {e}"
-            )));
-        }
-        *slot = Some(Buf { buf, size });
-    }
-    Ok(&slot.as_ref().expect("buffer just ensured").buf)
-}
-
-/// Reads `size` bytes of a MAP_READ buffer.
-fn read_back(ctx: &GpuContext, buf: &wgpu::Buffer, size: u64) -> Result<Vec<u8>> {
-    let slice = buf.slice(..size);
-    let (tx, rx) = std::sync::mpsc::channel();
-    slice.map_async(wgpu::MapMode::Read, move |r| {
-        let _ = tx.send(r);
-    });
-    ctx.device
-        .poll(wgpu::PollType::wait_indefinitely())
-        .map_err(|e| Error::Gpu(format!("waiting for the flow kernel: {e}")))?;
-    rx.recv()
-        .map_err(|e| Error::Gpu(format!("buffer map callback lost: {e}")))?
-        .map_err(|e| Error::Gpu(format!("mapping the result buffer: {e}")))?;
-    let out = {
-        let view = slice
-            .get_mapped_range()
-            .map_err(|e| Error::Gpu(format!("reading the result buffer: {e}")))?;
-        view.to_vec()
-    };
-    buf.unmap();
-    Ok(out)
-}
-
-const STORAGE_DST: wgpu::BufferUsages =
-    wgpu::BufferUsages::STORAGE.union(wgpu::BufferUsages::COPY_DST);
-const STORAGE_SRC: wgpu::BufferUsages =
-    wgpu::BufferUsages::STORAGE.union(wgpu::BufferUsages::COPY_SRC);
-const READ: wgpu::BufferUsages = wgpu::BufferUsages::MAP_READ.union(wgpu::BufferUsages::COPY_DST);
 
 impl FlowRunner {
     /// A runner on the shared device (errors when there is no adapter).
@@ -303,10 +198,11 @@ impl FlowRunner {
             enc.copy_buffer_to_buffer(field, 0, fread, 0, fbytes);
         }
         ctx.queue.submit([enc.finish()]);
-        let partials: Vec<f32> = bytemuck::pod_collect_to_vec(&read_back(ctx, pread, pbytes)?);
+        let partials: Vec<f32> =
+            bytemuck::pod_collect_to_vec(&read_back(ctx, pread, pbytes, "flow kernel")?);
         let field = if read_field {
             let fread = &self.field_read.as_ref().expect("ensured").buf;
-            bytemuck::pod_collect_to_vec(&read_back(ctx, fread, fbytes)?)
+            bytemuck::pod_collect_to_vec(&read_back(ctx, fread, fbytes, "flow kernel")?)
         } else {
             Vec::new()
         };

@@ -1,11 +1,11 @@
-//! CPU twins of `shaders/flow.wgsl`: the same f32 formula and summation
+//! CPU twins of `shaders/field.wgsl`: the same f32 formula and summation
 //! order as the kernels (single-threaded and rayon), plus an f64 reference
-//! built from the library's own [`crate::flow::flow_at`] and [`Camera`] maps.
+//! built from the library's own [`crate::model::flow::flow_at`] and [`Camera`] maps.
 
-use super::flow_params::{FlowParams, Grid, TwistGpu, CHUNK, TILE, WG};
-use crate::camera::Camera;
-use crate::flow::flow_at;
-use crate::motion::{Plane, Twist};
+use super::kernel::{FlowParams, Grid, TwistGpu, CHUNK, TILE, WG};
+use crate::model::camera::Camera;
+use crate::model::flow::flow_at;
+use crate::model::motion::{Plane, Twist};
 use rayon::prelude::*;
 
 /// Twin of the shader's `sensor_point`: centre of grid cell `(i, j)`, mm.

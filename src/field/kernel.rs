@@ -1,9 +1,9 @@
-//! Host-side structs shared with `shaders/flow.wgsl` (`Params`, `Twist`), with
+//! Host-side structs shared with `shaders/field.wgsl` (`Params`, `Twist`), with
 //! layout asserts, and the sample grid they describe.
 
-use crate::camera::Camera;
 use crate::error::{Error, Result};
-use crate::motion::{Plane, Twist};
+use crate::model::camera::Camera;
+use crate::model::motion::{Plane, Twist};
 use bytemuck::{Pod, Zeroable};
 
 /// Threads per workgroup of both kernels (`WG` in the shader).
@@ -74,7 +74,7 @@ const _: () = assert!(std::mem::offset_of!(TwistGpu, inv_depth) == 32);
 
 impl TwistGpu {
     /// The twist for focal length `f` mm; `plane = None` drops the translation
-    /// (rotation only, like [`crate::flow::flow_at`]).
+    /// (rotation only, like [`crate::model::flow::flow_at`]).
     pub fn new(f: f64, tw: &Twist, plane: Option<&Plane>) -> Self {
         let (a, b, c) = plane.map_or((0.0, 0.0, 0.0), |p| p.inverse_depth_coeffs(f));
         let w = tw.omega.as_vec3();

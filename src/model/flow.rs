@@ -12,7 +12,7 @@
 //! both components are quadratic polynomials in `(u, v)`: [`FlowPoly`] holds
 //! their 12 coefficients, the fast form used by the metric's inner loops.
 
-use crate::motion::{Plane, Twist};
+use crate::model::motion::{Plane, Twist};
 
 /// Flow (mm/s) at sensor point `(u, v)` mm, straight from the formula above.
 /// `inv_z` is the inverse depth (1/m) of the scene point seen there; it is

@@ -3,11 +3,11 @@
 //! with one thread and with all threads, at 320x240, 640x480 and 1920x1080;
 //! then the cost of a default-quality frame against blur length.
 
-use super::{maps, render_frame, Backend, Quality, RenderJob, Target, Trajectory};
-use crate::camera::Camera;
-use crate::error::Result;
-use crate::motion::Twist;
 use glam::DVec3;
+use mmbm::error::Result;
+use mmbm::model::camera::Camera;
+use mmbm::model::motion::Twist;
+use mmbm::render::{maps, render_frame, Backend, Quality, RenderJob, Target, Trajectory};
 use std::time::Instant;
 
 fn job(w: u32, h: u32, scale: f64, quality: Quality, backend: Backend) -> Result<RenderJob> {
@@ -41,7 +41,7 @@ fn time(j: &RenderJob, reps: usize) -> Result<(f64, u32)> {
 
 /// Prints the renderer benchmarks.
 pub fn bench() -> Result<()> {
-    let gpu = crate::gpu::gpu();
+    let gpu = mmbm::gpu::gpu();
     match &gpu {
         Ok(c) => println!("render bench, GPU: {}", c.description),
         Err(e) => println!("render bench, no GPU ({e})"),

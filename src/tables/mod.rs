@@ -8,12 +8,16 @@
 //! same on the roll rate; 4.5: one slow-walk motion, rotation only vs full
 //! motion over depths) and are printed with every row.
 
-use crate::camera::Camera;
 use crate::metric::{mmbm, Method, Scene};
-use crate::motion::{Plane, Twist};
+use crate::model::camera::Camera;
+use crate::model::motion::{Plane, Twist};
 use crate::Result;
 use glam::DVec3;
 use serde::Serialize;
+
+mod grid_error;
+
+pub use grid_error::{grid_error, grid_error_plot, study_motions, GridErrorRow};
 
 /// Exact-method tolerance used in the tables.
 pub const EXACT_TOL: f64 = 1e-10;
@@ -288,98 +292,6 @@ pub fn table_4_5() -> Result<Table> {
         &[0.2, 0.5, 1.0, 2.0, 5.0, 10.0, 20.0],
         true,
     )
-}
-
-/// One point of the grid-error study.
-#[derive(Debug, Clone, Serialize)]
-pub struct GridErrorRow {
-    /// Rule name (`riemann` or `gauss`).
-    pub rule: String,
-    /// Nodes across.
-    pub nu: u32,
-    /// Nodes down.
-    pub nv: u32,
-    /// Mean of `100 (mu - mu*) / mu` over the motions.
-    pub mean_pct: f64,
-    /// Largest `|100 (mu - mu*) / mu|` over the motions.
-    pub max_abs_pct: f64,
-}
-
-/// Rotation directions used for the grid-error study: the axes, pairs, the
-/// diagonal and 64 pseudo-random unit directions (fixed seed).
-pub fn study_motions() -> Vec<DVec3> {
-    let mut v = vec![
-        DVec3::X,
-        DVec3::Y,
-        DVec3::Z,
-        DVec3::new(1., 0., 1.),
-        DVec3::new(1., 1., 0.),
-        DVec3::ONE,
-    ];
-    let mut s = 0x9E37_79B9_7F4A_7C15u64;
-    let mut rnd = || {
-        s ^= s << 13;
-        s ^= s >> 7;
-        s ^= s << 17;
-        (s >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-    };
-    while v.len() < 70 {
-        let d = DVec3::new(rnd(), rnd(), rnd());
-        if d.length() > 0.1 && d.length() <= 1.0 {
-            v.push(d.normalize());
-        }
-    }
-    v
-}
-
-/// Fig. 4.6 as numbers: error of `riemann:NxM` and `gauss:NxM` against exact,
-/// for 4:3 grids from 2x2 (riemann 2x2, then 4x3 ... 64x48).
-pub fn grid_error() -> Result<Vec<GridErrorRow>> {
-    let s = Scene::thesis();
-    let motions = study_motions();
-    let exact: Vec<f64> = motions
-        .iter()
-        .map(|w| {
-            Ok(mmbm(
-                &s,
-                &Twist::new(*w, DVec3::ZERO),
-                Method::Exact { tol: 1e-11 },
-            )?
-            .mm_s)
-        })
-        .collect::<Result<_>>()?;
-    let grids = [
-        (2, 2),
-        (4, 3),
-        (8, 6),
-        (12, 9),
-        (16, 12),
-        (32, 24),
-        (64, 48),
-    ];
-    let mut rows = Vec::new();
-    for (nu, nv) in grids {
-        for (rule, method) in [
-            ("riemann", Method::Riemann { nu, nv }),
-            ("gauss", Method::Gauss { nu, nv }),
-        ] {
-            let errs: Vec<f64> = motions
-                .iter()
-                .zip(&exact)
-                .map(|(w, e)| {
-                    Ok(100.0 * (e - mmbm(&s, &Twist::new(*w, DVec3::ZERO), method)?.mm_s) / e)
-                })
-                .collect::<Result<_>>()?;
-            rows.push(GridErrorRow {
-                rule: rule.into(),
-                nu,
-                nv,
-                mean_pct: errs.iter().sum::<f64>() / errs.len() as f64,
-                max_abs_pct: errs.iter().fold(0.0, |a, b| a.max(b.abs())),
-            });
-        }
-    }
-    Ok(rows)
 }
 
 /// All sensitivity tables.

@@ -1,10 +1,18 @@
-//! MMBM for every sample of a gyro log, streamed: constant memory, CSV out
-//! with header `t,mmbm_mm_s,mmbm_px_s` and shortest round-trip float formatting.
+//! MMBM of a gyro log: the one owner of "the MMBM of every sample".
+//!
+//! [`sample_scene`] turns a sample into its twist and validated scene (the
+//! per-sample plane check lives only here); [`eval_batch_cpu`] evaluates a
+//! batch with a CPU method and [`gpu::series_evaluator`] with the GPU flow
+//! kernels; [`mmbm_series`] gives a whole in-memory log (what `trigger` and
+//! `experiment` use), and [`run`] streams a file in constant memory to CSV
+//! with header `t,mmbm_mm_s,mmbm_px_s` and shortest round-trip floats.
+
+pub mod gpu;
 
 use crate::error::{Error, Result};
-use crate::gyro::{GyroReader, GyroSample};
+use crate::io::gyro::{GyroReader, GyroSample};
 use crate::metric::{Evaluator, Method, Scene};
-use crate::motion::{Plane, Twist};
+use crate::model::motion::{Plane, Twist};
 use rayon::prelude::*;
 use std::io::Write;
 
@@ -23,10 +31,19 @@ pub struct SeriesOptions {
     pub use_velocity: bool,
 }
 
-/// The twist and plane for one sample under `opts`.
-pub fn sample_scene(s: &GyroSample, opts: &SeriesOptions) -> Result<(Twist, Option<Plane>)> {
+/// The twist and scene for one sample under `opts`: rotation only unless
+/// `use_velocity`; then the sample's `depth` (a fronto-parallel plane) or
+/// the options' plane, checked against the twist (errors name the sample's
+/// time).
+pub fn sample_scene(s: &GyroSample, opts: &SeriesOptions) -> Result<(Twist, Scene)> {
     if !opts.use_velocity {
-        return Ok((Twist::new(s.omega, glam::DVec3::ZERO), None));
+        return Ok((
+            Twist::new(s.omega, glam::DVec3::ZERO),
+            Scene {
+                plane: None,
+                ..opts.scene
+            },
+        ));
     }
     let v = s
         .velocity
@@ -41,7 +58,15 @@ pub fn sample_scene(s: &GyroSample, opts: &SeriesOptions) -> Result<(Twist, Opti
             "translation needs a scene depth: a 'depth' column in the log or --depth",
         ));
     }
-    Ok((Twist::new(s.omega, v), plane))
+    let tw = Twist::new(s.omega, v);
+    let scene = Scene {
+        plane,
+        ..opts.scene
+    };
+    scene
+        .validate_for(&tw)
+        .map_err(|e| Error::invalid(format!("sample at t = {} s", s.t), e.to_string()))?;
+    Ok((tw, scene))
 }
 
 /// Evaluates a batch of samples on the CPU (rayon), mm/s per sample.
@@ -51,19 +76,34 @@ pub fn eval_batch_cpu(batch: &[GyroSample], opts: &SeriesOptions) -> Result<Vec<
         .par_iter()
         .with_min_len(1024)
         .map(|s| {
-            let (tw, plane) = sample_scene(s, opts)?;
-            let scene = Scene {
-                plane,
-                ..opts.scene
-            };
-            if plane.is_some() {
-                scene.validate_for(&tw).map_err(|e| {
-                    Error::invalid(format!("sample at t = {} s", s.t), e.to_string())
-                })?;
-            }
+            let (tw, scene) = sample_scene(s, opts)?;
             Ok(ev.mean_speed(&scene.flow_poly(&tw)))
         })
         .collect()
+}
+
+/// The rotation-only MMBM (mm/s) of every sample, the thesis's metric, with
+/// `scene`'s camera and a CPU `method` (the thesis used `riemann:8x6`).
+pub fn mmbm_series(samples: &[GyroSample], scene: &Scene, method: Method) -> Result<Vec<f64>> {
+    mmbm_series_with(
+        samples,
+        &SeriesOptions {
+            scene: *scene,
+            method,
+            use_velocity: false,
+        },
+    )
+}
+
+/// MMBM of every sample under full series options (e.g. `use_velocity` with
+/// the log's velocity and a depth: an option, not the thesis default).
+pub fn mmbm_series_with(samples: &[GyroSample], opts: &SeriesOptions) -> Result<Vec<f64>> {
+    opts.scene.camera.validate()?;
+    let mut out = Vec::with_capacity(samples.len());
+    for chunk in samples.chunks(BATCH) {
+        out.extend(eval_batch_cpu(chunk, opts)?);
+    }
+    Ok(out)
 }
 
 /// A batch evaluator: CPU methods, or a GPU one supplied by the caller.

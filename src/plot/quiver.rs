@@ -2,8 +2,8 @@
 //! downsampled grid of pixels, each the image displacement over an exposure
 //! (px, optionally magnified by a stated factor), coloured by speed (px/s).
 
-use crate::camera::Camera;
 use crate::error::{Error, Result};
+use crate::model::camera::Camera;
 use plotters::prelude::*;
 use std::path::Path;
 
@@ -243,7 +243,7 @@ pub fn quiver_png(
     }
     let img =
         image::RgbImage::from_raw(cw, ch, buf).ok_or_else(|| err("bitmap size mismatch".into()))?;
-    crate::imageio::save_rgb8(path, &img)
+    crate::io::images::save_rgb8(path, &img)
 }
 
 #[cfg(test)]
@@ -277,7 +277,7 @@ mod tests {
         let d = tempfile::tempdir().unwrap();
         let p = d.path().join("q.png");
         quiver_png(&cam, &u, &v, 0.07, &p).unwrap();
-        let img = crate::imageio::read_rgb8(&p).unwrap();
+        let img = crate::io::images::read_rgb8(&p).unwrap();
         assert!(img.width() > 700);
     }
 }

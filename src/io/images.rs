@@ -2,7 +2,7 @@
 //! and reading textures. All writes are atomic (temp file + rename).
 
 use crate::error::{Error, Result};
-use crate::output::write_atomic_path;
+use crate::io::atomic::write_atomic_path;
 use exr::prelude::*;
 use std::path::Path;
 

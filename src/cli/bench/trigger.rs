@@ -1,9 +1,10 @@
 //! Throughput of the trigger policies (printed, never asserted).
 
-use super::{mmbm_series, parse_policy, run, CameraTiming};
-use crate::error::Result;
-use crate::metric::{Method, Scene};
-use crate::sim::{simulate, Gait, GaitConfig};
+use mmbm::error::Result;
+use mmbm::metric::{Method, Scene};
+use mmbm::series::mmbm_series;
+use mmbm::sim::{simulate, Gait, GaitConfig};
+use mmbm::trigger::{parse_policy, run, CameraTiming};
 use std::time::Instant;
 
 /// Policies timed by [`bench`].

@@ -1,0 +1,122 @@
+//! Flow fields (`shaders/field.wgsl`): the per-pixel image-plane flow of SPEC
+//! section 2 at full sensor resolution, its mean speed (MMBM, mm/s), and
+//! batched MMBM for many twists in one dispatch.
+//!
+//! The same shape as the renderer: [`kernel`] holds the host structs shared
+//! with WGSL (with layout asserts), [`gpu`] the compiled kernels and their
+//! runner, [`cpu`] the CPU twins written from the same formula, and
+//! [`flow_field`] picks one by [`Backend`].
+//!
+//! The field is computed in f32; per-thread and per-workgroup sums are f32
+//! (at most 32 and 64 terms), and the partial sums are added in f64 on the
+//! host.
+
+pub mod cpu;
+pub mod gpu;
+pub mod kernel;
+
+pub use crate::gpu::Backend;
+pub use cpu::FieldMean;
+pub use gpu::FlowRunner;
+pub use kernel::{FlowParams, Grid, TwistGpu};
+
+use crate::error::{Error, Result};
+use crate::gpu::Resolved;
+use crate::metric::{Mmbm, Scene};
+use crate::model::motion::Twist;
+use std::sync::atomic::AtomicBool;
+
+/// A flow field on a grid (px/s) and its MMBM.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FlowField {
+    /// Samples per row.
+    pub width: u32,
+    /// Rows.
+    pub height: u32,
+    /// Horizontal flow, px/s (+ right), row-major, top row first.
+    pub u: Vec<f32>,
+    /// Vertical flow, px/s (+ down).
+    pub v: Vec<f32>,
+    /// Mean speed of the field's samples (mm/s on the sensor; also px/s).
+    pub mmbm: Mmbm,
+}
+
+impl FlowField {
+    /// Per-sample speed `|(u, v)|`, px/s.
+    pub fn speed(&self) -> Vec<f32> {
+        self.u
+            .iter()
+            .zip(&self.v)
+            .map(|(a, b)| a.hypot(*b))
+            .collect()
+    }
+}
+
+fn to_mmbm(scene: &Scene, mean_mm_s: f64, grid: &Grid) -> Mmbm {
+    Mmbm {
+        mm_s: mean_mm_s,
+        px_s: mean_mm_s / scene.camera.pitch_x_mm,
+        error_estimate: None,
+        evaluations: grid.len() as u64,
+    }
+}
+
+static ANNOUNCED: AtomicBool = AtomicBool::new(false);
+
+/// The flow field (px/s) of `tw` on a `w x h` grid of cell centres (`0 x 0`:
+/// every pixel centre of the sensor) and its mean speed, on `backend` (the
+/// GPU kernel `flow_tiles` or its CPU twin). Validates the scene (a plane is
+/// needed when `tw` translates).
+pub fn flow_field(
+    scene: &Scene,
+    tw: &Twist,
+    w: u32,
+    h: u32,
+    backend: Backend,
+) -> Result<FlowField> {
+    scene.validate_for(tw)?;
+    let grid = Grid::new(&scene.camera, w, h)?;
+    let g = TwistGpu::new(scene.camera.focal_mm, tw, scene.plane.as_ref());
+    let (mean, field) = match backend.resolve("flow field", "twin", &ANNOUNCED)? {
+        Resolved::Gpu(_) => {
+            let (sums, field) = FlowRunner::new()?.tiles(&grid, &[g], true)?;
+            (sums[0] / grid.len() as f64, field)
+        }
+        Resolved::Cpu(threads) => {
+            let run = || cpu::flow_tiles(&grid, &g, true);
+            let f = match threads {
+                None => run(),
+                Some(t) => rayon::ThreadPoolBuilder::new()
+                    .num_threads(t)
+                    .build()
+                    .map_err(|e| Error::invalid("threads", e.to_string()))?
+                    .install(run),
+            };
+            (f.mean_mm_s, f.field)
+        }
+    };
+    Ok(FlowField {
+        width: grid.width,
+        height: grid.height,
+        u: field.iter().map(|x| x[0]).collect(),
+        v: field.iter().map(|x| x[1]).collect(),
+        mmbm: to_mmbm(scene, mean, &grid),
+    })
+}
+
+/// [`flow_field`] on the GPU (an error without an adapter).
+pub fn flow_field_gpu(scene: &Scene, tw: &Twist, w: u32, h: u32) -> Result<FlowField> {
+    flow_field(scene, tw, w, h, Backend::Gpu)
+}
+
+/// MMBM on the GPU: the mean flow speed over a `w x h` grid of cell centres
+/// (`0 x 0`: every pixel centre of the sensor), without writing the field.
+/// Validates the scene.
+pub fn mmbm_gpu(scene: &Scene, tw: &Twist, w: u32, h: u32) -> Result<Mmbm> {
+    scene.validate_for(tw)?;
+    let grid = Grid::new(&scene.camera, w, h)?;
+    let g = TwistGpu::new(scene.camera.focal_mm, tw, scene.plane.as_ref());
+    let mut r = FlowRunner::new()?;
+    let (sums, _) = r.tiles(&grid, &[g], false)?;
+    Ok(to_mmbm(scene, sums[0] / grid.len() as f64, &grid))
+}

@@ -1,0 +1,187 @@
+//! Compute plumbing shared by every kernel: building a WGSL module and its
+//! pipelines under a validation error scope, bind group layout entries,
+//! growable storage buffers with limit checks, and mapping a buffer back to
+//! the host.
+
+use super::context::GpuContext;
+use crate::error::{Error, Result};
+
+/// A storage buffer binding visible to compute shaders.
+pub fn storage_entry(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+/// A uniform buffer binding visible to compute shaders.
+pub fn uniform_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Uniform,
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+/// A compiled WGSL module: its bind group layout (group 0) and one pipeline
+/// per entry point, in the order asked for.
+pub struct Pipelines {
+    /// The layout of bind group 0.
+    pub bgl: wgpu::BindGroupLayout,
+    /// One pipeline per entry point.
+    pub pipelines: Vec<wgpu::ComputePipeline>,
+}
+
+/// Compiles `source` (named `file` in errors) and builds a pipeline for each
+/// of `entries`. With `layout` the bind group 0 layout is explicit; with
+/// `None` it is derived from the shader (from the first entry point).
+/// Validation errors come back as [`Error::Gpu`] naming `file`.
+pub fn build(
+    ctx: &GpuContext,
+    file: &str,
+    source: &str,
+    layout: Option<&[wgpu::BindGroupLayoutEntry]>,
+    entries: &[&str],
+) -> Result<Pipelines> {
+    let d = &ctx.device;
+    let scope = d.push_error_scope(wgpu::ErrorFilter::Validation);
+    let module = d.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some(file),
+        source: wgpu::ShaderSource::Wgsl(source.into()),
+    });
+    let explicit = layout.map(|l| {
+        let bgl = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some(file),
+            entries: l,
+        });
+        let pl = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some(file),
+            bind_group_layouts: &[Some(&bgl)],
+            immediate_size: 0,
+        });
+        (bgl, pl)
+    });
+    let pipelines: Vec<wgpu::ComputePipeline> = entries
+        .iter()
+        .map(|entry| {
+            d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(entry),
+                layout: explicit.as_ref().map(|(_, pl)| pl),
+                module: &module,
+                entry_point: Some(entry),
+                compilation_options: Default::default(),
+                cache: None,
+            })
+        })
+        .collect();
+    if let Some(e) = pollster::block_on(scope.pop()) {
+        return Err(Error::Gpu(format!("building shaders/{file}: {e}")));
+    }
+    let bgl = match explicit {
+        Some((bgl, _)) => bgl,
+        None => pipelines
+            .first()
+            .ok_or_else(|| Error::Gpu(format!("shaders/{file}: no entry point asked for")))?
+            .get_bind_group_layout(0),
+    };
+    Ok(Pipelines { bgl, pipelines })
+}
+
+/// A device buffer and its size in bytes.
+pub struct Buf {
+    /// The buffer.
+    pub buf: wgpu::Buffer,
+    /// Its size, bytes.
+    pub size: u64,
+}
+
+/// Storage buffer written from the host.
+pub const STORAGE_DST: wgpu::BufferUsages =
+    wgpu::BufferUsages::STORAGE.union(wgpu::BufferUsages::COPY_DST);
+/// Storage buffer copied back to the host.
+pub const STORAGE_SRC: wgpu::BufferUsages =
+    wgpu::BufferUsages::STORAGE.union(wgpu::BufferUsages::COPY_SRC);
+/// Host-readable staging buffer.
+pub const READ: wgpu::BufferUsages =
+    wgpu::BufferUsages::MAP_READ.union(wgpu::BufferUsages::COPY_DST);
+
+/// Makes `slot` hold a buffer of at least `size` bytes (rounded up to 16),
+/// reusing the one there when large enough. Sizes over the device's limits
+/// and failed allocations are errors naming `label`.
+pub fn ensure<'a>(
+    ctx: &GpuContext,
+    slot: &'a mut Option<Buf>,
+    size: u64,
+    usage: wgpu::BufferUsages,
+    label: &str,
+) -> Result<&'a wgpu::Buffer> {
+    let size = size.max(16).next_multiple_of(16);
+    let lim = ctx.device.limits();
+    let storage = usage.contains(wgpu::BufferUsages::STORAGE);
+    if size > lim.max_buffer_size || (storage && size > lim.max_storage_buffer_binding_size) {
+        return Err(Error::Gpu(format!(
+            "{label} needs a {:.1} MiB buffer; {} allows at most {:.1} MiB per storage buffer \
+             (use a smaller sensor or grid)",
+            size as f64 / 1048576.0,
+            ctx.description,
+            lim.max_storage_buffer_binding_size.min(lim.max_buffer_size) as f64 / 1048576.0
+        )));
+    }
+    match slot {
+        Some(b) if b.size >= size => {}
+        _ => {
+            *slot = None;
+            let scope = ctx.device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
+            let buf = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size,
+                usage,
+                mapped_at_creation: false,
+            });
+            if let Some(e) = pollster::block_on(scope.pop()) {
+                return Err(Error::Gpu(format!(
+                    "allocating {label} ({size} bytes): {e}"
+                )));
+            }
+            *slot = Some(Buf { buf, size });
+        }
+    }
+    slot.as_ref()
+        .map(|b| &b.buf)
+        .ok_or_else(|| Error::Gpu(format!("{label}: buffer missing")))
+}
+
+/// Waits for the queue and reads the first `size` bytes of a `MAP_READ`
+/// buffer; `what` names the work in errors.
+pub fn read_back(ctx: &GpuContext, buf: &wgpu::Buffer, size: u64, what: &str) -> Result<Vec<u8>> {
+    let slice = buf.slice(..size);
+    let (tx, rx) = std::sync::mpsc::channel();
+    slice.map_async(wgpu::MapMode::Read, move |r| {
+        let _ = tx.send(r);
+    });
+    ctx.device
+        .poll(wgpu::PollType::wait_indefinitely())
+        .map_err(|e| Error::Gpu(format!("waiting for the {what}: {e}")))?;
+    rx.recv()
+        .map_err(|e| Error::Gpu(format!("{what}: buffer map callback lost: {e}")))?
+        .map_err(|e| Error::Gpu(format!("{what}: mapping the result buffer: {e}")))?;
+    let out = {
+        let view = slice
+            .get_mapped_range()
+            .map_err(|e| Error::Gpu(format!("{what}: reading the result buffer: {e}")))?;
+        view.to_vec()
+    };
+    buf.unmap();
+    Ok(out)
+}

@@ -1,0 +1,101 @@
+//! The policy parser: `name:args` strings (grammar in the module docs of
+//! [`crate::trigger`]) to boxed [`Policy`] values.
+
+use super::policy::{Level, Policy};
+use super::predict::{Forecast, Oracle};
+use super::rules::{Adaptive, Deadline, Fixed, Gate, Threshold};
+use crate::error::{Error, Result};
+
+pub(crate) fn parse_num(s: &str, what: &str, spec: &str) -> Result<f64> {
+    let x: f64 = s
+        .trim()
+        .parse()
+        .map_err(|_| Error::invalid("policy", format!("'{spec}': {what} '{s}' is not a number")))?;
+    if !x.is_finite() {
+        return Err(Error::invalid(
+            "policy",
+            format!("'{spec}': {what} must be finite"),
+        ));
+    }
+    Ok(x)
+}
+
+pub(crate) fn parse_pos(s: &str, what: &str, spec: &str) -> Result<f64> {
+    let x = parse_num(s, what, spec)?;
+    if x <= 0.0 {
+        return Err(Error::invalid(
+            "policy",
+            format!("'{spec}': {what} must be > 0, got {x}"),
+        ));
+    }
+    Ok(x)
+}
+
+/// Parses `FPS[@PHASE]`.
+pub(crate) fn parse_rate(s: &str, spec: &str) -> Result<(f64, f64)> {
+    let (f, p) = match s.split_once('@') {
+        Some((f, p)) => (f, parse_num(p, "phase", spec)?),
+        None => (s, 0.0),
+    };
+    let fps = parse_pos(f, "frame rate", spec)?;
+    if p < 0.0 {
+        return Err(Error::invalid(
+            "policy",
+            format!("'{spec}': phase must be >= 0 s"),
+        ));
+    }
+    Ok((fps, p))
+}
+
+const GRAMMAR: &str = "fixed:FPS[@PHASE], threshold:X, adaptive[:X[:FPS]], oracle:X[:H], \
+forecast:X[:H], gate:X[:FPS[@PHASE]] or deadline:FPS[:X] (X in mm/s or pNN)";
+
+/// Parses a policy string (grammar in the module docs). The policy keeps the
+/// string exactly as given for the `policy` column.
+pub fn parse_policy(spec: &str) -> Result<Box<dyn Policy>> {
+    let parts: Vec<&str> = spec.trim().split(':').collect();
+    let name = parts[0].to_ascii_lowercase();
+    let args = &parts[1..];
+    let bad = |msg: &str| Error::invalid("policy", format!("'{spec}': {msg}; expected {GRAMMAR}"));
+    let level = |s: &str| Level::parse(s.trim(), &format!("policy '{spec}' threshold"));
+    let p: Box<dyn Policy> = match (name.as_str(), args) {
+        ("fixed", [r]) => {
+            let (fps, phase) = parse_rate(r, spec)?;
+            Box::new(Fixed::new(spec, fps, phase))
+        }
+        ("threshold", [x]) => Box::new(Threshold::new(spec, level(x)?)),
+        ("adaptive", []) => Box::new(Adaptive::new(spec, Level::Abs(0.4), 2.5)),
+        ("adaptive", [x]) => Box::new(Adaptive::new(spec, level(x)?, 2.5)),
+        ("adaptive", [x, f]) => Box::new(Adaptive::new(
+            spec,
+            level(x)?,
+            parse_pos(f, "target frame rate", spec)?,
+        )),
+        ("oracle", [x]) => Box::new(Oracle::new(spec, level(x)?, 0.2)),
+        ("oracle", [x, h]) => {
+            Box::new(Oracle::new(spec, level(x)?, parse_pos(h, "horizon", spec)?))
+        }
+        ("forecast", [x]) => Box::new(Forecast::new(spec, level(x)?, 0.2)),
+        ("forecast", [x, h]) => Box::new(Forecast::new(
+            spec,
+            level(x)?,
+            parse_pos(h, "horizon", spec)?,
+        )),
+        ("gate", [x]) => Box::new(Gate::new(spec, level(x)?, 5.0, 0.0)),
+        ("gate", [x, r]) => {
+            let (fps, phase) = parse_rate(r, spec)?;
+            Box::new(Gate::new(spec, level(x)?, fps, phase))
+        }
+        ("deadline", [f]) => Box::new(Deadline::new(spec, parse_pos(f, "frame rate", spec)?, None)),
+        ("deadline", [f, x]) => Box::new(Deadline::new(
+            spec,
+            parse_pos(f, "frame rate", spec)?,
+            Some(level(x)?),
+        )),
+        ("fixed" | "threshold" | "adaptive" | "oracle" | "forecast" | "gate" | "deadline", _) => {
+            return Err(bad("wrong number of ':' arguments"))
+        }
+        _ => return Err(bad("unknown policy")),
+    };
+    Ok(p)
+}

@@ -1,0 +1,98 @@
+//! The runner: a policy over a whole log, enforcing the camera's timing.
+
+use super::policy::{LogView, Observation, Policy};
+use super::timing::{CameraTiming, Frame, Integral};
+use crate::error::{Error, Result};
+use crate::io::gyro::GyroSample;
+
+/// Runs `policy` over a log: `mmbm_mm_s[i]` is the MMBM of `samples[i]`.
+/// The policy sees, at each sample, only the samples up to it (the oracle
+/// also gets the whole log in [`Policy::prepare`]). Returns the frames in
+/// time order.
+pub fn run(
+    samples: &[GyroSample],
+    mmbm_mm_s: &[f64],
+    policy: &mut dyn Policy,
+    timing: &CameraTiming,
+) -> Result<Vec<Frame>> {
+    timing.validate()?;
+    if samples.len() != mmbm_mm_s.len() {
+        return Err(Error::invalid(
+            "mmbm series",
+            format!(
+                "{} values for {} gyro samples",
+                mmbm_mm_s.len(),
+                samples.len()
+            ),
+        ));
+    }
+    if samples.is_empty() {
+        return Err(Error::invalid("gyro log", "no samples"));
+    }
+    let t: Vec<f64> = samples.iter().map(|s| s.t).collect();
+    for i in 0..t.len() {
+        crate::error::finite("sample time", t[i])?;
+        if i > 0 && t[i] <= t[i - 1] {
+            return Err(Error::invalid(
+                "gyro log",
+                format!("time not strictly increasing at sample {i} (t = {})", t[i]),
+            ));
+        }
+        let m = mmbm_mm_s[i];
+        if !(m.is_finite() && m >= 0.0) {
+            return Err(Error::invalid(
+                "mmbm series",
+                format!(
+                    "value {m} at sample {i} (t = {}) is not a finite number >= 0",
+                    t[i]
+                ),
+            ));
+        }
+    }
+    policy.prepare(
+        &LogView {
+            t: &t,
+            mmbm: mmbm_mm_s,
+        },
+        timing,
+    )?;
+    let integral = Integral::new(&t, mmbm_mm_s);
+    let t_last = t[t.len() - 1];
+    let mut frames = Vec::new();
+    let mut free_at = f64::NEG_INFINITY;
+    let mut last_trigger = None;
+    for i in 0..t.len() {
+        let start = t[i] + timing.delay;
+        let end = start + timing.exposure;
+        if end > t_last {
+            break;
+        }
+        let camera_free = start >= free_at;
+        let obs = Observation {
+            i,
+            t: &t[..=i],
+            mmbm: &mmbm_mm_s[..=i],
+            camera_free,
+            last_trigger,
+            frames: frames.len(),
+            timing,
+        };
+        if policy.decide(&obs) && camera_free {
+            let mut f = Frame {
+                policy: policy.spec().to_string(),
+                index: i,
+                trigger_t: t[i],
+                exposure_start: start,
+                exposure_end: end,
+                mmbm_trigger_mm_s: mmbm_mm_s[i],
+                mmbm_exposure_mm_s: integral.mean(start, end),
+                kept: true,
+            };
+            f.kept = policy.keep(&f);
+            frames.push(f);
+            free_at = end + timing.readout;
+            last_trigger = Some(t[i]);
+        }
+    }
+    Ok(frames)
+}
