@@ -29,10 +29,12 @@ fn all_shaders_validate() {
         .filter(|p| p.extension().is_some_and(|e| e == "wgsl"))
         .collect();
     files.sort();
-    assert!(
-        files.iter().any(|p| p.ends_with("flow.wgsl")),
-        "shaders/field.wgsl not found in {files:?}"
-    );
+    for name in ["field.wgsl", "render.wgsl"] {
+        assert!(
+            files.iter().any(|p| p.ends_with(name)),
+            "shaders/{name} not found in {files:?}"
+        );
+    }
     let errors: Vec<String> = files.iter().filter_map(|p| validate(p).err()).collect();
     assert!(errors.is_empty(), "{}", errors.join("\n\n"));
 }

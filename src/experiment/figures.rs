@@ -2,12 +2,128 @@
 //! (thesis Figs. 5.2 and 5.6), blur histograms per policy, and a side-by-side
 //! montage of frames.
 
+use super::config::ExperimentConfig;
+use super::measure::{half, FrameRecord};
+use super::walk::{camera, Walk};
 use crate::error::Result;
+use crate::gpu::Backend;
 use crate::io::atomic::write_atomic_path;
 use crate::io::images::{linear_to_srgb8, save_rgb8};
+use crate::metric::Scene;
 use crate::plot::{ensure_font, plot_error};
 use plotters::prelude::*;
+use std::collections::HashMap;
 use std::path::Path;
+
+/// The sharpest and the most blurred rendered frame of one run: `(blur px, linear RGB)`.
+pub struct Extremes {
+    /// The frame with the least ground-truth blur.
+    pub sharpest: (f64, Vec<f32>),
+    /// The frame with the most.
+    pub blurriest: (f64, Vec<f32>),
+}
+
+/// Writes every figure of the report into `out`: per walk the MMBM traces of
+/// the main policies, the blur histograms, the sharpest/most blurred frame
+/// montage (from `extremes`, keyed by `(walk, policy)` index) and a flow
+/// quiver at the sample of highest MMBM. Returns the file names.
+pub fn write_all(
+    out: &Path,
+    cfg: &ExperimentConfig,
+    walks: &[Walk],
+    records: &[FrameRecord],
+    extremes: &HashMap<(usize, usize), Extremes>,
+) -> Result<Vec<String>> {
+    let cam = camera(cfg);
+    let mut figs = Vec::new();
+    for (wi, w) in walks.iter().enumerate() {
+        let t: Vec<f64> = w.samples.iter().map(|s| s.t).collect();
+        let t0 = t.first().copied().unwrap_or(0.0);
+        let window = (
+            t0 + 2.0,
+            (t0 + 8.0).min(t.last().copied().unwrap_or(t0 + 8.0)),
+        );
+        for (p, frames) in &w.runs {
+            if !(p.starts_with("fixed")
+                || p == "threshold:0.4"
+                || p.starts_with("oracle")
+                || p.starts_with("forecast"))
+            {
+                continue;
+            }
+            let ex: Vec<Exposure> = frames
+                .iter()
+                .filter(|f| f.kept)
+                .map(|f| (f.trigger_t, f.exposure_start, f.exposure_end))
+                .collect();
+            let th = p
+                .split(':')
+                .nth(1)
+                .and_then(|x| x.parse::<f64>().ok())
+                .filter(|_| !p.starts_with("fixed"));
+            let name = format!("trace_{}_{}.png", w.name, p.replace([':', '.', '@'], "_"));
+            mmbm_trace(
+                &out.join(&name),
+                &format!(
+                    "{} walk, {p}: MMBM, triggers (x), exposures (shaded)",
+                    w.name
+                ),
+                &t,
+                &w.mmbm,
+                window,
+                &ex,
+                th,
+            )?;
+            figs.push(name);
+        }
+        let series: Vec<(String, Vec<f64>)> = w
+            .runs
+            .iter()
+            .map(|(p, _)| {
+                let v = records
+                    .iter()
+                    .filter(|r| r.walk == w.name && &r.frame.policy == p)
+                    .filter_map(|r| r.measure.as_ref().map(|m| m.blur_px))
+                    .collect();
+                (p.clone(), v)
+            })
+            .collect();
+        let name = format!("blur_hist_{}.png", w.name);
+        blur_histograms(&out.join(&name), &series)?;
+        figs.push(name);
+        // Sharpest and most blurred frame per policy, half resolution.
+        let mut imgs = Vec::new();
+        for pi in 0..w.runs.len() {
+            if let Some(e) = extremes.get(&(wi, pi)) {
+                imgs.push(half(cam.width, cam.height, &e.sharpest.1));
+                imgs.push(half(cam.width, cam.height, &e.blurriest.1));
+            }
+        }
+        if !imgs.is_empty() {
+            let refs: Vec<&[f32]> = imgs.iter().map(|v| v.as_slice()).collect();
+            let name = format!("frames_{}.png", w.name);
+            montage(&out.join(&name), cam.width / 2, cam.height / 2, &refs, 2)?;
+            figs.push(name);
+        }
+        // Flow quiver at the sample of highest MMBM.
+        if let Some((k, _)) = w.mmbm.iter().enumerate().max_by(|a, b| a.1.total_cmp(b.1)) {
+            let tw = crate::model::motion::Twist::new(w.samples[k].omega, glam::DVec3::ZERO);
+            // The field on the GPU, or its CPU twin when there is no adapter.
+            let scene = Scene {
+                camera: cam,
+                plane: None,
+            };
+            let f = crate::field::flow_field(&scene, &tw, 0, 0, Backend::Auto)?;
+            let (u, v) = (f.u, f.v);
+            {
+                let name = format!("quiver_{}.png", w.name);
+                crate::plot::quiver::quiver_png(&cam, &u, &v, cfg.exposure_s, &out.join(&name))?;
+                figs.push(name);
+            }
+        }
+    }
+    Ok(figs)
+}
 
 /// One exposure to shade on the trace: `(trigger_t, exposure_start, exposure_end)`, s.
 pub type Exposure = (f64, f64, f64);

@@ -2,9 +2,62 @@
 //! extraction), and the report's prose.
 
 use super::config::ExperimentConfig;
-use super::report::PolicyStats;
+use super::walk::Walk;
 use crate::error::{Error, Result};
 use crate::io::images::linear_to_srgb8;
+use crate::model::camera::Camera;
+use crate::render::{self, Backend, Quality, RenderJob, Target, Trajectory};
+use crate::trigger::Frame;
+use std::time::Instant;
+
+/// A 2-D point: board coordinates (m) or pixel coordinates (px).
+type Point2 = (f64, f64);
+
+/// What was measured on one rendered frame.
+#[derive(Debug, Clone, Default)]
+pub struct FrameMeasure {
+    /// Distance to the target at exposure start, m.
+    pub distance_m: f64,
+    /// Mean path length over the sensor (ground-truth blur), px.
+    pub blur_px: f64,
+    /// Mean end-to-start displacement, px.
+    pub disp_px: f64,
+    /// JNBM (higher = sharper); NaN when undefined.
+    pub jnbm: f64,
+    /// CPBD (higher = sharper).
+    pub cpbd: f64,
+    /// Crete et al. blur effect (0 sharp .. 1 blurred).
+    pub blur_effect: f64,
+    /// Variance of the Laplacian.
+    pub laplacian_var: f64,
+    /// Blobs found by the colour threshold.
+    pub blobs_found: usize,
+    /// Blobs matched to a true centre.
+    pub blobs_matched: usize,
+    /// All 16 found, each near its true centre.
+    pub blobs_ok: bool,
+    /// When all 16 blobs were extracted: error of the camera position estimated
+    /// from them (planar homography) against the true mid-exposure pose, m.
+    pub pose_err_m: f64,
+    /// The same for the orientation, degrees.
+    pub pose_err_deg: f64,
+    /// Samples per pixel used by the renderer.
+    pub samples_per_pixel: u32,
+    /// Render time, ms.
+    pub render_ms: f64,
+}
+
+/// A frame with its measurements (`None` for frames a gate discarded, or
+/// frames skipped by `max_frames_per_policy`).
+#[derive(Debug, Clone)]
+pub struct FrameRecord {
+    /// Walk name.
+    pub walk: String,
+    /// The trigger decision and exposure.
+    pub frame: Frame,
+    /// Measurements on the rendered frame.
+    pub measure: Option<FrameMeasure>,
+}
 
 /// Linear RGB (interleaved) to an 8-bit sRGB image.
 pub fn to_rgb8(width: u32, height: u32, rgb: &[f32]) -> Result<image::RgbImage> {
@@ -151,96 +204,133 @@ fn pitch_px(c: &[(f64, f64)]) -> f64 {
     }
 }
 
-/// The render-quality note: the preset and its measured error against the default preset.
-pub fn quality_note(cfg: &ExperimentConfig, check: Option<(f64, f64, f64)>) -> String {
-    match check {
-        Some((mean, p99, blur)) => format!(
-            "- Render quality preset `{}`: measured against the `default` preset on the central 160 x 120 window of the most blurred \
-             baseline frame ({blur:.1} px mean blur), mean |difference| {:.2}/255 and 99th percentile {:.2}/255 (linear 0..1 values x 255). \
-             `default` itself is within mean 0.5/255 and p99 3/255 of the exact integral (tests/render_exact.rs).\n",
-            cfg.quality,
-            mean * 255.0,
-            p99 * 255.0
-        ),
-        None => format!("- Render quality preset `{}` (not compared with `default`: no frame to compare).\n", cfg.quality),
-    }
-}
-
-/// Mean and 99th percentile of the per-value |difference| of two images.
+/// Mean and 99th percentile ([`crate::stats::percentile`]) of the per-value
+/// |difference| of two images.
 pub fn image_difference(a: &[f32], b: &[f32]) -> (f64, f64) {
-    let mut d: Vec<f64> = a
+    let d: Vec<f64> = a
         .iter()
         .zip(b)
         .map(|(x, y)| (*x as f64 - *y as f64).abs())
         .collect();
-    if d.is_empty() {
-        return (0.0, 0.0);
+    match (crate::stats::mean(&d), crate::stats::percentile(&d, 99.0)) {
+        (Some(mean), Some(p99)) => (mean, p99),
+        _ => (0.0, 0.0),
     }
-    let mean = d.iter().sum::<f64>() / d.len() as f64;
-    d.sort_by(f64::total_cmp);
-    let p99 = d[((0.99 * d.len() as f64).ceil() as usize).clamp(1, d.len()) - 1];
-    (mean, p99)
 }
 
-/// Prose: what the simulation found, compared with the thesis.
-pub fn findings(stats: &[PolicyStats]) -> String {
-    let mut s = String::from("## Findings\n\n");
-    for st in stats.iter().filter(|x| x.policy.starts_with("fixed")) {
-        let others: Vec<&PolicyStats> = stats
-            .iter()
-            .filter(|x| x.walk == st.walk && !x.policy.starts_with("fixed"))
-            .collect();
-        s += &format!(
-            "- {} walk, baseline `{}`: {} frames, blob success {:.0} %, mean JNBM {:.3}, mean blur {:.1} px (p95 {:.1}).\n",
-            st.walk, st.policy, st.kept, st.success_pct(), st.mean_jnbm, st.mean_blur, st.p95_blur
-        );
-        for o in others {
-            s += &format!(
-                "  - `{}`: {} frames ({:+} vs baseline), success {:.0} %, mean JNBM {:.3}, mean blur {:.1} px (p95 {:.1}).\n",
-                o.policy,
-                o.kept,
-                o.kept as i64 - st.kept as i64,
-                o.success_pct(),
-                o.mean_jnbm,
-                o.mean_blur,
-                o.p95_blur
-            );
-        }
-    }
-    // The headline comparison of the thesis: fixed 5 fps against MMBM triggering at 0.4.
-    for base in stats.iter().filter(|x| x.policy.starts_with("fixed")) {
-        let Some(th) = stats
-            .iter()
-            .find(|x| x.walk == base.walk && x.policy == "threshold:0.4")
-        else {
-            continue;
-        };
-        s += &format!(
-            "\nOn the {} walk, MMBM triggering at 0.4 mm/s (`threshold:0.4`, the thesis rule) against `{}`: \
-             blob success {:.0} % -> {:.0} %, mean ground-truth blur {:.1} -> {:.1} px (p95 {:.1} -> {:.1}), \
-             mean blur effect {:.3} -> {:.3} (lower = sharper), mean JNBM {:.3} -> {:.3}, with {} instead of {} frames. \
-             The thesis (real SensoRHex, chapter 6) found blob success rising from about 50 % to 62-82 % and mean \
-             JNBM from 0.36 to 0.49.\n",
-            base.walk,
-            base.policy,
-            base.success_pct(),
-            th.success_pct(),
-            base.mean_blur,
-            th.mean_blur,
-            base.p95_blur,
-            th.p95_blur,
-            base.mean_blur_effect,
-            th.mean_blur_effect,
-            base.mean_jnbm,
-            th.mean_jnbm,
-            th.kept,
-            base.kept
-        );
-    }
-    s += "\nWhy the numbers differ from the thesis: the rendered frames are ideal (no sensor noise, defocus, \
-          rolling shutter or lighting changes) and the blob detector's red threshold adapts to each frame, so \
-          moderate blur rarely breaks extraction; JNBM and CPBD measure edge widths along rows only (as the \
-          authors' code does) and so miss the vertical smear of the gait's pitching, which is most of the blur \
-          here; the gait is simulated, calibrated only to the thesis's MMBM range and trigger rates.\n";
-    s
+/// A rendered frame: measurements and the linear RGB image.
+pub struct Rendered {
+    /// The measurements.
+    pub measure: FrameMeasure,
+    /// Linear RGB, interleaved.
+    pub rgb: Vec<f32>,
+}
+
+/// Renders and measures one frame.
+pub fn render_and_measure(
+    cfg: &ExperimentConfig,
+    walk: &Walk,
+    frame: &Frame,
+    cam: Camera,
+    quality: Quality,
+    seed: u32,
+) -> Result<Rendered> {
+    let i = walk
+        .samples
+        .partition_point(|s| s.t < frame.exposure_start)
+        .min(walk.samples.len() - 1);
+    let distance = walk.distance[i];
+    let use_velocity = walk.samples[i].velocity.is_some();
+    let traj = Trajectory::from_log(
+        &walk.samples,
+        frame.exposure_start,
+        cfg.exposure_s,
+        use_velocity,
+    )?;
+    let target = Target::parse(&cfg.target, distance)?;
+    let mut job = RenderJob::new(cam, traj.clone(), target.clone());
+    job.quality = quality;
+    job.backend = Backend::Auto;
+    job.seed = seed;
+    let t0 = Instant::now();
+    let out = render::render_frame(&job)?;
+    let render_ms = t0.elapsed().as_secs_f64() * 1e3;
+    let maps = out
+        .maps
+        .as_ref()
+        .ok_or_else(|| Error::invalid("render", "no blur maps"))?;
+    let means = maps.means();
+    let rgb8 = to_rgb8(cam.width, cam.height, &out.rgb)?;
+    // True blob centres at mid-exposure (the centroid of a smear).
+    let mid = traj.pose_at(0.5 * cfg.exposure_s);
+    let frame_pl = target.frame();
+    let (board, expected): (Vec<Point2>, Vec<Point2>) = target
+        .blob_centres()
+        .unwrap_or_default()
+        .iter()
+        .filter_map(|&p| {
+            let d = p - frame_pl.origin;
+            render::project(&cam, &mid, p).map(|px| ((d.dot(frame_pl.e1), d.dot(frame_pl.e2)), px))
+        })
+        .unzip();
+    // Like the thesis, judge sharpness on the pattern cropped from the frame.
+    let crop = pattern_crop(&rgb8, &expected);
+    let img = image_metrics(&crop);
+    let blobs = blob_metrics(&rgb8, &expected);
+    let (pose_err_m, pose_err_deg) = if blobs.ok {
+        pose_error(&cam, &board, &blobs.matches, &frame_pl, &mid)
+    } else {
+        (f64::NAN, f64::NAN)
+    };
+    Ok(Rendered {
+        measure: FrameMeasure {
+            distance_m: distance,
+            blur_px: means.path_px,
+            disp_px: means.disp_px,
+            jnbm: img.jnbm,
+            cpbd: img.cpbd,
+            blur_effect: img.blur_effect,
+            laplacian_var: img.laplacian_var,
+            blobs_found: blobs.found,
+            blobs_matched: blobs.matched,
+            blobs_ok: blobs.ok,
+            pose_err_m,
+            pose_err_deg,
+            samples_per_pixel: out.samples_per_pixel,
+            render_ms,
+        },
+        rgb: out.rgb,
+    })
+}
+
+/// Pose from the matched blob centres against the true camera pose `mid`
+/// (world = camera at exposure start): `(position error m, angle error deg)`,
+/// NaN when the pose cannot be estimated.
+fn pose_error(
+    cam: &Camera,
+    board: &[(f64, f64)],
+    matches: &[Option<(f64, f64)>],
+    plane: &crate::render::target::PlaneFrame,
+    mid: &crate::render::Pose,
+) -> (f64, f64) {
+    let (b, px): (Vec<Point2>, Vec<Point2>) = board
+        .iter()
+        .zip(matches)
+        .filter_map(|(b, m)| m.map(|m| (*b, m)))
+        .unzip();
+    let Ok(est) = crate::board::pose::planar_pose(cam, &b, &px) else {
+        return (f64::NAN, f64::NAN);
+    };
+    // True camera-from-board transform: X_cam = R_q^T (O + B x - c).
+    let rq_t = glam::DMat3::from_quat(mid.0).transpose();
+    let board_axes = glam::DMat3::from_cols(plane.e1, plane.e2, plane.e1.cross(plane.e2));
+    let truth = crate::board::pose::PlanarPose {
+        rotation: rq_t * board_axes,
+        translation: rq_t * (plane.origin - mid.1),
+        rms_px: 0.0,
+    };
+    (
+        (est.camera_centre() - truth.camera_centre()).length(),
+        crate::board::pose::rotation_angle_deg(&est.rotation, &truth.rotation),
+    )
 }

@@ -1,142 +1,21 @@
-//! Running the experiment: walk -> MMBM -> every policy's triggers -> each
-//! kept frame rendered with its true motion -> ground-truth blur, image
-//! metrics and blob extraction per frame.
+//! Running the experiment: plan the renders, render and measure each planned
+//! frame, then write `frames.csv`, the figures and `report.md`.
 
 use super::config::ExperimentConfig;
+use super::figures::{self, Extremes};
+use super::measure::{image_difference, render_and_measure, FrameRecord};
+use super::report::{frames_csv, policy_stats, report_md, Outcome};
+use super::walk::{camera, make_walk, Walk};
 use crate::error::{Error, Result};
-use crate::io::gyro::{read_log, GyroOptions, GyroSample};
-use crate::metric::{Method, Scene};
-use crate::model::camera::Camera;
-use crate::render::{self, Backend, Quality, RenderJob, Target, Trajectory};
-use crate::sim::{simulate, Gait, GaitConfig};
-use crate::trigger::{self, parse_policy, CameraTiming, Frame};
+use crate::io::atomic::write_atomic;
+use crate::metric::Scene;
+use crate::render::Quality;
+use crate::trigger::Frame;
+use indicatif::{ProgressBar, ProgressStyle};
+use std::collections::HashMap;
+use std::path::Path;
 use std::str::FromStr;
 use std::time::Instant;
-
-/// A 2-D point: board coordinates (m) or pixel coordinates (px).
-type Point2 = (f64, f64);
-
-/// One walk (simulated or a real log) with its MMBM series and every policy's frames.
-#[derive(Debug, Clone)]
-pub struct Walk {
-    /// `moderate`, `slow`, `fast` or the log's file name.
-    pub name: String,
-    /// The gyro samples (true motion and measurement).
-    pub samples: Vec<GyroSample>,
-    /// Rotation-only MMBM per sample (8x6 grid), mm/s.
-    pub mmbm: Vec<f64>,
-    /// Distance to the target per sample, m.
-    pub distance: Vec<f64>,
-    /// `(policy, frames)` in configuration order.
-    pub runs: Vec<(String, Vec<Frame>)>,
-}
-
-/// What was measured on one rendered frame.
-#[derive(Debug, Clone, Default)]
-pub struct FrameMeasure {
-    /// Distance to the target at exposure start, m.
-    pub distance_m: f64,
-    /// Mean path length over the sensor (ground-truth blur), px.
-    pub blur_px: f64,
-    /// Mean end-to-start displacement, px.
-    pub disp_px: f64,
-    /// JNBM (higher = sharper); NaN when undefined.
-    pub jnbm: f64,
-    /// CPBD (higher = sharper).
-    pub cpbd: f64,
-    /// Crete et al. blur effect (0 sharp .. 1 blurred).
-    pub blur_effect: f64,
-    /// Variance of the Laplacian.
-    pub laplacian_var: f64,
-    /// Blobs found by the colour threshold.
-    pub blobs_found: usize,
-    /// Blobs matched to a true centre.
-    pub blobs_matched: usize,
-    /// All 16 found, each near its true centre.
-    pub blobs_ok: bool,
-    /// When all 16 blobs were extracted: error of the camera position estimated
-    /// from them (planar homography) against the true mid-exposure pose, m.
-    pub pose_err_m: f64,
-    /// The same for the orientation, degrees.
-    pub pose_err_deg: f64,
-    /// Samples per pixel used by the renderer.
-    pub samples_per_pixel: u32,
-    /// Render time, ms.
-    pub render_ms: f64,
-}
-
-/// A frame with its measurements (`None` for frames a gate discarded, or
-/// frames skipped by `max_frames_per_policy`).
-#[derive(Debug, Clone)]
-pub struct FrameRecord {
-    /// Walk name.
-    pub walk: String,
-    /// The trigger decision and exposure.
-    pub frame: Frame,
-    /// Measurements on the rendered frame.
-    pub measure: Option<FrameMeasure>,
-}
-
-/// Builds a walk from the configuration: the simulation of `gait`, or the log.
-pub fn make_walk(cfg: &ExperimentConfig, walk: &str, scene: &Scene) -> Result<Walk> {
-    let (name, samples) = match &cfg.gyro {
-        Some(p) => (
-            p.file_name()
-                .map_or("log".into(), |s| s.to_string_lossy().into_owned()),
-            read_log(p, GyroOptions::default())?,
-        ),
-        None => {
-            let gait = Gait::from_str(walk)?;
-            let g = GaitConfig::preset(gait);
-            (
-                walk.to_string(),
-                simulate(&g, cfg.duration_s, cfg.rate_hz, cfg.seed)?,
-            )
-        }
-    };
-    let mmbm = crate::series::mmbm_series(&samples, scene, Method::default())?;
-    // Distance to the target: integrate the forward velocity (or the
-    // configured speed), starting at start_distance, never closer than min_distance.
-    let mut distance = Vec::with_capacity(samples.len());
-    let mut d = cfg.start_distance_m;
-    for (k, s) in samples.iter().enumerate() {
-        if k > 0 {
-            let dt = s.t - samples[k - 1].t;
-            let vz = s.velocity.map_or(cfg.speed_m_s, |v| v.z);
-            d = (d - vz * dt).max(cfg.min_distance_m);
-        }
-        distance.push(d);
-    }
-    let timing = timing(cfg);
-    let mut runs = Vec::new();
-    for p in &cfg.policies {
-        let mut policy = parse_policy(p)?;
-        let frames = trigger::run(&samples, &mmbm, policy.as_mut(), &timing)?;
-        runs.push((p.clone(), frames));
-    }
-    Ok(Walk {
-        name,
-        samples,
-        mmbm,
-        distance,
-        runs,
-    })
-}
-
-/// The camera timing of the configuration.
-pub fn timing(cfg: &ExperimentConfig) -> CameraTiming {
-    CameraTiming {
-        delay: cfg.delay_s,
-        exposure: cfg.exposure_s,
-        readout: cfg.readout_s,
-        min_interval: cfg.min_interval_s,
-    }
-}
-
-/// The rendering camera: thesis focal length and pitch at the configured resolution.
-pub fn camera(cfg: &ExperimentConfig) -> Camera {
-    Camera::thesis().with_resolution(cfg.resolution[0], cfg.resolution[1])
-}
 
 /// Indices of the frames to render for one run: every kept frame, or an even
 /// spread of `max` of them.
@@ -148,119 +27,131 @@ pub fn frames_to_render(frames: &[Frame], max: usize) -> Vec<usize> {
     (0..max).map(|k| kept[k * kept.len() / max]).collect()
 }
 
-/// A rendered frame: measurements and the linear RGB image.
-pub struct Rendered {
-    /// The measurements.
-    pub measure: FrameMeasure,
-    /// Linear RGB, interleaved.
-    pub rgb: Vec<f32>,
-}
-
-/// Renders and measures one frame.
-pub fn render_and_measure(
-    cfg: &ExperimentConfig,
-    walk: &Walk,
-    frame: &Frame,
-    cam: Camera,
-    quality: Quality,
-    seed: u32,
-) -> Result<Rendered> {
-    let i = walk
-        .samples
-        .partition_point(|s| s.t < frame.exposure_start)
-        .min(walk.samples.len() - 1);
-    let distance = walk.distance[i];
-    let use_velocity = walk.samples[i].velocity.is_some();
-    let traj = Trajectory::from_log(
-        &walk.samples,
-        frame.exposure_start,
-        cfg.exposure_s,
-        use_velocity,
-    )?;
-    let target = Target::parse(&cfg.target, distance)?;
-    let mut job = RenderJob::new(cam, traj.clone(), target.clone());
-    job.quality = quality;
-    job.backend = Backend::Auto;
-    job.seed = seed;
-    let t0 = Instant::now();
-    let out = render::render_frame(&job)?;
-    let render_ms = t0.elapsed().as_secs_f64() * 1e3;
-    let maps = out
-        .maps
-        .as_ref()
-        .ok_or_else(|| Error::invalid("render", "no blur maps"))?;
-    let means = maps.means();
-    let rgb8 = super::measure::to_rgb8(cam.width, cam.height, &out.rgb)?;
-    // True blob centres at mid-exposure (the centroid of a smear).
-    let mid = traj.pose_at(0.5 * cfg.exposure_s);
-    let frame_pl = target.frame();
-    let (board, expected): (Vec<Point2>, Vec<Point2>) = target
-        .blob_centres()
-        .unwrap_or_default()
-        .iter()
-        .filter_map(|&p| {
-            let d = p - frame_pl.origin;
-            render::project(&cam, &mid, p).map(|px| ((d.dot(frame_pl.e1), d.dot(frame_pl.e2)), px))
-        })
-        .unzip();
-    // Like the thesis, judge sharpness on the pattern cropped from the frame.
-    let crop = super::measure::pattern_crop(&rgb8, &expected);
-    let img = super::measure::image_metrics(&crop);
-    let blobs = super::measure::blob_metrics(&rgb8, &expected);
-    let (pose_err_m, pose_err_deg) = if blobs.ok {
-        pose_error(&cam, &board, &blobs.matches, &frame_pl, &mid)
+/// Runs the experiment and writes `frames.csv`, `report.md` and the figures into `out`.
+pub fn run(cfg: &ExperimentConfig, out: &Path, progress: bool) -> Result<Outcome> {
+    cfg.validate()?;
+    let t_start = Instant::now();
+    std::fs::create_dir_all(out).map_err(|e| Error::io(out, e))?;
+    let quality = Quality::from_str(&cfg.quality)?;
+    let scene = Scene {
+        camera: camera(cfg),
+        plane: None,
+    };
+    let names: Vec<String> = if cfg.gyro.is_some() {
+        vec!["log".into()]
     } else {
-        (f64::NAN, f64::NAN)
+        cfg.walks.clone()
     };
-    Ok(Rendered {
-        measure: FrameMeasure {
-            distance_m: distance,
-            blur_px: means.path_px,
-            disp_px: means.disp_px,
-            jnbm: img.jnbm,
-            cpbd: img.cpbd,
-            blur_effect: img.blur_effect,
-            laplacian_var: img.laplacian_var,
-            blobs_found: blobs.found,
-            blobs_matched: blobs.matched,
-            blobs_ok: blobs.ok,
-            pose_err_m,
-            pose_err_deg,
-            samples_per_pixel: out.samples_per_pixel,
-            render_ms,
-        },
-        rgb: out.rgb,
-    })
+    let walks: Vec<Walk> = names
+        .iter()
+        .map(|w| make_walk(cfg, w, &scene))
+        .collect::<Result<_>>()?;
+
+    // Plan the renders.
+    let mut plan = Vec::new();
+    for (wi, w) in walks.iter().enumerate() {
+        for (pi, (_, frames)) in w.runs.iter().enumerate() {
+            for fi in frames_to_render(frames, cfg.max_frames_per_policy) {
+                plan.push((wi, pi, fi));
+            }
+        }
+    }
+    let bar = if progress {
+        ProgressBar::new(plan.len() as u64)
+    } else {
+        ProgressBar::hidden()
+    };
+    bar.set_style(
+        ProgressStyle::with_template(
+            "rendering {pos}/{len} frames [{elapsed_precise} < {eta_precise}] {msg}",
+        )
+        .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    let check = quality_check(cfg, &walks, &plan, quality)?;
+    let mut measures = HashMap::new();
+    let mut extremes: HashMap<(usize, usize), Extremes> = HashMap::new();
+    for (k, &(wi, pi, fi)) in plan.iter().enumerate() {
+        let w = &walks[wi];
+        let frame = &w.runs[pi].1[fi];
+        bar.set_message(format!("{} {}", w.name, frame.policy));
+        let r = render_and_measure(cfg, w, frame, camera(cfg), quality, k as u32)?;
+        // Keep the sharpest and the most blurred frame of each (walk, policy).
+        let b = r.measure.blur_px;
+        let e = extremes.entry((wi, pi)).or_insert_with(|| Extremes {
+            sharpest: (f64::INFINITY, Vec::new()),
+            blurriest: (f64::NEG_INFINITY, Vec::new()),
+        });
+        if b < e.sharpest.0 {
+            e.sharpest = (b, r.rgb.clone());
+        }
+        if b > e.blurriest.0 {
+            e.blurriest = (b, r.rgb.clone());
+        }
+        measures.insert((wi, pi, fi), r.measure);
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+
+    let mut records = Vec::new();
+    for (wi, w) in walks.iter().enumerate() {
+        for (pi, (_, frames)) in w.runs.iter().enumerate() {
+            for (fi, f) in frames.iter().enumerate() {
+                records.push(FrameRecord {
+                    walk: w.name.clone(),
+                    frame: f.clone(),
+                    measure: measures.remove(&(wi, pi, fi)),
+                });
+            }
+        }
+    }
+    let stats = policy_stats(&walks, &records);
+    let csv = frames_csv(&records);
+    write_atomic(&out.join("frames.csv"), |w| {
+        w.write_all(csv.as_bytes())
+            .map_err(|e| Error::io(out.join("frames.csv"), e))
+    })?;
+
+    let figs = figures::write_all(out, cfg, &walks, &records, &extremes)?;
+    let outcome = Outcome {
+        walks,
+        records,
+        stats,
+        seconds: t_start.elapsed().as_secs_f64(),
+        rendered: plan.len(),
+    };
+    let md = report_md(cfg, &outcome, &figs, check);
+    write_atomic(&out.join("report.md"), |w| {
+        w.write_all(md.as_bytes())
+            .map_err(|e| Error::io(out.join("report.md"), e))
+    })?;
+    Ok(outcome)
 }
 
-/// Pose from the matched blob centres against the true camera pose `mid`
-/// (world = camera at exposure start): `(position error m, angle error deg)`,
-/// NaN when the pose cannot be estimated.
-fn pose_error(
-    cam: &Camera,
-    board: &[(f64, f64)],
-    matches: &[Option<(f64, f64)>],
-    plane: &crate::render::target::PlaneFrame,
-    mid: &crate::render::Pose,
-) -> (f64, f64) {
-    let (b, px): (Vec<Point2>, Vec<Point2>) = board
-        .iter()
-        .zip(matches)
-        .filter_map(|(b, m)| m.map(|m| (*b, m)))
-        .unzip();
-    let Ok(est) = crate::board::pose::planar_pose(cam, &b, &px) else {
-        return (f64::NAN, f64::NAN);
+/// Renders the central 160 x 120 window of the most blurred planned frame of
+/// the first policy with the configured preset and with `default`: `(mean, p99, blur_px)` of the difference.
+fn quality_check(
+    cfg: &ExperimentConfig,
+    walks: &[Walk],
+    plan: &[(usize, usize, usize)],
+    quality: Quality,
+) -> Result<Option<(f64, f64, f64)>> {
+    let worst = plan.iter().filter(|&&(_, pi, _)| pi == 0).max_by(|a, b| {
+        let fa = &walks[a.0].runs[a.1].1[a.2];
+        let fb = &walks[b.0].runs[b.1].1[b.2];
+        fa.mmbm_exposure_mm_s.total_cmp(&fb.mmbm_exposure_mm_s)
+    });
+    let Some(&(wi, pi, fi)) = worst else {
+        return Ok(None);
     };
-    // True camera-from-board transform: X_cam = R_q^T (O + B x - c).
-    let rq_t = glam::DMat3::from_quat(mid.0).transpose();
-    let board_axes = glam::DMat3::from_cols(plane.e1, plane.e2, plane.e1.cross(plane.e2));
-    let truth = crate::board::pose::PlanarPose {
-        rotation: rq_t * board_axes,
-        translation: rq_t * (plane.origin - mid.1),
-        rms_px: 0.0,
-    };
-    (
-        (est.camera_centre() - truth.camera_centre()).length(),
-        crate::board::pose::rotation_angle_deg(&est.rotation, &truth.rotation),
-    )
+    if quality == Quality::Default {
+        return Ok(None);
+    }
+    let frame = &walks[wi].runs[pi].1[fi];
+    // The central 160 x 120 window (same focal length and pitch), where the
+    // board is: the default preset is slow at full resolution on lavapipe.
+    let cam = camera(cfg).with_resolution(160, 120);
+    let a = render_and_measure(cfg, &walks[wi], frame, cam, quality, 0)?;
+    let b = render_and_measure(cfg, &walks[wi], frame, cam, Quality::Default, 0)?;
+    let (mean, p99) = image_difference(&a.rgb, &b.rgb);
+    Ok(Some((mean, p99, b.measure.blur_px)))
 }

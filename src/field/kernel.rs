@@ -201,6 +201,33 @@ mod tests {
         assert!(Grid::new(&cam, 100_000, 100_000).is_err());
     }
 
+    /// The shader's `const` of this name, as a u32.
+    fn shader_const(m: &naga::Module, name: &str) -> u32 {
+        let c = m
+            .constants
+            .iter()
+            .map(|(_, c)| c)
+            .find(|c| c.name.as_deref() == Some(name))
+            .unwrap_or_else(|| panic!("field.wgsl has no const {name}"));
+        match m.global_expressions[c.init] {
+            naga::Expression::Literal(naga::Literal::U32(v)) => v,
+            ref e => panic!("const {name} is not a u32 literal: {e:?}"),
+        }
+    }
+
+    #[test]
+    fn shader_constants_match_host() {
+        // The workgroup geometry is written in both places; this ties them.
+        let m = naga::front::wgsl::parse_str(crate::field::gpu::FIELD_WGSL).expect("parses");
+        assert_eq!(shader_const(&m, "WG"), WG);
+        assert_eq!(shader_const(&m, "CHUNK"), CHUNK);
+        assert_eq!(shader_const(&m, "TILE"), TILE);
+        assert_eq!(m.entry_points.len(), 2);
+        for ep in &m.entry_points {
+            assert_eq!(ep.workgroup_size, [WG, 1, 1], "{}", ep.name);
+        }
+    }
+
     #[test]
     fn twist_without_plane_drops_translation() {
         let tw = Twist::new(glam::DVec3::new(1.0, 2.0, 3.0), glam::DVec3::ONE);

@@ -6,45 +6,7 @@ use crate::model::flow::FlowPoly;
 /// MMBM* (thesis eq. 4.1): the mean of the flow speed at the centres of an
 /// `nu x nv` grid of equal cells covering the sensor, mm/s.
 pub fn riemann(poly: &FlowPoly, r: &SensorRect, nu: u32, nv: u32) -> f64 {
-    super::avx2::riemann(poly, r, nu, nv).unwrap_or_else(|| riemann_impl(poly, r, nu, nv))
-}
-
-/// The body of [`riemann`], also compiled for AVX2 + FMA in [`super::avx2`].
-#[inline(always)]
-pub(super) fn riemann_impl(poly: &FlowPoly, r: &SensorRect, nu: u32, nv: u32) -> f64 {
-    let du = (r.u1 - r.u0) / nu as f64;
-    let dv = (r.v1 - r.v0) / nv as f64;
-    let (p, q) = (&poly.du, &poly.dv);
-    let mut total = 0.0;
-    for j in 0..nv {
-        let v = r.v0 + (j as f64 + 0.5) * dv;
-        // Along a row both components are quadratics in u: a0 + a1 u + a2 u^2.
-        let (a0, a1, a2) = (p[0] + v * (p[2] + p[5] * v), p[1] + p[4] * v, p[3]);
-        let (b0, b1, b2) = (q[0] + v * (q[2] + q[5] * v), q[1] + q[4] * v, q[3]);
-        // Full blocks of 8 cells in straight-line code the compiler
-        // vectorises (square roots included), then the remainder.
-        let mut acc = [0.0f64; 8];
-        let full = nu / 8 * 8;
-        let mut i = 0u32;
-        while i < full {
-            let base = r.u0 + (i as f64 + 0.5) * du;
-            for (k, a) in acc.iter_mut().enumerate() {
-                let u = base + k as f64 * du;
-                let x = a0 + u * (a1 + a2 * u);
-                let y = b0 + u * (b1 + b2 * u);
-                *a += (x * x + y * y).sqrt();
-            }
-            i += 8;
-        }
-        for i in full..nu {
-            let u = r.u0 + (i as f64 + 0.5) * du;
-            let x = a0 + u * (a1 + a2 * u);
-            let y = b0 + u * (b1 + b2 * u);
-            acc[0] += (x * x + y * y).sqrt();
-        }
-        total += acc.iter().sum::<f64>();
-    }
-    total / (nu as f64 * nv as f64)
+    super::avx2::riemann(poly, r, nu, nv)
 }
 
 /// Gauss-Legendre nodes and weights on `[-1, 1]` (Newton on the Legendre
@@ -162,32 +124,7 @@ impl GridRule {
 
     /// The rule's estimate of the mean flow speed, mm/s.
     pub fn mean_speed(&self, poly: &FlowPoly) -> f64 {
-        super::avx2::rule_mean(self, poly).unwrap_or_else(|| self.mean_speed_impl(poly))
-    }
-
-    /// The body of [`GridRule::mean_speed`], also compiled for AVX2 + FMA in
-    /// [`super::avx2`].
-    #[inline(always)]
-    pub(super) fn mean_speed_impl(&self, poly: &FlowPoly) -> f64 {
-        let (p, q) = (&poly.du, &poly.dv);
-        let mut acc = [0.0f64; 8];
-        let chunks = self.m[0]
-            .chunks_exact(8)
-            .zip(self.m[1].chunks_exact(8))
-            .zip(self.m[2].chunks_exact(8))
-            .zip(self.m[3].chunks_exact(8))
-            .zip(self.m[4].chunks_exact(8))
-            .zip(self.w.chunks_exact(8));
-        for (((((u, v), uu), uv), vv), w) in chunks {
-            for k in 0..8 {
-                let x =
-                    p[0] + p[1] * u[k] + p[2] * v[k] + p[3] * uu[k] + p[4] * uv[k] + p[5] * vv[k];
-                let y =
-                    q[0] + q[1] * u[k] + q[2] * v[k] + q[3] * uu[k] + q[4] * uv[k] + q[5] * vv[k];
-                acc[k] += w[k] * (x * x + y * y).sqrt();
-            }
-        }
-        acc.iter().sum()
+        super::avx2::rule_mean(&self.m, &self.w, poly)
     }
 }
 

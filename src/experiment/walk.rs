@@ -1,0 +1,87 @@
+//! The walks of the experiment: a simulated gait or a real log, its MMBM
+//! series, the board's distance, and every policy's frames.
+
+use super::config::ExperimentConfig;
+use crate::error::Result;
+use crate::io::gyro::{read_log, GyroOptions, GyroSample};
+use crate::metric::{Method, Scene};
+use crate::model::camera::Camera;
+use crate::sim::{simulate, Gait, GaitConfig};
+use crate::trigger::{self, parse_policy, CameraTiming, Frame};
+use std::str::FromStr;
+
+/// One walk (simulated or a real log) with its MMBM series and every policy's frames.
+#[derive(Debug, Clone)]
+pub struct Walk {
+    /// `moderate`, `slow`, `fast` or the log's file name.
+    pub name: String,
+    /// The gyro samples (true motion and measurement).
+    pub samples: Vec<GyroSample>,
+    /// Rotation-only MMBM per sample (8x6 grid), mm/s.
+    pub mmbm: Vec<f64>,
+    /// Distance to the target per sample, m.
+    pub distance: Vec<f64>,
+    /// `(policy, frames)` in configuration order.
+    pub runs: Vec<(String, Vec<Frame>)>,
+}
+
+/// Builds a walk from the configuration: the simulation of `gait`, or the log.
+pub fn make_walk(cfg: &ExperimentConfig, walk: &str, scene: &Scene) -> Result<Walk> {
+    let (name, samples) = match &cfg.gyro {
+        Some(p) => (
+            p.file_name()
+                .map_or("log".into(), |s| s.to_string_lossy().into_owned()),
+            read_log(p, GyroOptions::default())?,
+        ),
+        None => {
+            let gait = Gait::from_str(walk)?;
+            let g = GaitConfig::preset(gait);
+            (
+                walk.to_string(),
+                simulate(&g, cfg.duration_s, cfg.rate_hz, cfg.seed)?,
+            )
+        }
+    };
+    let mmbm = crate::series::mmbm_series(&samples, scene, Method::default())?;
+    // Distance to the target: integrate the forward velocity (or the
+    // configured speed), starting at start_distance, never closer than min_distance.
+    let mut distance = Vec::with_capacity(samples.len());
+    let mut d = cfg.start_distance_m;
+    for (k, s) in samples.iter().enumerate() {
+        if k > 0 {
+            let dt = s.t - samples[k - 1].t;
+            let vz = s.velocity.map_or(cfg.speed_m_s, |v| v.z);
+            d = (d - vz * dt).max(cfg.min_distance_m);
+        }
+        distance.push(d);
+    }
+    let timing = timing(cfg);
+    let mut runs = Vec::new();
+    for p in &cfg.policies {
+        let mut policy = parse_policy(p)?;
+        let frames = trigger::run(&samples, &mmbm, policy.as_mut(), &timing)?;
+        runs.push((p.clone(), frames));
+    }
+    Ok(Walk {
+        name,
+        samples,
+        mmbm,
+        distance,
+        runs,
+    })
+}
+
+/// The camera timing of the configuration.
+pub fn timing(cfg: &ExperimentConfig) -> CameraTiming {
+    CameraTiming {
+        delay: cfg.delay_s,
+        exposure: cfg.exposure_s,
+        readout: cfg.readout_s,
+        min_interval: cfg.min_interval_s,
+    }
+}
+
+/// The rendering camera: thesis focal length and pitch at the configured resolution.
+pub fn camera(cfg: &ExperimentConfig) -> Camera {
+    Camera::thesis().with_resolution(cfg.resolution[0], cfg.resolution[1])
+}
