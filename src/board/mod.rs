@@ -49,6 +49,22 @@ impl Board {
         }
     }
 
+    /// The board with every length multiplied by `scale` (`blobs:SCALE`).
+    pub fn scaled(&self, scale: f64) -> Self {
+        Board {
+            square_m: self.square_m * scale,
+            gap_m: self.gap_m * scale,
+            ..*self
+        }
+    }
+
+    /// Half the width of the white board (m): the grid of squares plus a
+    /// margin of one square side on each side.
+    pub fn half_width_m(&self) -> f64 {
+        (self.cols as f64 * self.square_m + (self.cols as f64 - 1.0) * self.gap_m) / 2.0
+            + self.square_m
+    }
+
     /// Centre-to-centre distance, m.
     pub fn pitch_m(&self) -> f64 {
         self.square_m + self.gap_m

@@ -7,7 +7,7 @@
 use super::kernel::{with_range, GpuPose, RenderParams};
 use super::texture::MipTexture;
 use crate::error::{Error, Result};
-use crate::gpu::GpuContext;
+use crate::gpu::{compute, GpuContext};
 use std::sync::OnceLock;
 use wgpu::util::DeviceExt;
 
@@ -17,35 +17,27 @@ pub const SHADER: &str = include_str!("../../shaders/render.wgsl");
 /// Upper bound of pixel-samples in one dispatch.
 pub const SAMPLES_PER_DISPATCH: u64 = 1 << 25;
 
-static PIPELINE: OnceLock<std::result::Result<wgpu::ComputePipeline, String>> = OnceLock::new();
+/// The compiled kernel: its bind group layout and pipeline.
+struct Kernel {
+    bgl: wgpu::BindGroupLayout,
+    pipeline: wgpu::ComputePipeline,
+}
 
-fn pipeline(ctx: &GpuContext) -> Result<&'static wgpu::ComputePipeline> {
-    PIPELINE
+static KERNEL: OnceLock<std::result::Result<Kernel, String>> = OnceLock::new();
+
+fn kernel(ctx: &GpuContext) -> Result<&'static Kernel> {
+    KERNEL
         .get_or_init(|| {
-            let scope = ctx.device.push_error_scope(wgpu::ErrorFilter::Validation);
-            let module = ctx
-                .device
-                .create_shader_module(wgpu::ShaderModuleDescriptor {
-                    label: Some("render.wgsl"),
-                    source: wgpu::ShaderSource::Wgsl(SHADER.into()),
-                });
-            let p = ctx
-                .device
-                .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                    label: Some("render"),
-                    layout: None,
-                    module: &module,
-                    entry_point: Some("main"),
-                    compilation_options: Default::default(),
-                    cache: None,
-                });
-            match pollster::block_on(scope.pop()) {
-                Some(e) => Err(format!("render pipeline: {e}")),
-                None => Ok(p),
-            }
+            let p = compute::build(ctx, "render.wgsl", SHADER, None, &["main"])
+                .map_err(|e| e.to_string())?;
+            let pipeline = p.pipelines.into_iter().next().ok_or("no pipeline")?;
+            Ok(Kernel {
+                bgl: p.bgl,
+                pipeline,
+            })
         })
         .as_ref()
-        .map_err(|e| Error::Gpu(e.clone()))
+        .map_err(|e| Error::Gpu(e.trim_start_matches("GPU: ").to_string()))
 }
 
 /// Renders on the GPU; returns linear RGB interleaved (mean over N samples).
@@ -55,7 +47,8 @@ pub fn render(
     poses: &[GpuPose],
     tex: Option<&MipTexture>,
 ) -> Result<Vec<f32>> {
-    let pipe = pipeline(ctx)?;
+    let k = kernel(ctx)?;
+    let pipe = &k.pipeline;
     let dev = &ctx.device;
     let (w, h, n) = (p.dims[0], p.dims[1], p.dims[3]);
     let npix = w as u64 * h as u64;
@@ -92,10 +85,9 @@ pub fn render(
         usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         mapped_at_creation: false,
     });
-    let bgl = pipe.get_bind_group_layout(0);
     let bg = dev.create_bind_group(&wgpu::BindGroupDescriptor {
         label: Some("render"),
-        layout: &bgl,
+        layout: &k.bgl,
         entries: &[
             wgpu::BindGroupEntry {
                 binding: 0,
@@ -161,22 +153,11 @@ pub fn render(
     if let Some(e) = pollster::block_on(scope.pop()) {
         return Err(Error::Gpu(format!("render: {e}")));
     }
-    let (tx, rx) = std::sync::mpsc::channel();
-    b_read.map_async(wgpu::MapMode::Read, .., move |r| {
-        let _ = tx.send(r);
-    });
-    dev.poll(wgpu::PollType::wait_indefinitely())
-        .map_err(|e| Error::Gpu(format!("render readback: {e}")))?;
-    rx.recv()
-        .map_err(|e| Error::Gpu(format!("render readback: {e}")))?
-        .map_err(|e| Error::Gpu(format!("render readback: {e}")))?;
-    let view = b_read
-        .get_mapped_range(..)
-        .map_err(|e| Error::Gpu(format!("render readback: {e}")))?;
-    let sums: &[[f32; 4]] = bytemuck::cast_slice(&view);
+    let bytes = compute::read_back(ctx, &b_read, out_bytes, "render readback")?;
+    let sums: Vec<[f32; 4]> = bytemuck::pod_collect_to_vec(&bytes);
     let inv = 1.0 / n as f32;
     let mut out = Vec::with_capacity((npix * 3) as usize);
-    for s in sums {
+    for s in &sums {
         out.extend_from_slice(&[s[0] * inv, s[1] * inv, s[2] * inv]);
     }
     Ok(out)

@@ -9,9 +9,10 @@
 //! `k / N` (shifted), so consecutive time samples are `duration / N` apart,
 //! and the x and y projections are exactly stratified too.
 
-use super::target::{Target, TargetKind, BLOB_GAP_M, BLOB_RED, BLOB_SIZE_M, BOARD_WHITE};
+use super::target::{Target, TargetKind};
 use super::texture::MipTexture;
 use super::trajectory::Pose;
+use crate::board::{BLOB_RED, BOARD_WHITE};
 use crate::model::camera::Camera;
 use bytemuck::{Pod, Zeroable};
 
@@ -197,10 +198,10 @@ pub fn params(cam: &Camera, target: &Target, n: u32, segments: u32, seed: u32) -
     let v4 = |v: glam::DVec3, w: f64| [v.x as f32, v.y as f32, v.z as f32, w as f32];
     let (kind, tex) = match &target.kind {
         TargetKind::Checker { size } => (KIND_CHECKER, [*size as f32, 0.0, 0.0, 0.0]),
-        TargetKind::Blobs { scale } => {
-            let sq = BLOB_SIZE_M * scale;
-            let pitch = (BLOB_SIZE_M + BLOB_GAP_M) * scale;
-            let half = (4.0 * sq + 3.0 * BLOB_GAP_M * scale) / 2.0 + sq;
+        TargetKind::Blobs { .. } => {
+            // The shader and its CPU twin draw a 4 x 4 grid (see the test below).
+            let b = target.board().unwrap_or_else(crate::board::Board::thesis);
+            let (sq, pitch, half) = (b.square_m, b.pitch_m(), b.half_width_m());
             (KIND_BLOBS, [sq as f32, pitch as f32, half as f32, 0.0])
         }
         TargetKind::Image {
@@ -280,5 +281,21 @@ mod tests {
         let s = shifts(3, 4, 0);
         assert!(s.iter().all(|&x| (0.0..1.0).contains(&x)));
         assert_ne!(shifts(3, 4, 0), shifts(4, 3, 0));
+    }
+
+    #[test]
+    fn kernel_board_is_the_thesis_board() {
+        // render.wgsl and cpu.rs index the squares as a 4 x 4 grid
+        // (`clamp(floor(a / pitch + 2), 0, 3) - 1.5`); the board they are given
+        // must be that grid, with the sizes of `board::Board`.
+        let b = crate::board::Board::thesis();
+        assert_eq!((b.cols, b.rows), (4, 4));
+        let t = Target::blobs(0.5, 3.0);
+        let p = params(&crate::model::camera::Camera::thesis(), &t, 64, 256, 0);
+        let h = b.scaled(0.5);
+        assert_eq!(p.tex[0], h.square_m as f32);
+        assert_eq!(p.tex[1], h.pitch_m() as f32);
+        assert_eq!(p.tex[2], h.half_width_m() as f32);
+        assert_eq!(t.blob_centres().map(|c| c.len()), Some(16));
     }
 }

@@ -24,16 +24,18 @@ pub mod target;
 pub mod texture;
 pub mod trajectory;
 
+pub use crate::gpu::Backend;
 pub use maps::{blur_maps, BlurMaps, BlurMeans};
 pub use psf::{psf, Psf};
 pub use target::{project, Target, TargetKind};
 pub use trajectory::{Pose, Trajectory};
 
 use crate::error::{Error, Result};
+use crate::gpu::Resolved;
 use crate::model::camera::Camera;
 use std::fmt;
 use std::str::FromStr;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::AtomicBool;
 
 /// Largest sample count per pixel accepted (a longer blur is an error).
 pub const MAX_SAMPLES: u32 = 1 << 22;
@@ -139,21 +141,6 @@ impl fmt::Display for Quality {
     }
 }
 
-/// Where the kernel runs.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum Backend {
-    /// The GPU when an adapter exists, else the CPU twin (announced on stderr).
-    #[default]
-    Auto,
-    /// The GPU or an error.
-    Gpu,
-    /// The CPU twin; `threads = None` uses rayon's global pool.
-    Cpu {
-        /// Worker threads.
-        threads: Option<usize>,
-    },
-}
-
 /// One frame to render.
 #[derive(Debug, Clone)]
 pub struct RenderJob {
@@ -219,34 +206,18 @@ pub fn render_frame(job: &RenderJob) -> Result<RenderOutput> {
     let poses = kernel::gpu_poses(&job.trajectory.table(segments));
     let params = kernel::params(cam, &job.target, n, segments as u32, job.seed);
     let tex = kernel::texture_of(&job.target);
-    let cpu = |threads: Option<usize>| {
-        let t = threads.unwrap_or_else(rayon::current_num_threads);
-        (
-            cpu::render(&params, &poses, tex, threads),
-            format!("cpu ({t} threads)"),
-        )
-    };
-    let (rgb, backend_used) = match job.backend {
-        Backend::Cpu { threads } => cpu(threads),
-        Backend::Gpu => {
-            let ctx = crate::gpu::gpu()?;
+    let (rgb, backend_used) = match job.backend.resolve("render", "renderer", &ANNOUNCED)? {
+        Resolved::Gpu(ctx) => (
+            gpu::render(ctx, &params, &poses, tex)?,
+            format!("gpu: {}", ctx.description),
+        ),
+        Resolved::Cpu(threads) => {
+            let t = threads.unwrap_or_else(rayon::current_num_threads);
             (
-                gpu::render(ctx, &params, &poses, tex)?,
-                format!("gpu: {}", ctx.description),
+                cpu::render(&params, &poses, tex, threads),
+                format!("cpu ({t} threads)"),
             )
         }
-        Backend::Auto => match crate::gpu::gpu() {
-            Ok(ctx) => (
-                gpu::render(ctx, &params, &poses, tex)?,
-                format!("gpu: {}", ctx.description),
-            ),
-            Err(e) => {
-                if !ANNOUNCED.swap(true, Ordering::Relaxed) {
-                    eprintln!("render: {e}; using the CPU renderer");
-                }
-                cpu(None)
-            }
-        },
     };
     let maps = job.with_maps.then(|| {
         let steps = ((lmax / 0.25).ceil() as usize).clamp(64, 4096);

@@ -11,22 +11,15 @@
 
 use super::texture::MipTexture;
 use super::trajectory::Pose;
+use crate::board::Board;
 use crate::error::{finite, positive, Error, Result};
 use crate::model::camera::Camera;
 use glam::{DMat3, DVec3};
 use std::path::PathBuf;
 use std::sync::Arc;
 
-/// Linear RGB of the thesis board's red squares.
-pub const BLOB_RED: [f32; 3] = [0.8, 0.03, 0.03];
-/// Linear RGB of the white board (and checker white).
-pub const BOARD_WHITE: [f32; 3] = [1.0, 1.0, 1.0];
 /// Default background (where rays miss the target), linear grey.
 pub const DEFAULT_BACKGROUND: [f32; 3] = [0.25, 0.25, 0.25];
-/// Thesis board at scale 1: square side (m).
-pub const BLOB_SIZE_M: f64 = 0.10;
-/// Thesis board at scale 1: gap between squares (m).
-pub const BLOB_GAP_M: f64 = 0.02;
 
 /// What is painted on the plane.
 #[derive(Debug, Clone, PartialEq)]
@@ -219,20 +212,26 @@ impl Target {
         f.origin + f.e1 * a + f.e2 * b
     }
 
-    /// World coordinates (m) of the 16 blob centres, row by row from the top
+    /// The painted board (`None` unless this is a blob board): the thesis
+    /// board ([`Board::thesis`]) at this target's scale.
+    pub fn board(&self) -> Option<Board> {
+        match self.kind {
+            TargetKind::Blobs { scale } => Some(Board::thesis().scaled(scale)),
+            _ => None,
+        }
+    }
+
+    /// World coordinates (m) of the blob centres, row by row from the top
     /// left (`None` unless this is a blob board).
     pub fn blob_centres(&self) -> Option<Vec<DVec3>> {
-        let TargetKind::Blobs { scale } = self.kind else {
-            return None;
-        };
-        let pitch = (BLOB_SIZE_M + BLOB_GAP_M) * scale;
-        let mut v = Vec::with_capacity(16);
-        for j in 0..4 {
-            for i in 0..4 {
-                v.push(self.point((i as f64 - 1.5) * pitch, (j as f64 - 1.5) * pitch));
-            }
-        }
-        Some(v)
+        let board = self.board()?;
+        Some(
+            board
+                .centres_m()
+                .into_iter()
+                .map(|(a, b)| self.point(a, b))
+                .collect(),
+        )
     }
 
     /// Intersection of the ray through pixel coordinates `(x, y)` (fractional,
