@@ -60,10 +60,12 @@ pub enum Error {
 
 impl Error {
     /// Shorthand for [`Error::Invalid`].
+    /// Messages are cut to [`MAX_MESSAGE`] bytes (a huge bad value is not
+    /// echoed whole).
     pub fn invalid(what: impl Into<String>, message: impl Into<String>) -> Self {
         Error::Invalid {
-            what: what.into(),
-            message: message.into(),
+            what: clip(&what.into(), MAX_MESSAGE),
+            message: clip(&message.into(), MAX_MESSAGE),
         }
     }
 
@@ -74,6 +76,27 @@ impl Error {
             source,
         }
     }
+}
+
+/// Longest message or echoed value kept in an error, bytes.
+pub const MAX_MESSAGE: usize = 512;
+
+/// `s` cut to at most `max` bytes (at a character boundary), with the
+/// original length stated when cut.
+pub fn clip(s: &str, max: usize) -> String {
+    if s.len() <= max {
+        return s.to_string();
+    }
+    let mut end = max;
+    while !s.is_char_boundary(end) {
+        end -= 1;
+    }
+    format!("{}... ({} bytes in all)", &s[..end], s.len())
+}
+
+/// A user's value quoted for an error message: `'value'`, cut to 64 bytes.
+pub fn quote(s: &str) -> String {
+    format!("'{}'", clip(s, 64))
 }
 
 /// Checks that `x` is finite, naming it in the error.

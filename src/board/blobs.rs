@@ -136,7 +136,18 @@ pub fn red_mask(img: &RgbImage, params: &BlobParams) -> Result<(GrayImage, f64)>
 /// Blobs of a binary mask (non-zero = foreground), size-filtered, sorted by
 /// centre (rows of 0.5 px, then x).
 pub fn components(mask: &GrayImage, params: &BlobParams) -> Vec<Blob> {
-    let labels = connected_components(mask, Connectivity::Eight, Luma([0u8]));
+    // imageproc's labelling asserts on images under 2 px a side: pad those
+    // with background on the right and bottom (components do not change).
+    let padded;
+    let labelled = if mask.width() < 2 || mask.height() < 2 {
+        let mut m = GrayImage::new(mask.width().max(2), mask.height().max(2));
+        image::imageops::replace(&mut m, mask, 0, 0);
+        padded = m;
+        &padded
+    } else {
+        mask
+    };
+    let labels = connected_components(labelled, Connectivity::Eight, Luma([0u8]));
     let n = labels.pixels().map(|p| p.0[0]).max().unwrap_or(0) as usize;
     // per label: area, sum x, sum y, bbox
     let mut acc = vec![(0u32, 0.0f64, 0.0f64, u32::MAX, u32::MAX, 0u32, 0u32); n + 1];

@@ -4,7 +4,7 @@ use clap::Args;
 use glam::DVec3;
 use mmbm::error::{Error, Result};
 use mmbm::{Camera, Plane};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// Parses `X,Y,Z` into a vector.
 pub fn parse_vec3(s: &str) -> std::result::Result<DVec3, String> {
@@ -65,10 +65,10 @@ pub struct CameraArgs {
     #[arg(long, value_name = "FILE")]
     pub camera: Option<PathBuf>,
     /// Focal length, mm (overrides the camera file; thesis: 4.2548).
-    #[arg(long, value_name = "MM")]
+    #[arg(allow_negative_numbers = true, long, value_name = "MM")]
     pub focal: Option<f64>,
     /// Square pixel pitch, mm (thesis: 0.00465).
-    #[arg(long, value_name = "MM")]
+    #[arg(allow_negative_numbers = true, long, value_name = "MM")]
     pub pitch: Option<f64>,
     /// Sensor resolution WxH, principal point at the centre (thesis: 640x480).
     #[arg(long, value_name = "WxH", value_parser = parse_resolution)]
@@ -126,5 +126,22 @@ impl SceneArgs {
             return Ok(Some(Plane::fronto(z)));
         }
         Ok(self.plane)
+    }
+}
+
+/// The lower-cased extension of `p` when it is one of `allowed`, else an
+/// error naming the option.
+pub fn check_ext(p: &Path, allowed: &[&str], what: &str) -> Result<String> {
+    let e = p
+        .extension()
+        .map(|e| e.to_string_lossy().to_lowercase())
+        .unwrap_or_default();
+    if allowed.contains(&e.as_str()) {
+        Ok(e)
+    } else {
+        Err(Error::invalid(
+            what,
+            format!("{}: extension must be one of {allowed:?}", p.display()),
+        ))
     }
 }

@@ -40,10 +40,10 @@ pub struct BlobsArgs {
     #[arg(long, value_enum, requires = "distance")]
     pub target: Option<Target>,
     /// Distance of the fronto-parallel board on the optical axis, m.
-    #[arg(long, value_name = "M")]
+    #[arg(allow_negative_numbers = true, long, value_name = "M")]
     pub distance: Option<f64>,
     /// Fixed redness threshold 0..255 (default: adaptive).
-    #[arg(long, value_name = "T")]
+    #[arg(allow_negative_numbers = true, long, value_name = "T")]
     pub threshold: Option<f64>,
     /// Smallest blob kept, pixels.
     #[arg(long, value_name = "PX", default_value_t = 4)]

@@ -34,7 +34,12 @@ pub struct FlowArgs {
     #[arg(long, value_name = "FILE.png")]
     pub quiver: Option<PathBuf>,
     /// Exposure for the quiver arrows, s (arrow = displacement over it).
-    #[arg(long, value_name = "S", default_value_t = 0.07)]
+    #[arg(
+        allow_negative_numbers = true,
+        long,
+        value_name = "S",
+        default_value_t = 0.07
+    )]
     pub exposure: f64,
     #[command(flatten)]
     pub camera: CameraArgs,
@@ -42,6 +47,13 @@ pub struct FlowArgs {
 
 pub fn run(a: FlowArgs) -> Result<()> {
     positive("--exposure (s)", a.exposure)?;
+    // Every output checked before any work.
+    super::args::check_ext(&a.out, &["exr"], "--out")?;
+    mmbm::io::atomic::check_output(&a.out)?;
+    if let Some(q) = &a.quiver {
+        super::args::check_ext(q, &["png"], "--quiver")?;
+        mmbm::io::atomic::check_output(q)?;
+    }
     let scene = Scene {
         camera: a.camera.camera()?,
         plane: a.scene.plane()?,
@@ -50,12 +62,18 @@ pub fn run(a: FlowArgs) -> Result<()> {
     scene.validate_for(&tw)?;
     let f = mmbm::field::flow_field_gpu(&scene, &tw, 0, 0)?;
     let speed = f.speed();
-    mmbm::io::images::write_exr(
-        &a.out,
-        f.width as usize,
-        f.height as usize,
-        &[("flow.u", &f.u), ("flow.v", &f.v), ("flow.speed", &speed)],
-    )?;
+    mmbm::io::atomic::all_or_nothing(|| {
+        mmbm::io::images::write_exr(
+            &a.out,
+            f.width as usize,
+            f.height as usize,
+            &[("flow.u", &f.u), ("flow.v", &f.v), ("flow.speed", &speed)],
+        )?;
+        if let Some(q) = &a.quiver {
+            mmbm::plot::quiver::quiver_png(&scene.camera, &f.u, &f.v, a.exposure, q)?;
+        }
+        Ok(())
+    })?;
     let desc = mmbm::gpu::gpu()
         .map(|c| c.description.clone())
         .unwrap_or_default();
@@ -65,7 +83,6 @@ pub fn run(a: FlowArgs) -> Result<()> {
     );
     println!("wrote {}", a.out.display());
     if let Some(q) = &a.quiver {
-        mmbm::plot::quiver::quiver_png(&scene.camera, &f.u, &f.v, a.exposure, q)?;
         println!("wrote {}", q.display());
     }
     Ok(())

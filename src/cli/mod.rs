@@ -70,6 +70,12 @@ enum Command {
 /// Parses arguments, runs, prints errors; returns the exit code.
 pub fn main() -> i32 {
     let cli = Cli::parse();
+    // Ctrl-C (SIGINT): remove temporary output files, exit 130.
+    let _ = ctrlc::set_handler(|| {
+        let n = mmbm::io::atomic::remove_pending();
+        eprintln!("interrupted; removed {n} temporary file(s)");
+        std::process::exit(130);
+    });
     let r = match cli.command {
         Command::Eval(a) => eval::run(a),
         Command::Series(a) => series::run(a),

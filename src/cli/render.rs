@@ -1,10 +1,11 @@
 //! `mmbm render`: a ground-truth motion-blurred image of a planar target.
 
-use super::args::{parse_vec3, CameraArgs};
+use super::args::{check_ext, parse_vec3, CameraArgs};
 use super::series::GyroArgs;
 use clap::Args;
 use glam::DVec3;
 use mmbm::error::{Error, Result};
+use mmbm::io::atomic::{all_or_nothing, check_output};
 use mmbm::io::images::{write_exr, write_png_linear_rgb};
 use mmbm::render::{self, Backend, Quality, RenderJob, RenderOutput, Target, Trajectory};
 use mmbm::Twist;
@@ -42,19 +43,34 @@ pub struct RenderOpts {
     #[arg(long, value_name = "FILE", requires = "at")]
     pub gyro: Option<PathBuf>,
     /// Exposure start on the log's clock, s (with --gyro).
-    #[arg(long, value_name = "T", allow_hyphen_values = true)]
+    #[arg(
+        allow_negative_numbers = true,
+        long,
+        value_name = "T",
+        allow_hyphen_values = true
+    )]
     pub at: Option<f64>,
     /// Use the log's vx,vy,vz (with --gyro).
     #[arg(long)]
     pub use_velocity: bool,
     /// Exposure time, s.
-    #[arg(long, value_name = "S", allow_hyphen_values = true)]
+    #[arg(
+        allow_negative_numbers = true,
+        long,
+        value_name = "S",
+        allow_hyphen_values = true
+    )]
     pub exposure: f64,
     /// checker:S, blobs[:SCALE] or image:PATH:WIDTH_M.
     #[arg(long, value_name = "SPEC")]
     pub target: String,
     /// Distance of the target plane along the optical axis at exposure start, m.
-    #[arg(long, value_name = "D", allow_hyphen_values = true)]
+    #[arg(
+        allow_negative_numbers = true,
+        long,
+        value_name = "D",
+        allow_hyphen_values = true
+    )]
     pub distance: f64,
     /// Target tilt about its horizontal and vertical axes, degrees.
     #[arg(long, value_name = "AX,AY", allow_hyphen_values = true)]
@@ -63,7 +79,7 @@ pub struct RenderOpts {
     #[arg(long, value_name = "X,Y", allow_hyphen_values = true)]
     pub offset: Option<String>,
     /// Background linear RGB where rays miss the target.
-    #[arg(long, value_name = "R,G,B", value_parser = parse_vec3)]
+    #[arg(allow_hyphen_values = true, long, value_name = "R,G,B", value_parser = parse_vec3)]
     pub background: Option<DVec3>,
     /// Output resolution WxH (keeps focal length and pixel pitch; principal point at the centre).
     #[arg(long, value_name = "WxH", value_parser = super::args::parse_resolution)]
@@ -78,7 +94,7 @@ pub struct RenderOpts {
     #[arg(long, value_name = "FILE")]
     pub sharp: Option<PathBuf>,
     /// Also write the PSF at pixel X,Y (.exr raw weights summing to 1, or .png scaled to its peak).
-    #[arg(long, value_name = "X,Y:FILE")]
+    #[arg(allow_hyphen_values = true, long, value_name = "X,Y:FILE")]
     pub psf: Option<String>,
     /// default, fast, or MIN_SAMPLES:SPACING_PX.
     #[arg(long, default_value = "default")]
@@ -112,21 +128,6 @@ fn pair(s: &str, what: &str) -> Result<[f64; 2]> {
     Ok([v[0], v[1]])
 }
 
-fn check_ext(p: &Path, allowed: &[&str], what: &str) -> Result<String> {
-    let e = p
-        .extension()
-        .map(|e| e.to_string_lossy().to_lowercase())
-        .unwrap_or_default();
-    if allowed.contains(&e.as_str()) {
-        Ok(e)
-    } else {
-        Err(Error::invalid(
-            what,
-            format!("{}: extension must be one of {allowed:?}", p.display()),
-        ))
-    }
-}
-
 fn write_image(p: &Path, o: &RenderOutput) -> Result<()> {
     if check_ext(p, &["exr", "png"], "output")? == "exr" {
         let n = (o.width * o.height) as usize;
@@ -145,13 +146,17 @@ fn write_image(p: &Path, o: &RenderOutput) -> Result<()> {
 
 pub fn run(args: RenderArgs) -> Result<()> {
     let a = *args.opts;
-    // Validate every output name before any work, so nothing is half-written.
+    // Validate every output name and place before any work, so nothing is
+    // half-written; the files then appear all together or not at all.
     check_ext(&a.out, &["exr", "png"], "--out")?;
+    check_output(&a.out)?;
     if let Some(p) = &a.maps {
         check_ext(p, &["exr"], "--maps")?;
+        check_output(p)?;
     }
     if let Some(p) = &a.sharp {
         check_ext(p, &["exr", "png"], "--sharp")?;
+        check_output(p)?;
     }
     let psf = match &a.psf {
         Some(s) => {
@@ -161,6 +166,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
             let [x, y] = pair(xy, "--psf")?;
             let file = PathBuf::from(file);
             check_ext(&file, &["exr", "png"], "--psf")?;
+            check_output(&file)?;
             Some((x, y, file))
         }
         None => None,
@@ -234,37 +240,40 @@ pub fn run(args: RenderArgs) -> Result<()> {
         Some(_) => Some(render::render_sharp(&job)?),
         None => None,
     };
-    write_image(&a.out, &out)?;
-    if let (Some(p), Some(m)) = (&a.maps, &out.maps) {
-        write_exr(
-            p,
-            m.width as usize,
-            m.height as usize,
-            &[
-                ("path_px", &m.path_px),
-                ("disp_px", &m.disp_px),
-                ("speed_px_s", &m.speed_px_s),
-            ],
-        )?;
-        let mm = m.means();
-        eprintln!(
-            "exposure MMBM: mean path {:.3} px, mean displacement {:.3} px, mean speed {:.2} px/s = {:.4} mm/s ({:.1}% of pixels tracked)",
-            mm.path_px, mm.disp_px, mm.speed_px_s, mm.speed_px_s * job.camera.pitch_x_mm, mm.valid * 100.0
-        );
-    }
-    if let (Some(p), Some(s)) = (&a.sharp, &sharp) {
-        write_image(p, s)?;
-    }
-    if let (Some((_, _, p)), Some(k)) = (&psf, &psf_img) {
-        let n = k.size as usize;
-        if check_ext(p, &["exr", "png"], "--psf")? == "exr" {
-            write_exr(p, n, n, &[("psf", &k.weights)])?;
-        } else {
-            let peak = k.weights.iter().cloned().fold(0.0f32, f32::max).max(1e-30);
-            let rgb: Vec<f32> = k.weights.iter().flat_map(|w| [w / peak; 3]).collect();
-            write_png_linear_rgb(p, k.size, k.size, &rgb)?;
+    all_or_nothing(|| {
+        write_image(&a.out, &out)?;
+        if let (Some(p), Some(m)) = (&a.maps, &out.maps) {
+            write_exr(
+                p,
+                m.width as usize,
+                m.height as usize,
+                &[
+                    ("path_px", &m.path_px),
+                    ("disp_px", &m.disp_px),
+                    ("speed_px_s", &m.speed_px_s),
+                ],
+            )?;
+            let mm = m.means();
+            eprintln!(
+                "exposure MMBM: mean path {:.3} px, mean displacement {:.3} px, mean speed {:.2} px/s = {:.4} mm/s ({:.1}% of pixels tracked)",
+                mm.path_px, mm.disp_px, mm.speed_px_s, mm.speed_px_s * job.camera.pitch_x_mm, mm.valid * 100.0
+            );
         }
-    }
+        if let (Some(p), Some(s)) = (&a.sharp, &sharp) {
+            write_image(p, s)?;
+        }
+        if let (Some((_, _, p)), Some(k)) = (&psf, &psf_img) {
+            let n = k.size as usize;
+            if check_ext(p, &["exr", "png"], "--psf")? == "exr" {
+                write_exr(p, n, n, &[("psf", &k.weights)])?;
+            } else {
+                let peak = k.weights.iter().cloned().fold(0.0f32, f32::max).max(1e-30);
+                let rgb: Vec<f32> = k.weights.iter().flat_map(|w| [w / peak; 3]).collect();
+                write_png_linear_rgb(p, k.size, k.size, &rgb)?;
+            }
+        }
+        Ok(())
+    })?;
     eprintln!(
         "{}x{}, {} samples/pixel (max path {:.1} px), {} in {:.2} s",
         out.width,

@@ -21,7 +21,12 @@ pub struct GyroArgs {
     #[arg(long, value_name = "R11,...,R33", allow_hyphen_values = true)]
     pub imu_rotation: Option<String>,
     /// Added to every time stamp, s.
-    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    #[arg(
+        allow_negative_numbers = true,
+        long,
+        default_value_t = 0.0,
+        allow_hyphen_values = true
+    )]
     pub time_offset: f64,
 }
 

@@ -17,10 +17,10 @@ pub struct SimulateArgs {
     #[arg(long, default_value = "moderate")]
     pub gait: String,
     /// Duration, s.
-    #[arg(long, default_value_t = 16.0)]
+    #[arg(allow_negative_numbers = true, long, default_value_t = 16.0)]
     pub duration: f64,
     /// Sample rate, Hz.
-    #[arg(long, default_value_t = 600.0)]
+    #[arg(allow_negative_numbers = true, long, default_value_t = 600.0)]
     pub rate: f64,
     /// Random seed (same seed, same log).
     #[arg(long, default_value_t = 0)]

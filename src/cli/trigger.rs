@@ -32,16 +32,31 @@ pub struct TriggerArgs {
     #[arg(long, required = true)]
     pub policy: Vec<String>,
     /// Exposure t_e, s (thesis: 0.05, 0.07).
-    #[arg(long, value_name = "S")]
+    #[arg(allow_negative_numbers = true, long, value_name = "S")]
     pub exposure: f64,
     /// Trigger delay t_d, s.
-    #[arg(long, value_name = "S", default_value_t = 0.0025)]
+    #[arg(
+        allow_negative_numbers = true,
+        long,
+        value_name = "S",
+        default_value_t = 0.0025
+    )]
     pub delay: f64,
     /// Readout t_r after the exposure, s.
-    #[arg(long, value_name = "S", default_value_t = 0.0125)]
+    #[arg(
+        allow_negative_numbers = true,
+        long,
+        value_name = "S",
+        default_value_t = 0.0125
+    )]
     pub readout: f64,
     /// Minimum interval between MMBM-triggered frames, s.
-    #[arg(long, value_name = "S", default_value_t = 0.2)]
+    #[arg(
+        allow_negative_numbers = true,
+        long,
+        value_name = "S",
+        default_value_t = 0.2
+    )]
     pub min_interval: f64,
     /// Output CSV of frames (default: stdout, unless --summary).
     #[arg(long, value_name = "FILE")]
@@ -66,13 +81,36 @@ pub struct TriggerArgs {
 fn summary_text(frames: &[Frame], spec: &str, duration: f64) -> String {
     let s = trigger::summary_over(frames, duration);
     let t = trigger::prediction_error(frames);
+    // Statistics of no frames are undefined: "n/a", never "NaN".
+    let n = |x: f64, d: usize| {
+        if x.is_finite() {
+            format!("{x:.d$}")
+        } else {
+            "n/a".to_string()
+        }
+    };
     format!(
-        "{spec}: {} frames, {} kept, {:.3} fps over {:.3} s; exposure MMBM mean {:.4} p95 {:.4} max {:.4} mm/s (trigger mean {:.4})\n  \
-         Table 5.1 (exposure - trigger): min {:.4} max {:.4} mean {:.4} abs mean {:.4} std {:.4} mm/s; \
-         % min {:.2} max {:.2} mean {:.2} abs mean {:.2} std {:.2}\n",
-        s.frames, s.kept, s.effective_fps, s.duration_s, s.mean_mm_s, s.p95_mm_s, s.max_mm_s,
-        s.mean_trigger_mm_s, t.abs.min, t.abs.max, t.abs.mean, t.abs.mean_abs, t.abs.std,
-        t.pct.min, t.pct.max, t.pct.mean, t.pct.mean_abs, t.pct.std
+        "{spec}: {} frames, {} kept, {} fps over {} s; exposure MMBM mean {} p95 {} max {} mm/s (trigger mean {})\n  \
+         Table 5.1 (exposure - trigger): min {} max {} mean {} abs mean {} std {} mm/s; \
+         % min {} max {} mean {} abs mean {} std {}\n",
+        s.frames,
+        s.kept,
+        n(s.effective_fps, 3),
+        n(s.duration_s, 3),
+        n(s.mean_mm_s, 4),
+        n(s.p95_mm_s, 4),
+        n(s.max_mm_s, 4),
+        n(s.mean_trigger_mm_s, 4),
+        n(t.abs.min, 4),
+        n(t.abs.max, 4),
+        n(t.abs.mean, 4),
+        n(t.abs.mean_abs, 4),
+        n(t.abs.std, 4),
+        n(t.pct.min, 2),
+        n(t.pct.max, 2),
+        n(t.pct.mean, 2),
+        n(t.pct.mean_abs, 2),
+        n(t.pct.std, 2)
     )
 }
 

@@ -137,6 +137,22 @@ impl ExperimentConfig {
         if self.resolution[0] == 0 || self.resolution[1] == 0 {
             return Err(Error::invalid("resolution", "must be positive"));
         }
+        // The strings, parsed now so that a bad one is reported with its key
+        // before any work.
+        let key = |k: &str, e: Error| Error::invalid(k.to_string(), e.to_string());
+        for p in &self.policies {
+            crate::trigger::parse_policy(p).map_err(|e| key("policies", e))?;
+        }
+        if self.gyro.is_none() {
+            for w in &self.walks {
+                w.parse::<crate::sim::Gait>().map_err(|e| key("walks", e))?;
+            }
+        }
+        self.quality
+            .parse::<crate::render::Quality>()
+            .map_err(|e| key("quality", e))?;
+        crate::render::Target::parse(&self.target, self.start_distance_m)
+            .map_err(|e| key("target", e))?;
         Ok(())
     }
 

@@ -31,7 +31,6 @@ pub fn frames_to_render(frames: &[Frame], max: usize) -> Vec<usize> {
 pub fn run(cfg: &ExperimentConfig, out: &Path, progress: bool) -> Result<Outcome> {
     cfg.validate()?;
     let t_start = Instant::now();
-    std::fs::create_dir_all(out).map_err(|e| Error::io(out, e))?;
     let quality = Quality::from_str(&cfg.quality)?;
     let scene = Scene {
         camera: camera(cfg),
@@ -104,27 +103,37 @@ pub fn run(cfg: &ExperimentConfig, out: &Path, progress: bool) -> Result<Outcome
             }
         }
     }
-    let stats = policy_stats(&walks, &records);
-    let csv = frames_csv(&records);
-    write_atomic(&out.join("frames.csv"), |w| {
-        w.write_all(csv.as_bytes())
-            .map_err(|e| Error::io(out.join("frames.csv"), e))
-    })?;
+    // The outputs appear together or not at all; a directory this run
+    // created is removed again when writing them fails.
+    let created = !out.exists();
+    std::fs::create_dir_all(out).map_err(|e| Error::io(out, e))?;
+    let written = crate::io::atomic::all_or_nothing(|| {
+        let stats = policy_stats(&walks, &records);
+        let csv = frames_csv(&records);
+        write_atomic(&out.join("frames.csv"), |w| {
+            w.write_all(csv.as_bytes())
+                .map_err(|e| Error::io(out.join("frames.csv"), e))
+        })?;
 
-    let figs = figures::write_all(out, cfg, &walks, &records, &extremes)?;
-    let outcome = Outcome {
-        walks,
-        records,
-        stats,
-        seconds: t_start.elapsed().as_secs_f64(),
-        rendered: plan.len(),
-    };
-    let md = report_md(cfg, &outcome, &figs, check);
-    write_atomic(&out.join("report.md"), |w| {
-        w.write_all(md.as_bytes())
-            .map_err(|e| Error::io(out.join("report.md"), e))
-    })?;
-    Ok(outcome)
+        let figs = figures::write_all(out, cfg, &walks, &records, &extremes)?;
+        let outcome = Outcome {
+            walks,
+            records,
+            stats,
+            seconds: t_start.elapsed().as_secs_f64(),
+            rendered: plan.len(),
+        };
+        let md = report_md(cfg, &outcome, &figs, check);
+        write_atomic(&out.join("report.md"), |w| {
+            w.write_all(md.as_bytes())
+                .map_err(|e| Error::io(out.join("report.md"), e))
+        })?;
+        Ok(outcome)
+    });
+    if written.is_err() && created {
+        let _ = std::fs::remove_dir(out);
+    }
+    written
 }
 
 /// Renders the central 160 x 120 window of the most blurred planned frame of

@@ -95,6 +95,16 @@ pub fn flow_field(
             (f.mean_mm_s, f.field)
         }
     };
+    if !mean.is_finite()
+        || field
+            .iter()
+            .any(|x| !(x[0].is_finite() && x[1].is_finite()))
+    {
+        return Err(Error::invalid(
+            "motion",
+            "the flow field overflows f32 (velocities too large for the sensor); nothing written",
+        ));
+    }
     Ok(FlowField {
         width: grid.width,
         height: grid.height,
@@ -118,5 +128,12 @@ pub fn mmbm_gpu(scene: &Scene, tw: &Twist, w: u32, h: u32) -> Result<Mmbm> {
     let g = TwistGpu::new(scene.camera.focal_mm, tw, scene.plane.as_ref());
     let mut r = FlowRunner::new()?;
     let (sums, _) = r.tiles(&grid, &[g], false)?;
-    Ok(to_mmbm(scene, sums[0] / grid.len() as f64, &grid))
+    let mean = sums[0] / grid.len() as f64;
+    if !mean.is_finite() {
+        return Err(Error::invalid(
+            "motion",
+            format!("MMBM is {mean}: the flow overflows f32 on the GPU"),
+        ));
+    }
+    Ok(to_mmbm(scene, mean, &grid))
 }

@@ -1,59 +1,300 @@
-//! Writing outputs atomically: to a temporary file beside the target, renamed
-//! on success, so a failed run never leaves a half-written file.
+//! Writing outputs without ever destroying what an output path points at.
+//!
+//! Where an output goes depends on what the path is ([`Destination`]):
+//! - `-`: standard output;
+//! - a regular file, or a path that does not exist yet: written to a
+//!   temporary file beside it (`.mmbm-*.tmp`), renamed over it on success, so
+//!   a failed run never leaves a half-written file under its final name;
+//! - a symlink: the same, on the file the link points to (the link stays);
+//! - anything else (`/dev/null`, `/dev/stdout`, a FIFO, process substitution
+//!   `>(cmd)`, any path under `/dev/` or `/proc/`): written in place, never
+//!   replaced;
+//! - a directory: an error.
+//!
+//! [`all_or_nothing`] defers the renames of every write made inside it until
+//! all of them succeeded. Temporary files still on disk when the process is
+//! interrupted are removed by [`remove_pending`] (the CLI calls it on Ctrl-C).
 
 use crate::error::{Error, Result};
+use std::cell::RefCell;
+use std::collections::HashSet;
 use std::io::Write;
-use std::path::Path;
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
 
-/// Temp files are created 0600; give the final file the usual 0644.
-fn publish(tmp: tempfile::NamedTempFile, path: &Path) -> Result<()> {
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::PermissionsExt;
-        std::fs::set_permissions(tmp.path(), std::fs::Permissions::from_mode(0o644))
-            .map_err(|e| Error::io(path, e))?;
-    }
-    tmp.persist(path).map_err(|e| Error::io(path, e.error))?;
-    Ok(())
+/// Where an output path leads.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Destination {
+    /// `-`: standard output.
+    Stdout,
+    /// A regular file (existing or new), replaced atomically; for a symlink,
+    /// the file it points to.
+    File(PathBuf),
+    /// Not a regular file (device, FIFO, pipe): written in place.
+    InPlace(PathBuf),
 }
 
-fn temp_beside(path: &Path) -> Result<tempfile::NamedTempFile> {
-    let dir = match path.parent() {
+impl Destination {
+    /// Classifies `path` (see the module docs). Errors for a directory, a
+    /// missing parent directory or an empty path.
+    pub fn of(path: &Path) -> Result<Self> {
+        if path.as_os_str() == "-" {
+            return Ok(Destination::Stdout);
+        }
+        if path.as_os_str().is_empty() {
+            return Err(Error::invalid("output path", "is empty"));
+        }
+        if path.starts_with("/dev") || path.starts_with("/proc") {
+            return Ok(Destination::InPlace(path.to_path_buf()));
+        }
+        let link = std::fs::symlink_metadata(path);
+        let target = match &link {
+            Ok(m) if m.file_type().is_symlink() => match std::fs::canonicalize(path) {
+                Ok(t) => t,
+                // A dangling link: create the file it names.
+                Err(_) => {
+                    let t = std::fs::read_link(path).map_err(|e| Error::io(path, e))?;
+                    match path.parent() {
+                        Some(d) if t.is_relative() => d.join(t),
+                        _ => t,
+                    }
+                }
+            },
+            _ => path.to_path_buf(),
+        };
+        match std::fs::metadata(&target) {
+            Ok(m) if m.is_dir() => Err(Error::io(
+                path,
+                std::io::Error::other("is a directory, expected a file"),
+            )),
+            Ok(m) if m.is_file() => Ok(Destination::File(target)),
+            Ok(_) => Ok(Destination::InPlace(target)),
+            Err(_) => {
+                let dir = parent_dir(&target);
+                match std::fs::metadata(dir) {
+                    Ok(m) if m.is_dir() => Ok(Destination::File(target)),
+                    _ => Err(Error::io(
+                        path,
+                        std::io::Error::new(
+                            std::io::ErrorKind::NotFound,
+                            format!("directory '{}' does not exist", dir.display()),
+                        ),
+                    )),
+                }
+            }
+        }
+    }
+}
+
+/// Checks, before any work, that `path` can take an output: `-`, an
+/// existing non-directory, or a new file in an existing directory.
+pub fn check_output(path: &Path) -> Result<()> {
+    Destination::of(path).map(|_| ())
+}
+
+fn parent_dir(path: &Path) -> &Path {
+    match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
-    };
-    let ext = path
-        .extension()
-        .map(|e| format!(".{}", e.to_string_lossy()))
-        .unwrap_or_default();
-    tempfile::Builder::new()
-        .prefix(".mmbm-")
-        .suffix(&format!(".tmp{ext}"))
-        .tempfile_in(dir)
-        .map_err(|e| Error::io(dir, e))
+    }
 }
 
-/// Runs `write` on a buffered temporary file and renames it to `path` on success.
+/// Temporary files not yet renamed or removed (for [`remove_pending`]).
+static PENDING: Mutex<Option<HashSet<PathBuf>>> = Mutex::new(None);
+
+fn pending(f: impl FnOnce(&mut HashSet<PathBuf>)) {
+    if let Ok(mut g) = PENDING.lock() {
+        f(g.get_or_insert_with(HashSet::new));
+    }
+}
+
+/// Removes every temporary output file this process still has on disk
+/// (called on interrupt); returns how many were removed.
+pub fn remove_pending() -> usize {
+    let paths: Vec<PathBuf> = match PENDING.lock() {
+        Ok(mut g) => g
+            .take()
+            .map(|s| s.into_iter().collect())
+            .unwrap_or_default(),
+        Err(_) => Vec::new(),
+    };
+    paths
+        .iter()
+        .filter(|p| std::fs::remove_file(p).is_ok())
+        .count()
+}
+
+/// A temporary file registered in [`PENDING`] for its lifetime.
+struct Temp {
+    file: Option<tempfile::NamedTempFile>,
+    path: PathBuf,
+}
+
+impl Temp {
+    fn new_in(dir: &Path, ext: &str) -> Result<Self> {
+        let file = tempfile::Builder::new()
+            .prefix(".mmbm-")
+            .suffix(&format!(".tmp{ext}"))
+            .tempfile_in(dir)
+            .map_err(|e| Error::io(dir, e))?;
+        let path = file.path().to_path_buf();
+        pending(|s| {
+            s.insert(path.clone());
+        });
+        Ok(Temp {
+            file: Some(file),
+            path,
+        })
+    }
+
+    fn path(&self) -> &Path {
+        &self.path
+    }
+
+    fn file_mut(&mut self) -> Result<&mut std::fs::File> {
+        self.file
+            .as_mut()
+            .map(|f| f.as_file_mut())
+            .ok_or_else(|| Error::io(&self.path, std::io::Error::other("temporary file closed")))
+    }
+
+    /// Renames onto `path` (permissions 0644 as for any new file).
+    fn publish(mut self, path: &Path) -> Result<()> {
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::PermissionsExt;
+            std::fs::set_permissions(&self.path, std::fs::Permissions::from_mode(0o644))
+                .map_err(|e| Error::io(path, e))?;
+        }
+        match self.file.take() {
+            Some(f) => f
+                .persist(path)
+                .map(|_| ())
+                .map_err(|e| Error::io(path, e.error)),
+            None => Err(Error::io(
+                &self.path,
+                std::io::Error::other("temporary file closed"),
+            )),
+        }
+    }
+}
+
+impl Drop for Temp {
+    fn drop(&mut self) {
+        pending(|s| {
+            s.remove(&self.path);
+        });
+    }
+}
+
+thread_local! {
+    /// Renames deferred by [`all_or_nothing`] on this thread.
+    static DEFERRED: RefCell<Option<Vec<(Temp, PathBuf)>>> = const { RefCell::new(None) };
+}
+
+/// Renames `tmp` onto `path` now, or at the end of the enclosing
+/// [`all_or_nothing`].
+fn finish(tmp: Temp, path: &Path) -> Result<()> {
+    let deferred = DEFERRED.with(|d| {
+        let mut d = d.borrow_mut();
+        match d.as_mut() {
+            Some(list) => {
+                list.push((tmp, path.to_path_buf()));
+                None
+            }
+            None => Some(tmp),
+        }
+    });
+    match deferred {
+        Some(tmp) => tmp.publish(path),
+        None => Ok(()),
+    }
+}
+
+/// Runs `work`; the files it writes to regular-file destinations appear
+/// under their names only if all of it succeeds (otherwise none does).
+/// Writes in place (stdout, devices, pipes) cannot be taken back and happen
+/// as they come.
+pub fn all_or_nothing<T>(work: impl FnOnce() -> Result<T>) -> Result<T> {
+    let outer = DEFERRED.with(|d| d.borrow().is_some());
+    if outer {
+        return work();
+    }
+    DEFERRED.with(|d| *d.borrow_mut() = Some(Vec::new()));
+    let r = work();
+    let list = DEFERRED.with(|d| d.borrow_mut().take()).unwrap_or_default();
+    let v = r?;
+    for (tmp, path) in list {
+        tmp.publish(&path)?;
+    }
+    Ok(v)
+}
+
+fn extension(path: &Path) -> String {
+    path.extension()
+        .map(|e| format!(".{}", e.to_string_lossy()))
+        .unwrap_or_default()
+}
+
+/// Opens a non-regular destination for writing in place (no truncation).
+fn open_in_place(path: &Path) -> Result<std::fs::File> {
+    std::fs::OpenOptions::new()
+        .write(true)
+        .open(path)
+        .map_err(|e| Error::io(path, e))
+}
+
+/// Runs `write` on a buffered writer to `path` (see the module docs for
+/// what each kind of path gets).
 pub fn write_atomic<F>(path: &Path, write: F) -> Result<()>
 where
     F: FnOnce(&mut dyn Write) -> Result<()>,
 {
-    let mut tmp = temp_beside(path)?;
-    {
-        let mut w = std::io::BufWriter::with_capacity(1 << 16, tmp.as_file_mut());
-        write(&mut w)?;
-        w.flush().map_err(|e| Error::io(path, e))?;
+    match Destination::of(path)? {
+        Destination::Stdout => {
+            let out = std::io::stdout();
+            let mut w = std::io::BufWriter::with_capacity(1 << 16, out.lock());
+            write(&mut w)?;
+            w.flush().map_err(|e| Error::io("<stdout>", e))
+        }
+        Destination::InPlace(p) => {
+            let mut f = open_in_place(&p)?;
+            let mut w = std::io::BufWriter::with_capacity(1 << 16, &mut f);
+            write(&mut w)?;
+            w.flush().map_err(|e| Error::io(&p, e))
+        }
+        Destination::File(p) => {
+            let mut tmp = Temp::new_in(parent_dir(&p), &extension(&p))?;
+            {
+                let mut w = std::io::BufWriter::with_capacity(1 << 16, tmp.file_mut()?);
+                write(&mut w)?;
+                w.flush().map_err(|e| Error::io(&p, e))?;
+            }
+            finish(tmp, &p)
+        }
     }
-    publish(tmp, path)
 }
 
-/// For encoders that write to a path (EXR, PNG): `write` gets a temporary path
-/// with the same extension, renamed to `path` on success.
+/// For encoders that write to a path (EXR, PNG): `write` gets a temporary
+/// path with the same extension; its bytes then go to `path` as
+/// [`write_atomic`] would send them.
 pub fn write_atomic_path<F>(path: &Path, write: F) -> Result<()>
 where
     F: FnOnce(&Path) -> Result<()>,
 {
-    let tmp = temp_beside(path)?;
-    write(tmp.path())?;
-    publish(tmp, path)
+    match Destination::of(path)? {
+        Destination::File(p) => {
+            let tmp = Temp::new_in(parent_dir(&p), &extension(&p))?;
+            write(tmp.path())?;
+            finish(tmp, &p)
+        }
+        _ => {
+            let tmp = Temp::new_in(&std::env::temp_dir(), &extension(path))?;
+            write(tmp.path())?;
+            let bytes = std::fs::read(tmp.path()).map_err(|e| Error::io(tmp.path(), e))?;
+            write_atomic(path, |w| {
+                w.write_all(&bytes).map_err(|e| Error::io(path, e))
+            })
+        }
+    }
 }

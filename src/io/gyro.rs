@@ -9,7 +9,7 @@ use crate::error::{Error, Result};
 use glam::{DMat3, DVec3};
 use serde::{Deserialize, Serialize};
 use std::fs::File;
-use std::io::BufReader;
+use std::io::{BufReader, Read};
 use std::path::{Path, PathBuf};
 use std::str::FromStr;
 
@@ -154,7 +154,7 @@ pub struct GyroSample {
 /// Streaming, validating reader of a gyro CSV.
 pub struct GyroReader {
     path: PathBuf,
-    reader: csv::Reader<BufReader<File>>,
+    reader: csv::Reader<BufReader<Box<dyn Read + Send>>>,
     opts: GyroOptions,
     idx_t: usize,
     idx_w: [usize; 3],
@@ -171,9 +171,17 @@ pub struct GyroReader {
 }
 
 impl GyroReader {
-    /// Opens `path` and checks the header.
+    /// Opens `path` (`-`: standard input, named `<stdin>` in errors) and
+    /// checks the header.
     pub fn open(path: &Path, opts: GyroOptions) -> Result<Self> {
-        let file = File::open(path).map_err(|e| Error::io(path, e))?;
+        let (file, path): (Box<dyn Read + Send>, &Path) = if path.as_os_str() == "-" {
+            (Box::new(std::io::stdin()), Path::new("<stdin>"))
+        } else {
+            (
+                Box::new(File::open(path).map_err(|e| Error::io(path, e))?),
+                path,
+            )
+        };
         let mut reader = csv::ReaderBuilder::new()
             .comment(Some(b'#'))
             .trim(csv::Trim::All)
@@ -184,6 +192,16 @@ impl GyroReader {
             .map_err(|e| csv_error(path, &e, "header"))?
             .clone();
         let names: Vec<String> = headers.iter().map(|s| s.to_string()).collect();
+        for n in ["t", "wx", "wy", "wz", "vx", "vy", "vz", "depth"] {
+            if names.iter().filter(|h| *h == n).count() > 1 {
+                return Err(Error::Parse {
+                    path: path.into(),
+                    line: 1,
+                    column: n.into(),
+                    message: format!("column '{n}' appears more than once in the header"),
+                });
+            }
+        }
         let find = |n: &str| names.iter().position(|h| h == n);
         let need = |n: &str| {
             find(n).ok_or_else(|| Error::Parse {
@@ -240,6 +258,13 @@ impl GyroReader {
         self.idx_depth.is_some()
     }
 
+    /// Prints [`GyroReader::warnings`] on stderr, one `warning: ...` line each.
+    pub fn print_warnings(&self) {
+        for w in &self.warnings {
+            eprintln!("warning: {w}");
+        }
+    }
+
     /// Warnings so far (gaps much longer than the median interval), at most 20 kept.
     pub fn warnings(&self) -> &[String] {
         &self.warnings
@@ -257,14 +282,14 @@ impl GyroReader {
             path: self.path.clone(),
             line,
             column: col.clone(),
-            message: format!("'{s}' is not a number"),
+            message: format!("{} is not a number", crate::error::quote(s)),
         })?;
         if !x.is_finite() {
             return Err(Error::Parse {
                 path: self.path.clone(),
                 line,
                 column: col.clone(),
-                message: format!("'{s}' is not finite"),
+                message: format!("{} is not finite", crate::error::quote(s)),
             });
         }
         Ok(x)
@@ -407,9 +432,13 @@ fn csv_error(path: &Path, e: &csv::Error, what: &str) -> Error {
     }
 }
 
-/// Reads a whole log into memory (for windows and policies that need random access).
+/// Reads a whole log into memory (for windows and policies that need random
+/// access). Its warnings (gaps) are printed on stderr as `warning: ...`.
 pub fn read_log(path: &Path, opts: GyroOptions) -> Result<Vec<GyroSample>> {
-    GyroReader::open(path, opts)?.collect()
+    let mut r = GyroReader::open(path, opts)?;
+    let samples = r.by_ref().collect::<Result<Vec<_>>>()?;
+    r.print_warnings();
+    Ok(samples)
 }
 
 #[cfg(test)]

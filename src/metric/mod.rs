@@ -78,13 +78,14 @@ fn parse_dims(s: &str, what: &str) -> Result<(u32, u32)> {
 impl FromStr for Method {
     type Err = Error;
 
-    /// Parses `riemann[:NUxNV]`, `gauss[:N|:NUxNV]`, `exact[:TOL]`, `gpu[:WxH]`.
+    /// Parses `riemann[:NUxNV]`, `gauss[:N|:NUxNV]`, `exact[:TOL]`, `gpu[:WxH]`
+    /// (grid rules within [`MAX_GRID_POINTS`] and [`MAX_GAUSS_NODES`]).
     fn from_str(s: &str) -> Result<Self> {
         let (name, arg) = match s.split_once(':') {
             Some((n, a)) => (n, Some(a)),
             None => (s, None),
         };
-        match (name.trim().to_ascii_lowercase().as_str(), arg) {
+        let m = match (name.trim().to_ascii_lowercase().as_str(), arg) {
             ("riemann", None) => Ok(Method::default()),
             ("riemann", Some(a)) => {
                 let (nu, nv) = parse_dims(a, "grid")?;
@@ -132,9 +133,31 @@ impl FromStr for Method {
                 "method",
                 format!("'{s}': expected riemann[:NUxNV], gauss[:N], exact[:TOL] or gpu[:WxH]"),
             )),
+        }?;
+        let too_big = |what: String| {
+            Err(Error::invalid(
+                "method",
+                format!("'{s}': {what} (limits: riemann and gauss at most {MAX_GRID_POINTS} points, gauss at most {MAX_GAUSS_NODES} nodes per side)"),
+            ))
+        };
+        match m {
+            Method::Riemann { nu, nv } | Method::Gauss { nu, nv }
+                if nu as u64 * nv as u64 > MAX_GRID_POINTS =>
+            {
+                too_big(format!("{nu} x {nv} = {} points", nu as u64 * nv as u64))
+            }
+            Method::Gauss { nu, nv } if nu.max(nv) > MAX_GAUSS_NODES => {
+                too_big(format!("{} nodes on one side", nu.max(nv)))
+            }
+            m => Ok(m),
         }
     }
 }
+
+/// Most points of a `riemann` or `gauss` rule (memory and time grow with it).
+pub const MAX_GRID_POINTS: u64 = 1 << 20;
+/// Most Gauss-Legendre nodes along one side (their computation is quadratic).
+pub const MAX_GAUSS_NODES: u32 = 1024;
 
 impl fmt::Display for Method {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
@@ -224,6 +247,12 @@ pub fn mmbm_poly(cam: &Camera, poly: &FlowPoly, method: Method) -> Result<Mmbm> 
             ))
         }
     };
+    if !mm_s.is_finite() {
+        return Err(Error::invalid(
+            "motion",
+            format!("MMBM is {mm_s}: the flow overflows f64 (a velocity near 1e308?)"),
+        ));
+    }
     Ok(Mmbm {
         mm_s,
         px_s: mm_s / cam.pitch_x_mm,

@@ -37,6 +37,11 @@ use std::fmt;
 use std::str::FromStr;
 use std::sync::atomic::AtomicBool;
 
+/// Most pixels of a rendered frame (memory: about 24 bytes each with maps).
+pub const MAX_PIXELS: u64 = 1 << 26;
+/// Most pixel-samples of one frame (work).
+pub const MAX_PIXEL_SAMPLES: u64 = 1 << 40;
+
 /// Largest sample count per pixel accepted (a longer blur is an error).
 pub const MAX_SAMPLES: u32 = 1 << 22;
 
@@ -200,8 +205,35 @@ static ANNOUNCED: AtomicBool = AtomicBool::new(false);
 pub fn render_frame(job: &RenderJob) -> Result<RenderOutput> {
     let cam = &job.camera;
     job.target.validate_for(cam)?;
+    // The camera must stay in front of the target for the whole exposure.
+    let f = job.target.frame();
+    let check = job.trajectory.table(1024);
+    if let Some(k) = check
+        .iter()
+        .position(|p| !(f.normal.dot(f.origin - p.1) > 0.0))
+    {
+        let t = job.trajectory.duration() * k as f64 / (check.len().max(2) - 1) as f64;
+        return Err(Error::invalid(
+            "motion",
+            format!(
+                "the camera reaches the target plane {t:.6} s into the exposure; \
+                 shorten the exposure or start farther away"
+            ),
+        ));
+    }
     let lmax = maps::max_path_px(cam, &job.target, &job.trajectory);
     let n = job.quality.samples_for(lmax)?;
+    let pixels = cam.width as u64 * cam.height as u64;
+    if pixels > MAX_PIXELS || pixels * n as u64 > MAX_PIXEL_SAMPLES {
+        return Err(Error::invalid(
+            "resolution",
+            format!(
+                "{}x{} pixels x {n} samples: the renderer takes at most {MAX_PIXELS} pixels \
+                 and {MAX_PIXEL_SAMPLES} pixel-samples per frame",
+                cam.width, cam.height
+            ),
+        ));
+    }
     let segments = ((lmax / 0.02).ceil() as usize).clamp(256, 1 << 16);
     let poses = kernel::gpu_poses(&job.trajectory.table(segments));
     let params = kernel::params(cam, &job.target, n, segments as u32, job.seed);

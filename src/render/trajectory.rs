@@ -135,10 +135,25 @@ impl Trajectory {
                 ));
             }
         }
-        let dt_min = samples
+        // A gap in the log inside the window: no motion is known there.
+        let intervals: Vec<f64> = samples.windows(2).map(|w| w[1].t - w[0].t).collect();
+        let median = crate::stats::percentile(&intervals, 50.0).unwrap_or(0.0);
+        if let Some(w) = samples
             .windows(2)
-            .map(|w| w[1].t - w[0].t)
-            .fold(f64::INFINITY, f64::min);
+            .find(|w| w[1].t > t0 && w[0].t < t1 && w[1].t - w[0].t > 5.0 * median)
+        {
+            return Err(Error::invalid(
+                "exposure window",
+                format!(
+                    "[{t0}, {t1}] s spans a gap in the gyro log: no sample between t = {} s and {} s \
+                     ({:.6} s; the median interval is {median:.6} s), so the motion there is unknown",
+                    w[0].t,
+                    w[1].t,
+                    w[1].t - w[0].t
+                ),
+            ));
+        }
+        let dt_min = intervals.iter().copied().fold(f64::INFINITY, f64::min);
         let n = ((duration / dt_min * 16.0).ceil() as usize).clamp(512, 1 << 20);
         let h = duration / n as f64;
         let interp = |t: f64| -> (DVec3, DVec3) {

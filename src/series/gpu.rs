@@ -32,6 +32,8 @@ pub fn series_evaluator(opts: SeriesOptions, w: u32, h: u32) -> Result<Box<Batch
             return Ok(Vec::new());
         }
         let twists = batch_twists(batch, &opts)?;
-        runner.batch_means(&grid, &twists)
+        let v = runner.batch_means(&grid, &twists)?;
+        super::check_values(batch, &v)?;
+        Ok(v)
     }))
 }

@@ -69,6 +69,18 @@ pub fn sample_scene(s: &GyroSample, opts: &SeriesOptions) -> Result<(Twist, Scen
     Ok((tw, scene))
 }
 
+/// Checks that every value of a batch is a finite MMBM (an overflow of huge
+/// rates gives inf or NaN), naming the first bad sample.
+pub fn check_values(batch: &[GyroSample], values: &[f64]) -> Result<()> {
+    match batch.iter().zip(values).find(|(_, m)| !m.is_finite()) {
+        Some((s, m)) => Err(Error::invalid(
+            format!("sample at t = {} s", s.t),
+            format!("MMBM is {m}: the flow overflows (rates near the float range?)"),
+        )),
+        None => Ok(()),
+    }
+}
+
 /// Evaluates a batch of samples on the CPU (rayon), mm/s per sample.
 pub fn eval_batch_cpu(batch: &[GyroSample], opts: &SeriesOptions) -> Result<Vec<f64>> {
     let ev = Evaluator::new(&opts.scene.camera, opts.method)?;
@@ -79,7 +91,8 @@ pub fn eval_batch_cpu(batch: &[GyroSample], opts: &SeriesOptions) -> Result<Vec<
             let (tw, scene) = sample_scene(s, opts)?;
             Ok(ev.mean_speed(&scene.flow_poly(&tw)))
         })
-        .collect()
+        .collect::<Result<Vec<f64>>>()
+        .and_then(|v| check_values(batch, &v).map(|_| v))
 }
 
 /// The rotation-only MMBM (mm/s) of every sample, the thesis's metric, with
@@ -139,6 +152,7 @@ pub fn run<W: Write>(reader: GyroReader, eval: &mut BatchFn, pitch_mm: f64, out:
                 };
                 // A closed channel means the consumer failed: just stop.
                 if tx.send(msg).is_err() || done {
+                    reader.print_warnings();
                     return;
                 }
             }

@@ -58,6 +58,9 @@ mod gen;
 
 pub use gen::{simulate, write_log, LOG_HEADER};
 
+/// Highest step rate of a gait, steps/s (legged gaits take a few).
+pub const MAX_STEP_HZ: f64 = 100.0;
+
 use crate::error::{Error, Result};
 use serde::{Deserialize, Serialize};
 use std::fmt;
@@ -204,6 +207,12 @@ impl GaitConfig {
         };
         nonneg("speed_m_s", self.speed_m_s)?;
         crate::error::positive("step_hz", self.step_hz)?;
+        if self.step_hz > MAX_STEP_HZ {
+            return Err(Error::invalid(
+                "step_hz",
+                format!("must be <= {MAX_STEP_HZ} steps/s, got {}", self.step_hz),
+            ));
+        }
         nonneg("touchdown_jitter", self.touchdown_jitter)?;
         if self.touchdown_jitter > 0.15 {
             return Err(Error::invalid(

@@ -31,13 +31,28 @@ pub(crate) fn parse_pos(s: &str, what: &str, spec: &str) -> Result<f64> {
     Ok(x)
 }
 
+/// Highest frame rate a policy accepts, frames/s.
+pub const MAX_FPS: f64 = 1000.0;
+
+/// A frame rate in `(0, MAX_FPS]`.
+fn parse_fps(s: &str, what: &str, spec: &str) -> Result<f64> {
+    let fps = parse_pos(s, what, spec)?;
+    if fps > MAX_FPS {
+        return Err(Error::invalid(
+            "policy",
+            format!("'{spec}': {what} {fps} is above the limit of {MAX_FPS} frames/s"),
+        ));
+    }
+    Ok(fps)
+}
+
 /// Parses `FPS[@PHASE]`.
 pub(crate) fn parse_rate(s: &str, spec: &str) -> Result<(f64, f64)> {
     let (f, p) = match s.split_once('@') {
         Some((f, p)) => (f, parse_num(p, "phase", spec)?),
         None => (s, 0.0),
     };
-    let fps = parse_pos(f, "frame rate", spec)?;
+    let fps = parse_fps(f, "frame rate", spec)?;
     if p < 0.0 {
         return Err(Error::invalid(
             "policy",
@@ -69,7 +84,7 @@ pub fn parse_policy(spec: &str) -> Result<Box<dyn Policy>> {
         ("adaptive", [x, f]) => Box::new(Adaptive::new(
             spec,
             level(x)?,
-            parse_pos(f, "target frame rate", spec)?,
+            parse_fps(f, "target frame rate", spec)?,
         )),
         ("oracle", [x]) => Box::new(Oracle::new(spec, level(x)?, 0.2)),
         ("oracle", [x, h]) => {
@@ -86,10 +101,10 @@ pub fn parse_policy(spec: &str) -> Result<Box<dyn Policy>> {
             let (fps, phase) = parse_rate(r, spec)?;
             Box::new(Gate::new(spec, level(x)?, fps, phase))
         }
-        ("deadline", [f]) => Box::new(Deadline::new(spec, parse_pos(f, "frame rate", spec)?, None)),
+        ("deadline", [f]) => Box::new(Deadline::new(spec, parse_fps(f, "frame rate", spec)?, None)),
         ("deadline", [f, x]) => Box::new(Deadline::new(
             spec,
-            parse_pos(f, "frame rate", spec)?,
+            parse_fps(f, "frame rate", spec)?,
             Some(level(x)?),
         )),
         ("fixed" | "threshold" | "adaptive" | "oracle" | "forecast" | "gate" | "deadline", _) => {

@@ -28,6 +28,12 @@ impl Schedule {
         if now < self.slot(t0, self.k) {
             return false;
         }
+        // Jump near the first slot after `now` (a long gap or a high rate
+        // passes many slots), then settle on it exactly.
+        let guess = ((now - t0 - self.phase) * self.fps).floor();
+        if guess.is_finite() && guess > self.k as f64 + 2.0 {
+            self.k = (guess as u64).saturating_sub(1);
+        }
         while self.slot(t0, self.k) <= now {
             self.k += 1;
         }
