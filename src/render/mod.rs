@@ -208,10 +208,9 @@ pub fn render_frame(job: &RenderJob) -> Result<RenderOutput> {
     // The camera must stay in front of the target for the whole exposure.
     let f = job.target.frame();
     let check = job.trajectory.table(1024);
-    if let Some(k) = check
-        .iter()
-        .position(|p| !(f.normal.dot(f.origin - p.1) > 0.0))
-    {
+    if let Some(k) = check.iter().position(|p| {
+        f.normal.dot(f.origin - p.1).partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater)
+    }) {
         let t = job.trajectory.duration() * k as f64 / (check.len().max(2) - 1) as f64;
         return Err(Error::invalid(
             "motion",
