@@ -92,13 +92,27 @@ fn bad_config_is_a_clear_error() {
     std::fs::write(&p, "duration_s = -1\n").unwrap();
     let e = ExperimentConfig::load(&p).unwrap_err().to_string();
     assert!(e.contains("bad.toml") && e.contains("duration_s"), "{e}");
+    // A bad value is reported when the file is loaded, naming the file,
+    // the key and the value (before any work).
     std::fs::write(&p, "walks = [\"moonwalk\"]\n").unwrap();
-    let cfg = ExperimentConfig::load(&p).unwrap();
-    let e = match experiment::run(&cfg, d.path(), false) {
+    let e = ExperimentConfig::load(&p).unwrap_err().to_string();
+    assert!(
+        e.contains("bad.toml") && e.contains("walks") && e.contains("moonwalk"),
+        "{e}"
+    );
+    // A configuration built in code is checked by run, and a failed run
+    // leaves no output directory behind.
+    let cfg = ExperimentConfig {
+        walks: vec!["moonwalk".into()],
+        ..ExperimentConfig::default()
+    };
+    let out = d.path().join("never");
+    let e = match experiment::run(&cfg, &out, false) {
         Err(e) => e.to_string(),
         Ok(_) => panic!("moonwalk accepted"),
     };
     assert!(e.contains("moonwalk"), "{e}");
+    assert!(!out.exists(), "a failed run left {}", out.display());
     std::fs::write(&p, "unknown_key = 1\n").unwrap();
     assert!(ExperimentConfig::load(&p)
         .unwrap_err()
