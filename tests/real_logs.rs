@@ -3,23 +3,14 @@
 //! matches the figures printed in `../shared/data/README.md` (computed
 //! independently of this project: thesis camera, 8x6 grid, mm/s).
 
+mod common;
+
 use mmbm::io::gyro::{read_log, GyroOptions};
 use mmbm::metric::{Evaluator, Method, Scene};
 use std::path::PathBuf;
 
 fn data(name: &str) -> Option<PathBuf> {
-    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/data")
-        .join(name)
-        .join("gyro.csv");
-    if p.exists() {
-        return Some(p);
-    }
-    if std::env::var("MMBM_REQUIRE_DATA").is_ok_and(|v| v == "1") {
-        panic!("MMBM_REQUIRE_DATA=1 but {} is missing", p.display());
-    }
-    eprintln!("SKIPPED: {} not found", p.display());
-    None
+    common::shared_log(name)
 }
 
 fn median_and_max(name: &str) -> Option<(f64, f64, usize)> {

@@ -145,3 +145,44 @@ pub fn check_ext(p: &Path, allowed: &[&str], what: &str) -> Result<String> {
         ))
     }
 }
+
+/// The trigger timing options besides the exposure (`trigger`, `live`).
+#[derive(Args, Debug, Clone)]
+pub struct TimingArgs {
+    /// Trigger delay t_d, s.
+    #[arg(
+        allow_negative_numbers = true,
+        long,
+        value_name = "S",
+        default_value_t = 0.0025
+    )]
+    pub delay: f64,
+    /// Readout t_r after the exposure, s.
+    #[arg(
+        allow_negative_numbers = true,
+        long,
+        value_name = "S",
+        default_value_t = 0.0125
+    )]
+    pub readout: f64,
+    /// Minimum interval between MMBM-triggered frames, s.
+    #[arg(
+        allow_negative_numbers = true,
+        long,
+        value_name = "S",
+        default_value_t = 0.2
+    )]
+    pub min_interval: f64,
+}
+
+impl TimingArgs {
+    /// The camera timing with exposure `exposure` (s); validated by its users.
+    pub fn timing(&self, exposure: f64) -> mmbm::trigger::CameraTiming {
+        mmbm::trigger::CameraTiming {
+            delay: self.delay,
+            exposure,
+            readout: self.readout,
+            min_interval: self.min_interval,
+        }
+    }
+}

@@ -9,6 +9,7 @@ mod eval;
 mod experiment;
 mod flow;
 mod info;
+mod live;
 mod render;
 mod series;
 mod simulate;
@@ -65,6 +66,8 @@ enum Command {
     Experiment(experiment::ExperimentArgs),
     /// The experiment with built-in defaults (the README's first command).
     Demo(demo::DemoArgs),
+    /// Trigger decisions in real time from an IMU stream (stdin, UDP, replay).
+    Live(live::LiveArgs),
 }
 
 /// Parses arguments, runs, prints errors; returns the exit code.
@@ -72,6 +75,7 @@ pub fn main() -> i32 {
     let cli = Cli::parse();
     // Ctrl-C (SIGINT): remove temporary output files, exit 130.
     let _ = ctrlc::set_handler(|| {
+        live::on_interrupt();
         let n = mmbm::io::atomic::remove_pending();
         eprintln!("interrupted; removed {n} temporary file(s)");
         std::process::exit(130);
@@ -90,6 +94,7 @@ pub fn main() -> i32 {
         Command::Blobs(a) => blobs::run(a),
         Command::Experiment(a) => experiment::run(a),
         Command::Demo(a) => demo::run(a),
+        Command::Live(a) => live::run(a),
     };
     match r {
         Ok(()) => 0,

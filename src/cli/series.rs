@@ -28,6 +28,11 @@ pub struct GyroArgs {
         allow_hyphen_values = true
     )]
     pub time_offset: f64,
+    /// ROS 2 MCAP log (.mcap): the topic of sensor_msgs/msg/Imu messages
+    /// (default: the only IMU topic). Time from header.stamp, rad/s; the
+    /// IMU-to-camera frame is --imu-rotation (/tf is not read).
+    #[arg(long, value_name = "TOPIC")]
+    pub topic: Option<String>,
 }
 
 impl GyroArgs {
@@ -40,6 +45,7 @@ impl GyroArgs {
                 None => glam::DMat3::IDENTITY,
             },
             time_offset: mmbm::error::finite("--time-offset", self.time_offset)?,
+            topic: self.topic.clone(),
         })
     }
 }

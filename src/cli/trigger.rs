@@ -1,12 +1,12 @@
 //! `mmbm trigger`: run trigger policies on a gyro log.
 
-use super::args::{CameraArgs, SceneArgs};
+use super::args::{CameraArgs, SceneArgs, TimingArgs};
 use super::series::GyroArgs;
 use clap::Args;
 use mmbm::error::{Error, Result};
 use mmbm::io::gyro::read_log;
 use mmbm::series::SeriesOptions;
-use mmbm::trigger::{self, CameraTiming, Frame};
+use mmbm::trigger::{self, Frame};
 use mmbm::{Method, Scene};
 use std::io::Write;
 use std::path::PathBuf;
@@ -34,30 +34,8 @@ pub struct TriggerArgs {
     /// Exposure t_e, s (thesis: 0.05, 0.07).
     #[arg(allow_negative_numbers = true, long, value_name = "S")]
     pub exposure: f64,
-    /// Trigger delay t_d, s.
-    #[arg(
-        allow_negative_numbers = true,
-        long,
-        value_name = "S",
-        default_value_t = 0.0025
-    )]
-    pub delay: f64,
-    /// Readout t_r after the exposure, s.
-    #[arg(
-        allow_negative_numbers = true,
-        long,
-        value_name = "S",
-        default_value_t = 0.0125
-    )]
-    pub readout: f64,
-    /// Minimum interval between MMBM-triggered frames, s.
-    #[arg(
-        allow_negative_numbers = true,
-        long,
-        value_name = "S",
-        default_value_t = 0.2
-    )]
-    pub min_interval: f64,
+    #[command(flatten)]
+    pub timing: TimingArgs,
     /// Output CSV of frames (default: stdout, unless --summary).
     #[arg(long, value_name = "FILE")]
     pub out: Option<PathBuf>,
@@ -119,12 +97,7 @@ pub fn run(a: TriggerArgs) -> Result<()> {
     if matches!(method, Method::Gpu { .. }) {
         return Err(Error::invalid("--method", "trigger uses a CPU method"));
     }
-    let timing = CameraTiming {
-        delay: a.delay,
-        exposure: a.exposure,
-        readout: a.readout,
-        min_interval: a.min_interval,
-    };
+    let timing = a.timing.timing(a.exposure);
     timing.validate()?;
     let mut policies = Vec::new();
     for p in &a.policy {

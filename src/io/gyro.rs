@@ -82,7 +82,7 @@ impl FromStr for AngleUnit {
 }
 
 /// How to turn the file's columns into camera-frame samples.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct GyroOptions {
     /// Unit of `t`.
     pub time_unit: TimeUnit,
@@ -92,6 +92,9 @@ pub struct GyroOptions {
     pub imu_to_camera: DMat3,
     /// Added to every time stamp after unit conversion, s (camera clock = IMU clock + offset).
     pub time_offset: f64,
+    /// MCAP input: the topic of `sensor_msgs/msg/Imu` messages (None: the
+    /// only such topic in the file).
+    pub topic: Option<String>,
 }
 
 impl Default for GyroOptions {
@@ -101,6 +104,25 @@ impl Default for GyroOptions {
             angle_unit: AngleUnit::Rad,
             imu_to_camera: DMat3::IDENTITY,
             time_offset: 0.0,
+            topic: None,
+        }
+    }
+}
+
+impl GyroOptions {
+    /// A sample from raw column values in the log's units: `t` converted and
+    /// offset, `w` converted to rad/s, `w` and `v` rotated into the camera
+    /// frame (the same arithmetic as [`GyroReader`]).
+    pub fn sample(&self, t: f64, w: DVec3, v: Option<DVec3>, depth: Option<f64>) -> GyroSample {
+        let k = match self.angle_unit {
+            AngleUnit::Rad => 1.0,
+            AngleUnit::Deg => std::f64::consts::PI / 180.0,
+        };
+        GyroSample {
+            t: t * self.time_unit.seconds() + self.time_offset,
+            omega: self.imu_to_camera * (w * k),
+            velocity: v.map(|v| self.imu_to_camera * v),
+            depth,
         }
     }
 }
@@ -176,6 +198,19 @@ impl GyroReader {
     pub fn open(path: &Path, opts: GyroOptions) -> Result<Self> {
         let (file, path): (Box<dyn Read + Send>, &Path) = if path.as_os_str() == "-" {
             (Box::new(std::io::stdin()), Path::new("<stdin>"))
+        } else if super::mcap::is_mcap(path) {
+            if opts.time_unit != TimeUnit::S || opts.angle_unit != AngleUnit::Rad {
+                return Err(Error::invalid(
+                    path.display().to_string(),
+                    "an MCAP log holds ROS units (s, rad/s): leave --time-unit and --angle-unit at their defaults",
+                ));
+            }
+            // The messages become CSV text so that they pass the same
+            // checks (order, gaps) and options (rotation, offset) as a CSV
+            // log; a line number in an error is the message number + 1.
+            let messages = super::mcap::read_imu(path, opts.topic.as_deref())?;
+            let text = super::mcap::to_csv(&messages).into_bytes();
+            (Box::new(std::io::Cursor::new(text)), path)
         } else {
             (
                 Box::new(File::open(path).map_err(|e| Error::io(path, e))?),

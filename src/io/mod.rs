@@ -1,7 +1,10 @@
 //! Files in and out: atomic output ([`atomic`]: temp file + rename), image
 //! files ([`images`]: EXR, sRGB PNG, textures) and gyro log readers
-//! ([`gyro`]). This layer imports nothing above `error`.
+//! ([`gyro`]: CSV, and ROS 2 MCAP through [`mcap`]; [`lines`]: one line at a
+//! time, for live streams). This layer imports nothing above `error`.
 
 pub mod atomic;
 pub mod gyro;
 pub mod images;
+pub mod lines;
+pub mod mcap;

@@ -41,6 +41,7 @@
 //! | `gate:X[:FPS[@PHASE]]` | `fixed` (default 5 fps), frames whose exposure MMBM is above `X` marked not kept |
 //! | `deadline:FPS[:X]` | one frame per fixed-rate slot at the best causal instant (see [`Deadline`]) |
 
+mod live;
 mod parse;
 mod policy;
 mod predict;
@@ -49,6 +50,7 @@ mod run;
 mod stats;
 mod timing;
 
+pub use live::{Event, Live};
 pub use parse::parse_policy;
 pub use policy::{Level, LogView, Observation, Policy};
 pub use predict::{Forecast, Oracle};

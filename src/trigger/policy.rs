@@ -19,11 +19,14 @@ pub struct LogView<'a> {
 /// What a policy sees at the decision sample `i`: nothing after it.
 #[derive(Debug, Clone, Copy)]
 pub struct Observation<'a> {
-    /// Index of the decision sample.
+    /// Index of the decision sample (counted from the log's first sample).
     pub i: usize,
-    /// Sample times `0..=i`, s.
+    /// Time of the log's first sample, s.
+    pub t0: f64,
+    /// Times of recent samples ending with the decision sample, s: the whole
+    /// log up to it offline, at least the last [`Observation::RECENT`] live.
     pub t: &'a [f64],
-    /// MMBM of samples `0..=i`, mm/s.
+    /// MMBM of the same samples as `t`, mm/s.
     pub mmbm: &'a [f64],
     /// True when a pulse sent now would find the camera free.
     pub camera_free: bool,
@@ -36,9 +39,22 @@ pub struct Observation<'a> {
 }
 
 impl Observation<'_> {
+    /// The fewest recent samples an observation holds (where the log has them).
+    pub const RECENT: usize = 16;
+
     /// The decision time `t_i`, s.
     pub fn now(&self) -> f64 {
         self.t[self.t.len() - 1]
+    }
+
+    /// MMBM at the decision sample, mm/s.
+    pub fn current(&self) -> f64 {
+        self.mmbm[self.mmbm.len() - 1]
+    }
+
+    /// Time of the sample before the decision sample, s.
+    pub fn previous_time(&self) -> Option<f64> {
+        self.t.len().checked_sub(2).map(|k| self.t[k])
     }
 
     /// True when no frame was triggered yet or the minimum interval has passed.

@@ -241,13 +241,19 @@ impl Policy for Forecast {
         Ok(())
     }
     fn decide(&mut self, obs: &Observation) -> bool {
-        for k in self.hist.len()..=obs.i {
+        let last = self.hist.last_time().unwrap_or(f64::NEG_INFINITY);
+        let new = obs.t.partition_point(|&s| s <= last);
+        for k in new..obs.t.len() {
             self.hist.push(obs.t[k], obs.mmbm[k]);
         }
+        // The forecast looks back at most WINDOW (period estimate) or a
+        // period plus the slack (< WINDOW): older samples are dropped, so
+        // memory stays constant on an endless stream.
+        self.hist.trim_before(obs.now() - Self::WINDOW - 1.0);
         if !(obs.camera_free && obs.interval_passed()) {
             return false;
         }
-        let (t0, now) = (obs.t[0], obs.now());
+        let (t0, now) = (obs.t0, obs.now());
         if now - self.estimated_at >= Self::REESTIMATE {
             self.period = self.estimate_period(t0, now);
             self.estimated_at = now;

@@ -23,7 +23,7 @@ impl Schedule {
     /// True at the first sample at or after the pending slot; slots at or
     /// before `now` are then consumed (also when the camera is busy: skipped).
     fn due(&mut self, obs: &Observation) -> bool {
-        let t0 = obs.t[0];
+        let t0 = obs.t0;
         let now = obs.now();
         if now < self.slot(t0, self.k) {
             return false;
@@ -177,7 +177,7 @@ impl Policy for Adaptive {
     }
     fn decide(&mut self, obs: &Observation) -> bool {
         let now = obs.now();
-        let m = obs.mmbm[obs.i];
+        let m = obs.current();
         // Sliding minimum over the window (monotone deque).
         while self.mins.back().is_some_and(|&(_, v)| v >= m) {
             self.mins.pop_back();
@@ -199,7 +199,7 @@ impl Policy for Adaptive {
         }
         let recent_min = self.mins.front().map_or(m, |&(_, v)| v);
         let mut thr = self.x.max(Self::SCALE * recent_min);
-        if now - obs.t[0] >= Self::WINDOW {
+        if now - obs.t0 >= Self::WINDOW {
             let achieved = self.triggers.len() as f64 / Self::WINDOW;
             let deficit = (1.0 - achieved / self.target_fps).max(0.0);
             thr *= 1.0 + Self::GAIN * deficit;
@@ -306,7 +306,7 @@ impl Policy for Deadline {
         Ok(())
     }
     fn decide(&mut self, obs: &Observation) -> bool {
-        let t0 = obs.t[0];
+        let t0 = obs.t0;
         let now = obs.now();
         let period = 1.0 / self.fps;
         let mut slot = ((now - t0) * self.fps).floor() as i64;
@@ -321,7 +321,7 @@ impl Policy for Deadline {
         }
         let start = t0 + slot as f64 * period;
         let end = start + period;
-        let m = obs.mmbm[obs.i];
+        let m = obs.current();
         let observing = self.level.is_none() && now < start + period / std::f64::consts::E;
         if observing {
             self.obs_min = self.obs_min.min(m);
@@ -329,11 +329,7 @@ impl Policy for Deadline {
         if self.taken || !obs.camera_free {
             return false;
         }
-        let dt = if obs.i > 0 {
-            now - obs.t[obs.i - 1]
-        } else {
-            0.0
-        };
+        let dt = obs.previous_time().map_or(0.0, |p| now - p);
         let deadline = now + 1.5 * dt >= end;
         let good = match self.level {
             Some(_) => thesis_rule(obs.mmbm, self.x),

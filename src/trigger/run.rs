@@ -70,6 +70,7 @@ pub fn run(
         let camera_free = start >= free_at;
         let obs = Observation {
             i,
+            t0: t[0],
             t: &t[..=i],
             mmbm: &mmbm_mm_s[..=i],
             camera_free,

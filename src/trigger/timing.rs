@@ -104,6 +104,24 @@ impl Integral {
         self.cum.push(c);
     }
 
+    /// Time of the last sample, s.
+    pub fn last_time(&self) -> Option<f64> {
+        self.t.last().copied()
+    }
+
+    /// Forgets samples before `t` (s), keeping the last one at or before it,
+    /// so means over windows from `t` on are unchanged (bit for bit: the
+    /// running integral is kept as it was). Drops in bulk, once at least half
+    /// of the samples are stale: amortised O(1) per sample.
+    pub fn trim_before(&mut self, t: f64) {
+        let j = self.t.partition_point(|&s| s <= t).saturating_sub(1);
+        if j > 0 && 2 * j >= self.t.len() {
+            self.t.drain(..j);
+            self.m.drain(..j);
+            self.cum.drain(..j);
+        }
+    }
+
     /// Number of samples.
     pub fn len(&self) -> usize {
         self.t.len()
