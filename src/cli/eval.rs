@@ -23,6 +23,7 @@ pub struct EvalArgs {
     #[command(flatten)]
     pub scene: SceneArgs,
     /// riemann[:NUxNV] (default 8x6), gauss[:N|:NUxNV], exact[:TOL] (default 1e-9), gpu[:WxH].
+    /// Limits: 1,048,576 grid points, 1024 Gauss nodes per side.
     #[arg(long, default_value = "riemann:8x6")]
     pub method: String,
     /// Print one JSON object instead of text.

@@ -54,6 +54,7 @@ pub struct LiveArgs {
     #[command(flatten)]
     pub timing: TimingArgs,
     /// CPU metric: riemann[:NUxNV], gauss[:N] or exact[:TOL].
+    /// Limits: 1,048,576 grid points, 1024 Gauss nodes per side.
     #[arg(long, default_value = "riemann:8x6")]
     pub method: String,
     /// Include the samples' vx,vy,vz (needs depth, --depth or --plane).
@@ -118,14 +119,15 @@ impl Latency {
         self.max_ns = self.max_ns.max(ns);
     }
 
-    /// Upper edge (us) of the bucket holding the `q` quantile.
+    /// Upper edge (us) of the bucket holding the `q` quantile (at most the maximum).
     fn quantile_us(&self, q: f64) -> f64 {
         let need = ((q * self.n as f64).ceil() as u64).max(1);
         let mut cum = 0;
         for (b, &c) in self.buckets.iter().enumerate() {
             cum += c;
             if cum >= need {
-                return 2f64.powf((b + 1) as f64 / Self::PER_OCTAVE) / 1e3;
+                let edge = 2f64.powf((b + 1) as f64 / Self::PER_OCTAVE);
+                return edge.min(self.max_ns as f64) / 1e3;
             }
         }
         self.max_ns as f64 / 1e3

@@ -82,6 +82,7 @@ pub struct RenderOpts {
     #[arg(allow_hyphen_values = true, long, value_name = "R,G,B", value_parser = parse_vec3)]
     pub background: Option<DVec3>,
     /// Output resolution WxH (keeps focal length and pixel pitch; principal point at the centre).
+    /// Limits: 2^26 pixels, 2^40 pixel-samples per frame.
     #[arg(long, value_name = "WxH", value_parser = super::args::parse_resolution)]
     pub resolution: Option<(u32, u32)>,
     /// Output image: .exr (linear float R,G,B) or .png (sRGB 8-bit).

@@ -61,6 +61,7 @@ pub struct SeriesArgs {
     #[arg(long, value_name = "FILE")]
     pub gyro: PathBuf,
     /// riemann[:NUxNV], gauss[:N], exact[:TOL] or gpu[:WxH].
+    /// Limits: 1,048,576 grid points, 1024 Gauss nodes per side.
     #[arg(long, default_value = "riemann:8x6")]
     pub method: String,
     /// Output CSV (default: stdout).

@@ -16,10 +16,10 @@ pub struct SimulateArgs {
     /// slow (0.085 m/s), moderate (0.17 m/s) or fast (0.53 m/s).
     #[arg(long, default_value = "moderate")]
     pub gait: String,
-    /// Duration, s.
+    /// Duration, s (at most 1e8 samples in all).
     #[arg(allow_negative_numbers = true, long, default_value_t = 16.0)]
     pub duration: f64,
-    /// Sample rate, Hz.
+    /// Sample rate, Hz (a config's step_hz: at most 100 steps/s).
     #[arg(allow_negative_numbers = true, long, default_value_t = 600.0)]
     pub rate: f64,
     /// Random seed (same seed, same log).

@@ -14,7 +14,7 @@ use std::path::PathBuf;
 /// Run trigger policies on a gyro log: CSV of frames, summary.
 #[derive(Args, Debug)]
 #[command(
-    after_help = "Policies (X in mm/s, or pNN = NN-th percentile of the log's MMBM):
+    after_help = "Policies (X in mm/s, or pNN = NN-th percentile of the log's MMBM; FPS at most 1000):
   fixed:FPS[@PHASE]  threshold:X  adaptive[:X[:FPS]]  oracle:X[:H]  forecast:X[:H]
   gate:X[:FPS[@PHASE]]  deadline:FPS[:X]
 
@@ -43,6 +43,7 @@ pub struct TriggerArgs {
     #[arg(long)]
     pub summary: bool,
     /// MMBM method (CPU): riemann[:NUxNV], gauss[:N], exact[:TOL].
+    /// Limits: 1,048,576 grid points, 1024 Gauss nodes per side.
     #[arg(long, default_value = "riemann:8x6")]
     pub method: String,
     /// Include the log's vx,vy,vz (needs a depth column, --depth or --plane).

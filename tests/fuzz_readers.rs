@@ -1,0 +1,164 @@
+//! Property tests of every reader of user files: random bytes and random
+//! mutations (replaced, inserted and deleted bytes) of valid files give a
+//! value or an error, never a panic; an error names the file.
+
+use mmbm::experiment::ExperimentConfig;
+use mmbm::io::gyro::{read_log, GyroOptions};
+use mmbm::io::lines::LineParser;
+use mmbm::sim::{Gait, GaitConfig};
+use mmbm::Camera;
+use proptest::prelude::*;
+use std::path::{Path, PathBuf};
+
+fn fixture(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(name)
+}
+
+const GYRO: &str = "# a comment\nt,wx,wy,wz,vx,vy,vz,depth\n0,0.1,-0.2,0.3,0,0,0.1,2\n\
+0.01,0.1,-0.2,0.31,0,0,0.1,2\n0.02,0.12,-0.2,0.3,0,0,0.1,2\n0.03,0.1,-0.25,0.3,0,0,0.1,2\n";
+const CAMERA: &str =
+    "focal_mm = 4.2548\npitch_mm = 0.00465\nwidth = 640\nheight = 480\ncx = 320\ncy = 240\n";
+const GAIT: &str = "speed_m_s = 0.2\nstep_hz = 1.5\nsway = [0.1, 0.05, 0.1]\nnoise_std = 0.002\n";
+const EXPERIMENT: &str =
+    "walks = [\"moderate\"]\nduration_s = 4.0\npolicies = [\"fixed:5\", \"threshold:0.4\"]\n\
+exposure_s = 0.07\ntarget = \"blobs\"\nresolution = [64, 48]\nquality = \"fast\"\n";
+
+/// A valid file with some bytes replaced, inserted or deleted.
+fn mutated(valid: Vec<u8>) -> impl Strategy<Value = Vec<u8>> {
+    let n = valid.len();
+    prop::collection::vec((0..3u8, 0..n.max(1), any::<u8>()), 1..8).prop_map(move |edits| {
+        let mut b = valid.clone();
+        for (kind, at, byte) in edits {
+            let at = at.min(b.len());
+            match kind {
+                0 if at < b.len() => b[at] = byte,
+                1 => b.insert(at, byte),
+                _ if at < b.len() => {
+                    b.remove(at);
+                }
+                _ => b.push(byte),
+            }
+        }
+        b
+    })
+}
+
+/// Random bytes, or a mutation of `valid`.
+fn inputs(valid: &[u8]) -> impl Strategy<Value = Vec<u8>> {
+    prop_oneof![
+        prop::collection::vec(any::<u8>(), 0..300),
+        mutated(valid.to_vec()),
+    ]
+}
+
+fn write(dir: &Path, name: &str, bytes: &[u8]) -> PathBuf {
+    let p = dir.join(name);
+    std::fs::write(&p, bytes).unwrap();
+    p
+}
+
+/// An error must name the file it is about.
+fn names_file<T>(r: mmbm::Result<T>, name: &str) -> std::result::Result<(), TestCaseError> {
+    if let Err(e) = r {
+        let msg = e.to_string();
+        prop_assert!(msg.contains(name), "error does not name {name}: {msg}");
+    }
+    Ok(())
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 200, failure_persistence: None, ..ProptestConfig::default() })]
+
+    #[test]
+    fn gyro_csv(bytes in inputs(GYRO.as_bytes())) {
+        let d = tempfile::tempdir().unwrap();
+        let p = write(d.path(), "log.csv", &bytes);
+        names_file(read_log(&p, GyroOptions::default()), "log.csv")?;
+    }
+
+    #[test]
+    fn gyro_lines(bytes in inputs(GYRO.as_bytes())) {
+        let mut parser = LineParser::new(GyroOptions::default(), "<stdin>");
+        for (k, line) in String::from_utf8_lossy(&bytes).lines().enumerate() {
+            if let Err(e) = parser.parse(line, k as u64 + 1) {
+                prop_assert!(e.to_string().contains(&format!("<stdin>:{}:", k + 1)), "{e}");
+            }
+        }
+    }
+
+    #[test]
+    fn camera_toml(bytes in inputs(CAMERA.as_bytes())) {
+        let d = tempfile::tempdir().unwrap();
+        let p = write(d.path(), "cam.toml", &bytes);
+        names_file(Camera::load(&p), "cam.toml")?;
+        let p = write(d.path(), "cam.json", &bytes);
+        names_file(Camera::load(&p), "cam.json")?;
+    }
+
+    #[test]
+    fn gait_toml(bytes in inputs(GAIT.as_bytes())) {
+        let d = tempfile::tempdir().unwrap();
+        let p = write(d.path(), "gait.toml", &bytes);
+        names_file(GaitConfig::load(&p, Gait::Moderate), "gait.toml")?;
+    }
+
+    #[test]
+    fn experiment_toml(bytes in inputs(EXPERIMENT.as_bytes())) {
+        let d = tempfile::tempdir().unwrap();
+        let p = write(d.path(), "exp.toml", &bytes);
+        names_file(ExperimentConfig::load(&p), "exp.toml")?;
+    }
+
+    #[test]
+    fn images(bytes in inputs(&std::fs::read(fixture("tests/fixtures/bars.png")).unwrap())) {
+        let d = tempfile::tempdir().unwrap();
+        let p = write(d.path(), "img.png", &bytes);
+        names_file(mmbm::io::images::read_rgb8(&p), "img.png")?;
+        names_file(mmbm::assess::load_grey(&p), "img.png")?;
+        names_file(mmbm::render::texture::MipTexture::load(&p), "img.png")?;
+        let p = write(d.path(), "img.exr", &bytes);
+        names_file(mmbm::io::images::read_exr(&p), "img.exr")?;
+    }
+}
+
+/// Valid EXR bytes mutated (the PNG strategy above rarely makes a valid EXR header).
+#[test]
+fn exr_mutations() {
+    let d = tempfile::tempdir().unwrap();
+    let src = d.path().join("f.exr");
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_mmbm"))
+        .args([
+            "render",
+            "--omega",
+            "0.1,0.2,0.3",
+            "--exposure",
+            "0.02",
+            "--backend",
+            "cpu",
+        ])
+        .args([
+            "--target",
+            "checker:0.02",
+            "--distance",
+            "1",
+            "--resolution",
+            "16x12",
+            "--out",
+        ])
+        .arg(&src)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let valid = std::fs::read(&src).unwrap();
+    let mut runner = proptest::test_runner::TestRunner::new(ProptestConfig {
+        cases: 200,
+        failure_persistence: None,
+        ..ProptestConfig::default()
+    });
+    runner
+        .run(&mutated(valid), |bytes| {
+            let p = write(d.path(), "m.exr", &bytes);
+            names_file(mmbm::io::images::read_exr(&p), "m.exr")
+        })
+        .unwrap();
+}
