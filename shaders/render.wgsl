@@ -1,36 +1,47 @@
 // Ground-truth motion-blur renderer (mmbm::render). One invocation per pixel;
 // for each of the pixel's samples k in [k0, k1) of a rank-1 lattice in
-// (x, y, t) with a per-pixel Cranley-Patterson shift: interpolate the camera
-// pose at time t from the pose table, intersect the ray through (x, y) with
-// the target plane, evaluate the target (procedural checker / blob board, or a
+// (x, y, t) with a per-pixel Cranley-Patterson shift in x and y:
+// map the sample point through the homography of its instant (pixel to
+// target-plane coordinates, one table entry per instant, computed on the
+// host), evaluate the target (procedural checker / blob board, or a
 // mip-mapped linear-light image), and accumulate into out_rgb (sums; the host
-// divides by N). Registers only, no barriers (barriers are slow on lavapipe).
-// CPU twin: src/render/cpu.rs. Layouts: src/render/kernel.rs.
+// divides by N). Pixels outside the target's bounding box over the exposure
+// add the background without sampling. Registers only, no barriers (barriers
+// are slow on lavapipe). CPU twin: src/render/cpu.rs. Layouts:
+// src/render/kernel.rs.
+//
+// Entry points: `main` supersamples area and time (any target; the only one
+// for images); `analytic` (checker and blob board) takes one sample per
+// instant at the pixel centre and integrates the pixel's area in closed form:
+// the footprint is the parallelogram that the affine part of the homography
+// makes of the pixel square, and the target is averaged over the
+// footprint's marginal distributions along its two axes (each a trapezoid,
+// the sum of two uniform variables), taken as independent. That is exact for
+// footprints aligned with the target's axes and, in general, wherever one
+// edge crosses the footprint; it is approximate only where two edges do (a
+// corner inside a pixel). Formulas and their derivation: src/render/cpu.rs.
 
 struct Params {
-    cam: vec4<f32>,        // fx, fy, cx, cy (px)
-    cam2: vec4<f32>,       // skew, 1/sqrt(fx fy), LOD scale, 0
-    origin: vec4<f32>,     // plane origin (m), n.O
-    e1: vec4<f32>,
-    e2: vec4<f32>,
-    normal: vec4<f32>,
     background: vec4<f32>,
     tex: vec4<f32>,
     colour_a: vec4<f32>,
     colour_b: vec4<f32>,
+    lod: vec4<f32>,        // LOD_SCALE, 1/N, 0, 0
     dims: vec4<u32>,       // width, height, kind, N
-    lattice: vec4<u32>,    // g1, g2, K, seed
+    lattice: vec4<u32>,    // g1, g2, 0, seed
     range: vec4<u32>,      // row0, k0, k1, (k0 g1) mod N
     range2: vec4<u32>,     // (k0 g2) mod N, rows, 0, 0
+    bbox: vec4<u32>,       // x0, y0, x1, y1 (end exclusive)
 }
 
-struct Pose {
-    q: vec4<f32>,
-    c: vec4<f32>,
+struct Homography {
+    h0: vec4<f32>,
+    h1: vec4<f32>,
+    h2: vec4<f32>,         // row 2, |det H|
 }
 
 @group(0) @binding(0) var<uniform> P: Params;
-@group(0) @binding(1) var<storage, read> poses: array<Pose>;
+@group(0) @binding(1) var<storage, read> homs: array<Homography>;
 @group(0) @binding(2) var<storage, read> texels: array<f32>;
 @group(0) @binding(3) var<storage, read> levels: array<vec4<u32>>;
 @group(0) @binding(4) var<storage, read_write> out_rgb: array<vec4<f32>>;
@@ -43,12 +54,6 @@ fn pcg(v: u32) -> u32 {
 
 fn unit(h: u32) -> f32 {
     return f32(h >> 8u) * (1.0 / 16777216.0);
-}
-
-fn rotate(q: vec4<f32>, v: vec3<f32>) -> vec3<f32> {
-    let u = q.xyz;
-    let t = cross(u, v) + v * q.w;
-    return v + 2.0 * cross(u, t);
 }
 
 fn texel(l: u32, x: u32, y: u32) -> vec3<f32> {
@@ -85,24 +90,19 @@ fn trilinear(u: f32, v: f32, lod_in: f32) -> vec3<f32> {
     return a + (b - a) * f;
 }
 
-fn shade(q: vec4<f32>, c: vec3<f32>, px: f32, py: f32) -> vec3<f32> {
+fn shade(h: Homography, px: f32, py: f32) -> vec3<f32> {
     let bg = P.background.xyz;
-    let yc = (py - P.cam.w) / P.cam.y;
-    let dc = vec3<f32>((px - P.cam.z - P.cam2.x * yc) / P.cam.x, yc, 1.0);
-    let dw = rotate(q, dc);
-    let n = P.normal.xyz;
-    let den = dot(n, dw);
-    let s = (P.origin.w - dot(n, c)) / den;
-    if (abs(den) < 1e-12 || !(s > 0.0)) {
+    let w = h.h2.x * px + h.h2.y * py + h.h2.z;
+    if (!(w > 0.0)) {
         return bg;
     }
-    let d = c + dw * s - P.origin.xyz;
-    let a = dot(d, P.e1.xyz);
-    let b = dot(d, P.e2.xyz);
+    let r = 1.0 / w;
+    let a = (h.h0.x * px + h.h0.y * py + h.h0.z) * r;
+    let b = (h.h1.x * px + h.h1.y * py + h.h1.z) * r;
     let kind = P.dims.z;
     if (kind == 0u) {
-        let sz = P.tex.x;
-        let k = i32(floor(a / sz)) + i32(floor(b / sz));
+        let inv_sz = P.tex.y;
+        let k = i32(floor(a * inv_sz)) + i32(floor(b * inv_sz));
         return vec3<f32>(select(0.0, 1.0, (k & 1) == 0));
     }
     if (kind == 1u) {
@@ -112,8 +112,9 @@ fn shade(q: vec4<f32>, c: vec3<f32>, px: f32, py: f32) -> vec3<f32> {
         if (abs(a) > half || abs(b) > half) {
             return bg;
         }
-        let ca = (clamp(floor(a / pitch + 2.0), 0.0, 3.0) - 1.5) * pitch;
-        let cb = (clamp(floor(b / pitch + 2.0), 0.0, 3.0) - 1.5) * pitch;
+        let inv_pitch = P.tex.w;
+        let ca = (clamp(floor(a * inv_pitch + 2.0), 0.0, 3.0) - 1.5) * pitch;
+        let cb = (clamp(floor(b * inv_pitch + 2.0), 0.0, 3.0) - 1.5) * pitch;
         if (abs(a - ca) <= 0.5 * sq && abs(b - cb) <= 0.5 * sq) {
             return P.colour_a.xyz;
         }
@@ -124,10 +125,9 @@ fn shade(q: vec4<f32>, c: vec3<f32>, px: f32, py: f32) -> vec3<f32> {
     if (u < 0.0 || u > 1.0 || v < 0.0 || v > 1.0) {
         return bg;
     }
-    let len = length(dw);
-    let cosv = abs(den) / len;
-    let tx = s * len * P.cam2.y / sqrt(cosv) * P.tex.z;
-    let lod = log2(max(tx * P.cam2.z, 1.0));
+    // Footprint side (m) = sqrt(|det H| / w^3); in texels of level 0.
+    let tx = sqrt(h.h2.w * r * r * r) * P.tex.z;
+    let lod = log2(max(tx * P.lod.x, 1.0));
     return trilinear(u, v, lod);
 }
 
@@ -140,31 +140,28 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     let n = P.dims.w;
-    let nf = f32(n);
+    let o = j * w + i;
+    let count = P.range.z - P.range.y;
+    if (i < P.bbox.x || j < P.bbox.y || i >= P.bbox.z || j >= P.bbox.w) {
+        out_rgb[o] = out_rgb[o] + vec4<f32>(P.background.xyz * f32(count), 0.0);
+        return;
+    }
     let g1 = P.lattice.x;
     let g2 = P.lattice.y;
-    let segs = P.lattice.z;
     let h1 = pcg(i + pcg(j + pcg(P.lattice.w)));
     let h2 = pcg(h1);
-    let h3 = pcg(h2);
     let shx = unit(h1);
     let shy = unit(h2);
-    let sht = unit(h3);
+    let inv_n = P.lod.y;
     var xi = P.range.w;
     var yi = P.range2.x;
     var acc = vec3<f32>(0.0);
+    let fi = f32(i);
+    let fj = f32(j);
     for (var k = P.range.y; k < P.range.z; k = k + 1u) {
-        let sx = fract(f32(xi) / nf + shx);
-        let sy = fract(f32(yi) / nf + shy);
-        let st = fract(f32(k) / nf + sht);
-        let tt = st * f32(segs);
-        let idx = min(u32(tt), segs - 1u);
-        let f = tt - f32(idx);
-        let pa = poses[idx];
-        let pb = poses[idx + 1u];
-        let q = normalize(mix(pa.q, pb.q, f));
-        let c = mix(pa.c.xyz, pb.c.xyz, f);
-        acc = acc + shade(q, c, f32(i) + sx, f32(j) + sy);
+        let sx = fract(f32(xi) * inv_n + shx);
+        let sy = fract(f32(yi) * inv_n + shy);
+        acc = acc + shade(homs[k], fi + sx, fj + sy);
         xi = xi + g1;
         if (xi >= n) {
             xi = xi - n;
@@ -174,6 +171,155 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
             yi = yi - n;
         }
     }
+    out_rgb[o] = out_rgb[o] + vec4<f32>(acc, 0.0);
+}
+
+// ---- analytic area integration (twin: src/render/cpu.rs, same names) ----
+
+// Feature-relative width below which a footprint is a point.
+const TINY: f32 = 0.001;
+
+// Integral from 0 of the square wave s (+1 on [0, S), -1 on [S, 2S), period
+// 2S): a triangle wave in [0, S].
+fn tri(x: f32, sz: f32) -> f32 {
+    let y = x - floor(x / (2.0 * sz)) * (2.0 * sz);
+    return select(2.0 * sz - y, y, y < sz);
+}
+
+// Integral from 0 of tri, for y in [0, 4S).
+fn tri_int(y: f32, sz: f32) -> f32 {
+    let per = floor(y / (2.0 * sz));
+    let r = y - per * 2.0 * sz;
+    var v = 0.5 * r * r;
+    if (r >= sz) {
+        v = 0.5 * sz * sz + 2.0 * sz * (r - sz) - 0.5 * (r * r - sz * sz);
+    }
+    return per * sz * sz + v;
+}
+
+// Mean of tri over [c - q, c + q].
+fn tri_mean(c: f32, q: f32, sz: f32) -> f32 {
+    if (q < TINY * sz) {
+        return tri(c, sz);
+    }
+    if (q < 0.25 * sz) {
+        // One kink at most: the nearest multiple of S (slope change +2 at
+        // even multiples, -2 at odd ones).
+        let k = round(c / sz);
+        let d = abs(c - k * sz);
+        var m = tri(c, sz);
+        if (d < q) {
+            let delta = select(-2.0, 2.0, (i32(k) & 1) == 0);
+            m = m + delta * (q - d) * (q - d) / (4.0 * q);
+        }
+        return m;
+    }
+    let base = floor((c - q) / (2.0 * sz)) * (2.0 * sz);
+    return (tri_int(c + q - base, sz) - tri_int(c - q - base, sz)) / (2.0 * q);
+}
+
+// Mean of the square wave s over x + U(-p, p) + U(-q, q), p >= q.
+fn square_mean(x: f32, p: f32, q: f32, sz: f32) -> f32 {
+    if (p < TINY * sz) {
+        let k = i32(floor(x / sz));
+        return select(-1.0, 1.0, (k & 1) == 0);
+    }
+    return (tri_mean(x + p, q, sz) - tri_mean(x - p, q, sz)) / (2.0 * p);
+}
+
+// Mean of max(c, 0) over [c - q, c + q].
+fn ramp_mean(c: f32, q: f32, tiny: f32) -> f32 {
+    var m = max(c, 0.0);
+    if (q >= tiny && abs(c) < q) {
+        m = m + (q - abs(c)) * (q - abs(c)) / (4.0 * q);
+    }
+    return m;
+}
+
+// P(U(-p, p) + U(-q, q) <= x), p >= q.
+fn trap_cdf(x: f32, p: f32, q: f32, tiny: f32) -> f32 {
+    if (x >= p + q) {
+        return 1.0;
+    }
+    if (x <= -(p + q)) {
+        return 0.0;
+    }
+    if (p < tiny) {
+        return select(0.0, 1.0, x >= 0.0);
+    }
+    return clamp((ramp_mean(x + p, q, tiny) - ramp_mean(x - p, q, tiny)) / (2.0 * p), 0.0, 1.0);
+}
+
+// P(lo <= c + U(-p, p) + U(-q, q) <= hi).
+fn trap_in(lo: f32, hi: f32, c: f32, p: f32, q: f32, tiny: f32) -> f32 {
+    return trap_cdf(hi - c, p, q, tiny) - trap_cdf(lo - c, p, q, tiny);
+}
+
+// Board and blob-column (or row) coverage along one axis: (board, blobs).
+fn board_axis(c: f32, p: f32, q: f32) -> vec2<f32> {
+    let sq = P.tex.x;
+    let pitch = P.tex.y;
+    let half = P.tex.z;
+    let tiny = TINY * sq;
+    let board = trap_in(-half, half, c, p, q, tiny);
+    var blobs = 0.0;
+    for (var k = 0; k < 4; k = k + 1) {
+        let cc = (f32(k) - 1.5) * pitch;
+        blobs = blobs + trap_in(cc - 0.5 * sq, cc + 0.5 * sq, c, p, q, tiny);
+    }
+    return vec2<f32>(board, blobs);
+}
+
+// The target averaged over the footprint of pixel centre (px, py) at one instant.
+fn footprint_mean(h: Homography, px: f32, py: f32) -> vec3<f32> {
+    let bg = P.background.xyz;
+    let w = h.h2.x * px + h.h2.y * py + h.h2.z;
+    if (!(w > 0.0)) {
+        return bg;
+    }
+    let r = 1.0 / w;
+    let a = (h.h0.x * px + h.h0.y * py + h.h0.z) * r;
+    let b = (h.h1.x * px + h.h1.y * py + h.h1.z) * r;
+    // Half-widths of the footprint's extent along a and b (affine part of H).
+    let dax = abs((h.h0.x - a * h.h2.x) * r);
+    let day = abs((h.h0.y - a * h.h2.y) * r);
+    let dbx = abs((h.h1.x - b * h.h2.x) * r);
+    let dby = abs((h.h1.y - b * h.h2.y) * r);
+    let pa = 0.5 * max(dax, day);
+    let qa = 0.5 * min(dax, day);
+    let pb = 0.5 * max(dbx, dby);
+    let qb = 0.5 * min(dbx, dby);
+    if (P.dims.z == 0u) {
+        let sz = P.tex.x;
+        let m = square_mean(a, pa, qa, sz) * square_mean(b, pb, qb, sz);
+        return vec3<f32>(0.5 + 0.5 * m);
+    }
+    let ca = board_axis(a, pa, qa);
+    let cb = board_axis(b, pb, qb);
+    let white = P.colour_b.xyz;
+    let red = P.colour_a.xyz;
+    return bg + (white - bg) * (ca.x * cb.x) + (red - white) * (ca.y * cb.y);
+}
+
+@compute @workgroup_size(8, 8, 1)
+fn analytic(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let w = P.dims.x;
+    let i = gid.x;
+    let j = gid.y + P.range.x;
+    if (i >= w || gid.y >= P.range2.y || j >= P.dims.y) {
+        return;
+    }
     let o = j * w + i;
+    let count = P.range.z - P.range.y;
+    if (i < P.bbox.x || j < P.bbox.y || i >= P.bbox.z || j >= P.bbox.w) {
+        out_rgb[o] = out_rgb[o] + vec4<f32>(P.background.xyz * f32(count), 0.0);
+        return;
+    }
+    let px = f32(i) + 0.5;
+    let py = f32(j) + 0.5;
+    var acc = vec3<f32>(0.0);
+    for (var k = P.range.y; k < P.range.z; k = k + 1u) {
+        acc = acc + footprint_mean(homs[k], px, py);
+    }
     out_rgb[o] = out_rgb[o] + vec4<f32>(acc, 0.0);
 }

@@ -3,7 +3,7 @@
 use glam::DVec3;
 use mmbm::gpu::context::gpu_or_skip;
 use mmbm::io::images::{read_rgb8, save_rgb8, write_png_linear_rgb};
-use mmbm::render::{self, Backend, Quality, RenderJob, Target, Trajectory};
+use mmbm::render::{self, Backend, Integrator, Quality, RenderJob, Target, Trajectory};
 use mmbm::{Camera, Twist};
 use std::path::PathBuf;
 
@@ -54,35 +54,40 @@ fn gpu_matches_cpu_twin_per_pixel() {
     eprintln!("adapter: {}", ctx.description);
     let d = tempfile::tempdir().unwrap();
     let tex = test_texture(d.path());
-    for (name, mut job) in scenes(&tex) {
-        job.quality = Quality::Custom {
-            min_samples: 256,
-            max_spacing_px: 0.5,
-        };
-        job.with_maps = false;
-        job.backend = Backend::Gpu;
-        let g = render::render_frame(&job).unwrap();
-        job.backend = Backend::Cpu { threads: None };
-        let c = render::render_frame(&job).unwrap();
-        let n = g.samples_per_pixel as f32;
-        let diffs: Vec<f32> = g
-            .rgb
-            .iter()
-            .zip(&c.rgb)
-            .map(|(a, b)| (a - b).abs())
-            .collect();
-        let max = diffs.iter().cloned().fold(0.0, f32::max);
-        let mean = diffs.iter().sum::<f32>() / diffs.len() as f32;
-        eprintln!("{name}: N {n}, max |gpu - cpu| {max:.2e}, mean {mean:.2e}");
-        // f32 rounding may flip a few samples that lie on an edge (each flip is
-        // 1/N) and texture filtering rounds differently: 3 flips + 1e-3.
-        assert!(max <= 3.0 / n + 1e-3, "{name}: max {max}");
-        assert!(mean <= 1e-4, "{name}: mean {mean}");
+    for (name, scene) in scenes(&tex) {
+        for integrator in [Integrator::Auto, Integrator::Lattice] {
+            let mut job = scene.clone();
+            job.integrator = integrator;
+            job.quality = Quality::Custom {
+                min_samples: 256,
+                max_spacing_px: 0.5,
+            };
+            job.with_maps = false;
+            job.backend = Backend::Gpu;
+            let g = render::render_frame(&job).unwrap();
+            job.backend = Backend::Cpu { threads: None };
+            let c = render::render_frame(&job).unwrap();
+            let n = g.samples_per_pixel as f32;
+            let diffs: Vec<f32> = g
+                .rgb
+                .iter()
+                .zip(&c.rgb)
+                .map(|(a, b)| (a - b).abs())
+                .collect();
+            let max = diffs.iter().cloned().fold(0.0, f32::max);
+            let mean = diffs.iter().sum::<f32>() / diffs.len() as f32;
+            eprintln!("{name} ({integrator}): N {n}, max |gpu - cpu| {max:.2e}, mean {mean:.2e}");
+            // Lattice: f32 rounding may flip a few samples that lie on an edge
+            // (each flip is 1/N) and texture filtering rounds differently: 3
+            // flips + 1e-3. Analytic: no discontinuity, f32 rounding only.
+            assert!(max <= 3.0 / n + 1e-3, "{name} {integrator}: max {max}");
+            assert!(mean <= 1e-4, "{name} {integrator}: mean {mean}");
+        }
     }
 }
 
-/// Golden renders: PNG (sRGB 8-bit) under `golden/`. Written when missing or
-/// with `MMBM_REGEN_GOLDEN=1`; otherwise compared in 8-bit levels: mean
+/// Golden renders: PNG (sRGB 8-bit) under `golden/`. Written only with
+/// `MMBM_REGEN_GOLDEN=1` (a missing golden fails); otherwise compared in 8-bit levels: mean
 /// |diff| <= 0.5 and 99th percentile <= 3 levels (the renderer's stated error
 /// is 0.5/255 mean and 3/255 p99 in linear light; sRGB encoding stretches
 /// dark values, so this is looser there). On failure the actual image and a
@@ -120,9 +125,19 @@ fn golden_renders() {
         job.with_maps = false;
         let out = render::render_frame(&job).unwrap();
         let path = dir.join(name);
-        if regen || !path.exists() {
+        if regen {
             write_png_linear_rgb(&path, out.width, out.height, &out.rgb).unwrap();
-            eprintln!("wrote golden {}", path.display());
+            eprintln!(
+                "wrote golden {} (look at it before committing)",
+                path.display()
+            );
+            continue;
+        }
+        if !path.exists() {
+            failures.push(format!(
+                "{name}: golden missing ({}); regenerate with MMBM_REGEN_GOLDEN=1 and check it",
+                path.display()
+            ));
             continue;
         }
         let gold = read_rgb8(&path).unwrap();

@@ -100,6 +100,11 @@ pub struct RenderOpts {
     /// default, fast, or MIN_SAMPLES:SPACING_PX.
     #[arg(long, default_value = "default")]
     pub quality: String,
+    /// Area integration: auto (analytic for checker and blobs, lattice for
+    /// images), analytic (closed-form pixel area, one sample per instant) or
+    /// lattice (supersampled area and time).
+    #[arg(long, default_value = "auto")]
+    pub integrator: String,
     /// auto (GPU if any, else CPU), gpu, or cpu.
     #[arg(long, default_value = "auto")]
     pub backend: String,
@@ -223,6 +228,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
         quality: a.quality.parse::<Quality>()?,
         backend,
         seed: a.seed,
+        integrator: a.integrator.parse()?,
         with_maps: a.maps.is_some(),
     };
     let t0 = std::time::Instant::now();

@@ -9,7 +9,7 @@ pub mod context;
 
 pub use context::{gpu, GpuContext};
 
-use crate::error::Result;
+use crate::error::{Error, Result};
 use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Where a kernel runs.
@@ -39,13 +39,18 @@ pub enum Resolved {
 impl Backend {
     /// The device for `Gpu` (or an error) and `Auto` (when one exists), else
     /// the CPU twin. `Auto` without an adapter prints `"{what}: {error}; using
-    /// the CPU {twin}"` on stderr, once per `announced` flag.
+    /// the CPU {twin}"` on stderr, once per `announced` flag; with
+    /// `MMBM_REQUIRE_GPU=1` in the environment (CI) it is an error instead, so
+    /// that no check silently runs on the twin where the GPU was meant.
     pub fn resolve(self, what: &str, twin: &str, announced: &AtomicBool) -> Result<Resolved> {
         match self {
             Backend::Cpu { threads } => Ok(Resolved::Cpu(threads)),
             Backend::Gpu => Ok(Resolved::Gpu(gpu()?)),
             Backend::Auto => match gpu() {
                 Ok(ctx) => Ok(Resolved::Gpu(ctx)),
+                Err(e) if std::env::var("MMBM_REQUIRE_GPU").is_ok_and(|v| v == "1") => Err(
+                    Error::Gpu(format!("{what}: MMBM_REQUIRE_GPU=1 and no adapter: {e}")),
+                ),
                 Err(e) => {
                     if !announced.swap(true, Ordering::Relaxed) {
                         eprintln!("{what}: {e}; using the CPU {twin}");

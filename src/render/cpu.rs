@@ -1,9 +1,9 @@
-//! CPU twin of `shaders/render.wgsl`: the same samples, pose interpolation,
-//! ray/plane intersection and texture maths in f32, one pixel per task (rayon).
+//! CPU twin of `shaders/render.wgsl`: the same samples, homography table,
+//! background box and texture maths in f32, one pixel per task (rayon).
 
-use super::kernel::{shifts, GpuPose, RenderParams, KIND_BLOBS, KIND_CHECKER};
+use super::kernel::{shifts, GpuHomography, RenderParams, KIND_BLOBS, KIND_CHECKER};
 use super::texture::MipTexture;
-use glam::{Vec3, Vec4};
+use glam::Vec3;
 use rayon::prelude::*;
 
 #[inline]
@@ -12,38 +12,25 @@ fn v3(a: [f32; 4]) -> Vec3 {
 }
 
 #[inline]
-fn rotate(q: Vec4, v: Vec3) -> Vec3 {
-    let u = q.truncate();
-    let t = u.cross(v) + v * q.w;
-    v + 2.0 * u.cross(t)
-}
-
-#[inline]
 fn fract(x: f32) -> f32 {
     x - x.floor()
 }
 
-/// Radiance (linear RGB) seen along one sample ray.
+/// Radiance (linear RGB) seen at pixel point `(px, py)` through homography `h`.
 #[inline]
-fn shade(p: &RenderParams, tex: Option<&MipTexture>, q: Vec4, c: Vec3, px: f32, py: f32) -> Vec3 {
+fn shade(p: &RenderParams, tex: Option<&MipTexture>, h: &GpuHomography, px: f32, py: f32) -> Vec3 {
     let bg = v3(p.background);
-    let (fx, fy, cx, cy) = (p.cam[0], p.cam[1], p.cam[2], p.cam[3]);
-    let yc = (py - cy) / fy;
-    let dc = Vec3::new((px - cx - p.cam2[0] * yc) / fx, yc, 1.0);
-    let dw = rotate(q, dc);
-    let n = v3(p.normal);
-    let den = n.dot(dw);
-    let s = (p.origin[3] - n.dot(c)) / den;
-    if den.abs() < 1e-12 || s.is_nan() || s <= 0.0 {
+    let w = h.h2[0] * px + h.h2[1] * py + h.h2[2];
+    if w.is_nan() || w <= 0.0 {
         return bg;
     }
-    let d = c + dw * s - v3(p.origin);
-    let a = d.dot(v3(p.e1));
-    let b = d.dot(v3(p.e2));
+    let r = 1.0 / w;
+    let a = (h.h0[0] * px + h.h0[1] * py + h.h0[2]) * r;
+    let b = (h.h1[0] * px + h.h1[1] * py + h.h1[2]) * r;
     match p.dims[2] {
         KIND_CHECKER => {
-            let sz = p.tex[0];
-            let k = (a / sz).floor() as i32 + (b / sz).floor() as i32;
+            let inv_sz = p.tex[1];
+            let k = (a * inv_sz).floor() as i32 + (b * inv_sz).floor() as i32;
             let w = if k & 1 == 0 { 1.0 } else { 0.0 };
             Vec3::splat(w)
         }
@@ -52,8 +39,9 @@ fn shade(p: &RenderParams, tex: Option<&MipTexture>, q: Vec4, c: Vec3, px: f32, 
             if a.abs() > half || b.abs() > half {
                 return bg;
             }
-            let ca = ((a / pitch + 2.0).floor().clamp(0.0, 3.0) - 1.5) * pitch;
-            let cb = ((b / pitch + 2.0).floor().clamp(0.0, 3.0) - 1.5) * pitch;
+            let inv_pitch = p.tex[3];
+            let ca = ((a * inv_pitch + 2.0).floor().clamp(0.0, 3.0) - 1.5) * pitch;
+            let cb = ((b * inv_pitch + 2.0).floor().clamp(0.0, 3.0) - 1.5) * pitch;
             if (a - ca).abs() <= 0.5 * sq && (b - cb).abs() <= 0.5 * sq {
                 v3(p.colour_a)
             } else {
@@ -67,10 +55,9 @@ fn shade(p: &RenderParams, tex: Option<&MipTexture>, q: Vec4, c: Vec3, px: f32, 
             if !(0.0..=1.0).contains(&u) || !(0.0..=1.0).contains(&v) {
                 return bg;
             }
-            let len = dw.length();
-            let cos = den.abs() / len;
-            let texels = s * len * p.cam2[1] / cos.sqrt() * p.tex[2];
-            let lod = (texels * p.cam2[2]).max(1.0).log2();
+            // Footprint side (m) = sqrt(|det H| / w^3); in texels of level 0.
+            let texels = (h.h2[3] * r * r * r).sqrt() * p.tex[2];
+            let lod = (texels * p.lod[0]).max(1.0).log2();
             Vec3::from(t.trilinear(u, v, lod))
         }
     }
@@ -79,28 +66,27 @@ fn shade(p: &RenderParams, tex: Option<&MipTexture>, q: Vec4, c: Vec3, px: f32, 
 /// Sum (not mean) of the samples `k0..k1` of pixel `(i, j)`.
 pub fn pixel_sum(
     p: &RenderParams,
-    poses: &[GpuPose],
+    homs: &[GpuHomography],
     tex: Option<&MipTexture>,
     i: u32,
     j: u32,
 ) -> Vec3 {
     let n = p.dims[3];
-    let nf = n as f32;
-    let (g1, g2, segs, seed) = (p.lattice[0], p.lattice[1], p.lattice[2], p.lattice[3]);
-    let sh = shifts(i, j, seed);
+    let count = p.range[2] - p.range[1];
+    let b = p.bbox;
+    if i < b[0] || j < b[1] || i >= b[2] || j >= b[3] {
+        return v3(p.background) * count as f32;
+    }
+    let (g1, g2, seed) = (p.lattice[0], p.lattice[1], p.lattice[3]);
+    let (shx, shy) = shifts(i, j, seed);
+    let inv_n = p.lod[1];
     let (mut xi, mut yi) = (p.range[3], p.range2[0]);
     let mut acc = Vec3::ZERO;
+    let (fi, fj) = (i as f32, j as f32);
     for k in p.range[1]..p.range[2] {
-        let sx = fract(xi as f32 / nf + sh[0]);
-        let sy = fract(yi as f32 / nf + sh[1]);
-        let st = fract(k as f32 / nf + sh[2]);
-        let tt = st * segs as f32;
-        let idx = (tt as u32).min(segs - 1);
-        let f = tt - idx as f32;
-        let (a, b) = (&poses[idx as usize], &poses[idx as usize + 1]);
-        let q = Vec4::from(a.q).lerp(Vec4::from(b.q), f).normalize();
-        let c = v3(a.c).lerp(v3(b.c), f);
-        acc += shade(p, tex, q, c, i as f32 + sx, j as f32 + sy);
+        let sx = fract(xi as f32 * inv_n + shx);
+        let sy = fract(yi as f32 * inv_n + shy);
+        acc += shade(p, tex, &homs[k as usize], fi + sx, fj + sy);
         xi += g1;
         if xi >= n {
             xi -= n;
@@ -114,11 +100,13 @@ pub fn pixel_sum(
 }
 
 /// Renders the whole image on the CPU: linear RGB, interleaved, mean over the
-/// `N` samples of each pixel. `threads = Some(1)` runs single-threaded.
+/// `N` samples (or instants, `analytic`) of each pixel. `threads = Some(1)`
+/// runs single-threaded.
 pub fn render(
     p: &RenderParams,
-    poses: &[GpuPose],
+    homs: &[GpuHomography],
     tex: Option<&MipTexture>,
+    analytic: bool,
     threads: Option<usize>,
 ) -> Vec<f32> {
     let (w, h) = (p.dims[0], p.dims[1]);
@@ -127,8 +115,12 @@ pub fn render(
         let mut out = vec![0.0f32; (w * h * 3) as usize];
         out.par_chunks_mut(3).enumerate().for_each(|(idx, o)| {
             let (i, j) = (idx as u32 % w, idx as u32 / w);
-            let s = pixel_sum(p, poses, tex, i, j) * inv;
-            o.copy_from_slice(&s.to_array());
+            let s = if analytic {
+                pixel_sum_analytic(p, homs, i, j)
+            } else {
+                pixel_sum(p, homs, tex, i, j)
+            };
+            o.copy_from_slice(&(s * inv).to_array());
         });
         out
     };
@@ -139,4 +131,154 @@ pub fn render(
         },
         None => run(),
     }
+}
+
+// ---- analytic area integration (twin of the same names in render.wgsl) ----
+//
+// At one instant the pixel square maps, through the affine part of the
+// homography at the pixel centre, to a parallelogram in target coordinates:
+// `a = a_c + x * J_ax + y * J_ay` with `x, y` uniform on [-1/2, 1/2], so `a`
+// is `a_c + U(-p, p) + U(-q, q)` with `p, q` the larger and smaller of
+// `|J_ax| / 2`, `|J_ay| / 2` (a trapezoidal distribution), and likewise `b`.
+// The kernel averages the target over these two marginals, taken as
+// independent (exact for axis-aligned footprints and wherever one edge
+// crosses the footprint).
+//
+// Checker: value = (1 + s(a) s(b)) / 2 with the square wave s (period 2S).
+// With T = integral of s (a triangle wave) and M(c) = mean of T over
+// [c - q, c + q], E[s(a_c + U_p + U_q)] = (M(a_c + p) - M(a_c - p)) / (2p).
+// M is T plus, when a kink of T (at multiples of S, slope change +-2) lies
+// within q of c, delta * (q - d)^2 / (4q) (d: distance to the kink); for
+// q >= S/4 it is the difference of the integral of T. Blob board: interval
+// probabilities of the trapezoid, from its CDF
+// F(x) = (R(x + p) - R(x - p)) / (2p), R(c) = mean of max(c, 0) over [c - q, c + q].
+
+/// Feature-relative width below which a footprint is a point.
+const TINY: f32 = 0.001;
+
+fn tri(x: f32, sz: f32) -> f32 {
+    let y = x - (x / (2.0 * sz)).floor() * (2.0 * sz);
+    if y < sz {
+        y
+    } else {
+        2.0 * sz - y
+    }
+}
+
+fn tri_int(y: f32, sz: f32) -> f32 {
+    let per = (y / (2.0 * sz)).floor();
+    let r = y - per * 2.0 * sz;
+    let v = if r >= sz {
+        0.5 * sz * sz + 2.0 * sz * (r - sz) - 0.5 * (r * r - sz * sz)
+    } else {
+        0.5 * r * r
+    };
+    per * sz * sz + v
+}
+
+fn tri_mean(c: f32, q: f32, sz: f32) -> f32 {
+    if q < TINY * sz {
+        return tri(c, sz);
+    }
+    if q < 0.25 * sz {
+        let k = (c / sz).round();
+        let d = (c - k * sz).abs();
+        let mut m = tri(c, sz);
+        if d < q {
+            let delta = if (k as i32) & 1 == 0 { 2.0 } else { -2.0 };
+            m += delta * (q - d) * (q - d) / (4.0 * q);
+        }
+        return m;
+    }
+    let base = ((c - q) / (2.0 * sz)).floor() * (2.0 * sz);
+    (tri_int(c + q - base, sz) - tri_int(c - q - base, sz)) / (2.0 * q)
+}
+
+/// Mean of the square wave over `x + U(-p, p) + U(-q, q)`, `p >= q`.
+pub fn square_mean(x: f32, p: f32, q: f32, sz: f32) -> f32 {
+    if p < TINY * sz {
+        let k = (x / sz).floor() as i32;
+        return if k & 1 == 0 { 1.0 } else { -1.0 };
+    }
+    (tri_mean(x + p, q, sz) - tri_mean(x - p, q, sz)) / (2.0 * p)
+}
+
+fn ramp_mean(c: f32, q: f32, tiny: f32) -> f32 {
+    let mut m = c.max(0.0);
+    if q >= tiny && c.abs() < q {
+        m += (q - c.abs()) * (q - c.abs()) / (4.0 * q);
+    }
+    m
+}
+
+/// `P(U(-p, p) + U(-q, q) <= x)`, `p >= q`.
+pub fn trap_cdf(x: f32, p: f32, q: f32, tiny: f32) -> f32 {
+    if x >= p + q {
+        return 1.0;
+    }
+    if x <= -(p + q) {
+        return 0.0;
+    }
+    if p < tiny {
+        return if x >= 0.0 { 1.0 } else { 0.0 };
+    }
+    ((ramp_mean(x + p, q, tiny) - ramp_mean(x - p, q, tiny)) / (2.0 * p)).clamp(0.0, 1.0)
+}
+
+fn trap_in(lo: f32, hi: f32, c: f32, p: f32, q: f32, tiny: f32) -> f32 {
+    trap_cdf(hi - c, p, q, tiny) - trap_cdf(lo - c, p, q, tiny)
+}
+
+fn board_axis(prm: &RenderParams, c: f32, p: f32, q: f32) -> (f32, f32) {
+    let (sq, pitch, half) = (prm.tex[0], prm.tex[1], prm.tex[2]);
+    let tiny = TINY * sq;
+    let board = trap_in(-half, half, c, p, q, tiny);
+    let mut blobs = 0.0;
+    for k in 0..4 {
+        let cc = (k as f32 - 1.5) * pitch;
+        blobs += trap_in(cc - 0.5 * sq, cc + 0.5 * sq, c, p, q, tiny);
+    }
+    (board, blobs)
+}
+
+/// The target averaged over the footprint of pixel centre `(px, py)` through `h`.
+fn footprint_mean(prm: &RenderParams, h: &GpuHomography, px: f32, py: f32) -> Vec3 {
+    let bg = v3(prm.background);
+    let w = h.h2[0] * px + h.h2[1] * py + h.h2[2];
+    if w.is_nan() || w <= 0.0 {
+        return bg;
+    }
+    let r = 1.0 / w;
+    let a = (h.h0[0] * px + h.h0[1] * py + h.h0[2]) * r;
+    let b = (h.h1[0] * px + h.h1[1] * py + h.h1[2]) * r;
+    let dax = ((h.h0[0] - a * h.h2[0]) * r).abs();
+    let day = ((h.h0[1] - a * h.h2[1]) * r).abs();
+    let dbx = ((h.h1[0] - b * h.h2[0]) * r).abs();
+    let dby = ((h.h1[1] - b * h.h2[1]) * r).abs();
+    let (pa, qa) = (0.5 * dax.max(day), 0.5 * dax.min(day));
+    let (pb, qb) = (0.5 * dbx.max(dby), 0.5 * dbx.min(dby));
+    if prm.dims[2] == KIND_CHECKER {
+        let sz = prm.tex[0];
+        let m = square_mean(a, pa, qa, sz) * square_mean(b, pb, qb, sz);
+        return Vec3::splat(0.5 + 0.5 * m);
+    }
+    let (ba, ca) = board_axis(prm, a, pa, qa);
+    let (bb, cb) = board_axis(prm, b, pb, qb);
+    let (white, red) = (v3(prm.colour_b), v3(prm.colour_a));
+    bg + (white - bg) * (ba * bb) + (red - white) * (ca * cb)
+}
+
+/// Sum over the instants `k0..k1` of pixel `(i, j)` (analytic area).
+pub fn pixel_sum_analytic(p: &RenderParams, homs: &[GpuHomography], i: u32, j: u32) -> Vec3 {
+    let count = p.range[2] - p.range[1];
+    let b = p.bbox;
+    if i < b[0] || j < b[1] || i >= b[2] || j >= b[3] {
+        return v3(p.background) * count as f32;
+    }
+    let (px, py) = (i as f32 + 0.5, j as f32 + 0.5);
+    let mut acc = Vec3::ZERO;
+    for k in p.range[1]..p.range[2] {
+        acc += footprint_mean(p, &homs[k as usize], px, py);
+    }
+    acc
 }

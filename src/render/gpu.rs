@@ -4,7 +4,7 @@
 //! accumulated in place), each submitted and waited for separately, so that no
 //! single dispatch runs long enough to trip a GPU watchdog.
 
-use super::kernel::{with_range, GpuPose, RenderParams};
+use super::kernel::{with_range, GpuHomography, RenderParams};
 use super::texture::MipTexture;
 use crate::error::{Error, Result};
 use crate::gpu::{compute, GpuContext};
@@ -17,10 +17,11 @@ pub const SHADER: &str = include_str!("../../shaders/render.wgsl");
 /// Upper bound of pixel-samples in one dispatch.
 pub const SAMPLES_PER_DISPATCH: u64 = 1 << 25;
 
-/// The compiled kernel: its bind group layout and pipeline.
+/// The compiled kernel: its bind group layout and pipelines (`main`, `analytic`).
 struct Kernel {
     bgl: wgpu::BindGroupLayout,
-    pipeline: wgpu::ComputePipeline,
+    lattice: wgpu::ComputePipeline,
+    analytic: wgpu::ComputePipeline,
 }
 
 static KERNEL: OnceLock<std::result::Result<Kernel, String>> = OnceLock::new();
@@ -28,27 +29,59 @@ static KERNEL: OnceLock<std::result::Result<Kernel, String>> = OnceLock::new();
 fn kernel(ctx: &GpuContext) -> Result<&'static Kernel> {
     KERNEL
         .get_or_init(|| {
-            let p = compute::build(ctx, "render.wgsl", SHADER, None, &["main"])
-                .map_err(|e| e.to_string())?;
-            let pipeline = p.pipelines.into_iter().next().ok_or("no pipeline")?;
+            // One explicit layout shared by both entry points (`analytic`
+            // does not read the texture bindings).
+            let entry = |binding: u32, ty: wgpu::BufferBindingType| wgpu::BindGroupLayoutEntry {
+                binding,
+                visibility: wgpu::ShaderStages::COMPUTE,
+                ty: wgpu::BindingType::Buffer {
+                    ty,
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                count: None,
+            };
+            let ro = wgpu::BufferBindingType::Storage { read_only: true };
+            let layout = [
+                entry(0, wgpu::BufferBindingType::Uniform),
+                entry(1, ro),
+                entry(2, ro),
+                entry(3, ro),
+                entry(4, wgpu::BufferBindingType::Storage { read_only: false }),
+            ];
+            let p = compute::build(
+                ctx,
+                "render.wgsl",
+                SHADER,
+                Some(&layout),
+                &["main", "analytic"],
+            )
+            .map_err(|e| e.to_string())?;
+            let mut it = p.pipelines.into_iter();
+            let (Some(lattice), Some(analytic)) = (it.next(), it.next()) else {
+                return Err("render.wgsl: missing pipeline".to_string());
+            };
             Ok(Kernel {
                 bgl: p.bgl,
-                pipeline,
+                lattice,
+                analytic,
             })
         })
         .as_ref()
         .map_err(|e| Error::Gpu(e.trim_start_matches("GPU: ").to_string()))
 }
 
-/// Renders on the GPU; returns linear RGB interleaved (mean over N samples).
+/// Renders on the GPU; returns linear RGB interleaved (mean over the N
+/// samples, or instants with `analytic`).
 pub fn render(
     ctx: &GpuContext,
     p: &RenderParams,
-    poses: &[GpuPose],
+    homs: &[GpuHomography],
     tex: Option<&MipTexture>,
+    analytic: bool,
 ) -> Result<Vec<f32>> {
     let k = kernel(ctx)?;
-    let pipe = &k.pipeline;
+    let pipe = if analytic { &k.analytic } else { &k.lattice };
     let dev = &ctx.device;
     let (w, h, n) = (p.dims[0], p.dims[1], p.dims[3]);
     let npix = w as u64 * h as u64;
@@ -70,7 +103,7 @@ pub fn render(
             usage: wgpu::BufferUsages::STORAGE,
         })
     };
-    let b_poses = storage("poses", bytemuck::cast_slice(poses));
+    let b_homs = storage("homographies", bytemuck::cast_slice(homs));
     let b_tex = storage("texels", bytemuck::cast_slice(&texels));
     let b_lev = storage("levels", bytemuck::cast_slice(&levels));
     let b_out = dev.create_buffer(&wgpu::BufferDescriptor {
@@ -95,7 +128,7 @@ pub fn render(
             },
             wgpu::BindGroupEntry {
                 binding: 1,
-                resource: b_poses.as_entire_binding(),
+                resource: b_homs.as_entire_binding(),
             },
             wgpu::BindGroupEntry {
                 binding: 2,

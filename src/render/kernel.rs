@@ -1,20 +1,35 @@
 //! What the render kernel sees: the parameter block shared with
 //! `shaders/render.wgsl` (bytemuck Pod, layout asserted), the per-pixel
-//! sample set, and the pose table.
+//! sample set, and the homography table.
 //!
 //! Sample set: per pixel a rank-1 lattice of `N` points in (x, y, t) with
 //! generator `(g1, g2, 1)` (`g1, g2` the integers coprime to `N` nearest to
 //! `N * (0.75488, 0.56984)`, the R2 sequence's constants), shifted per pixel
-//! by a hashed Cranley-Patterson rotation. Time coordinates are exactly
-//! `k / N` (shifted), so consecutive time samples are `duration / N` apart,
-//! and the x and y projections are exactly stratified too.
+//! by a hashed Cranley-Patterson rotation in x and y. The time coordinate of
+//! sample `k` is the midpoint `(k + 0.5) / N` of step `k` (the same `N`
+//! instants for every pixel, `duration / N` apart: a midpoint rule in time;
+//! the per-pixel x and y shifts decorrelate which sensor point meets which
+//! instant), and the x and y projections are exactly stratified. Every lane
+//! of a SIMD group reads the same table entry at the same step.
+//!
+//! Homography table: at each instant `m`, the map from pixel coordinates
+//! `(x, y, 1)` to target-plane coordinates `(a, b)` (m) is a 3x3 homography
+//! `H_m` (ray through the pixel from the camera pose at that instant,
+//! intersected with the plane), computed once per frame in f64 on the host.
+//! The kernel's per-sample work is one table read, 9 multiply-adds and a
+//! division, instead of interpolating a pose and intersecting a ray.
+//!
+//! Pixels that the target never reaches during the exposure (outside the
+//! bounding box of the finite target's projections at every instant) see
+//! only the background: the kernel writes it without sampling.
 
 use super::target::{Target, TargetKind};
 use super::texture::MipTexture;
-use super::trajectory::Pose;
+use super::trajectory::Trajectory;
 use crate::board::{BLOB_RED, BOARD_WHITE};
 use crate::model::camera::Camera;
 use bytemuck::{Pod, Zeroable};
+use glam::{DMat3, DVec3};
 
 /// Target kind codes in [`RenderParams::dims`].
 pub const KIND_CHECKER: u32 = 0;
@@ -31,52 +46,150 @@ pub const LOD_SCALE: f32 = 1.0 / 8.0;
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
 pub struct RenderParams {
-    /// fx, fy (focal length in px), cx, cy (principal point, px).
-    pub cam: [f32; 4],
-    /// skew (px), 1/sqrt(fx*fy) (pixel angular size), LOD_SCALE, 0.
-    pub cam2: [f32; 4],
-    /// Plane origin O (m), and n.O.
-    pub origin: [f32; 4],
-    /// In-plane right axis.
-    pub e1: [f32; 4],
-    /// In-plane down axis.
-    pub e2: [f32; 4],
-    /// Plane normal.
-    pub normal: [f32; 4],
     /// Background linear RGB.
     pub background: [f32; 4],
-    /// Checker: [S, 0, 0, 0]; blobs: [square, pitch, board half-width, 0];
+    /// Checker: [S, 1/S, 0, 0]; blobs: [square, pitch, board half-width, 1/pitch];
     /// image: [width_m, height_m, texels per m (level 0), levels].
     pub tex: [f32; 4],
     /// First colour (blob red).
     pub colour_a: [f32; 4],
     /// Second colour (board white).
     pub colour_b: [f32; 4],
+    /// LOD_SCALE, 1/N, 0, 0.
+    pub lod: [f32; 4],
     /// width, height (full image, px), target kind, N (samples per pixel).
     pub dims: [u32; 4],
-    /// g1, g2 (lattice generator), K (pose table segments), seed.
+    /// g1, g2 (lattice generator), 0, seed.
     pub lattice: [u32; 4],
     /// First row of this dispatch, first and end sample index k0, k1, (k0*g1) mod N.
     pub range: [u32; 4],
     /// (k0*g2) mod N, rows in this dispatch, 0, 0.
     pub range2: [u32; 4],
+    /// x0, y0, x1, y1 (px, end exclusive): pixels outside see only the background.
+    pub bbox: [u32; 4],
 }
 
-const _: () = assert!(std::mem::size_of::<RenderParams>() == 14 * 16);
-const _: () = assert!(std::mem::offset_of!(RenderParams, dims) == 10 * 16);
-const _: () = assert!(std::mem::offset_of!(RenderParams, range2) == 13 * 16);
+const _: () = assert!(std::mem::size_of::<RenderParams>() == 10 * 16);
+const _: () = assert!(std::mem::offset_of!(RenderParams, dims) == 5 * 16);
+const _: () = assert!(std::mem::offset_of!(RenderParams, range2) == 8 * 16);
+const _: () = assert!(std::mem::offset_of!(RenderParams, bbox) == 9 * 16);
 
-/// One pose table entry: quaternion (x, y, z, w) and position (m, w unused).
+/// One instant of the homography table: rows of `H` (pixel `(x, y, 1)` to
+/// homogeneous target coordinates `(a w, b w, w)`, scaled so that `w > 0`
+/// exactly where the ray meets the plane in front of the camera); `h2[3]` is
+/// `|det H|` (the target area per pixel area is `|det H| / w^3`, m^2).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
-pub struct GpuPose {
-    /// Rotation camera-to-world.
-    pub q: [f32; 4],
-    /// Camera centre, m.
-    pub c: [f32; 4],
+pub struct GpuHomography {
+    /// Row 0 (a), w unused.
+    pub h0: [f32; 4],
+    /// Row 1 (b), w unused.
+    pub h1: [f32; 4],
+    /// Row 2 (w), and |det H|.
+    pub h2: [f32; 4],
 }
 
-const _: () = assert!(std::mem::size_of::<GpuPose>() == 32);
+const _: () = assert!(std::mem::size_of::<GpuHomography>() == 48);
+
+/// The pixel-to-ray matrix: `K^-1 (x, y, 1)` is the camera-frame direction
+/// `(u / f, v / f, 1)` through pixel coordinates `(x, y)` (affine, so read off
+/// the camera's own mapping at three points).
+fn pixel_to_ray(cam: &Camera) -> DMat3 {
+    let d = |x: f64, y: f64| {
+        let (u, v) = cam.pixel_to_mm(x, y);
+        DVec3::new(u / cam.focal_mm, v / cam.focal_mm, 1.0)
+    };
+    let o = d(0.0, 0.0);
+    DMat3::from_cols(d(1.0, 0.0) - o, d(0.0, 1.0) - o, o)
+}
+
+/// The homography of pose `pose` (f64).
+pub fn homography(cam: &Camera, target: &Target, pose: &super::trajectory::Pose) -> DMat3 {
+    let f = target.frame();
+    let (q, c) = pose;
+    let dist = f.normal.dot(f.origin) - f.normal.dot(*c);
+    let rows = [
+        f.normal * f.e1.dot(*c - f.origin) + f.e1 * dist,
+        f.normal * f.e2.dot(*c - f.origin) + f.e2 * dist,
+        f.normal,
+    ];
+    let m = DMat3::from_cols(rows[0], rows[1], rows[2]).transpose();
+    let h = m * DMat3::from_quat(*q) * pixel_to_ray(cam);
+    // s = dist / (n . d) > 0 exactly where sign(dist) * w > 0.
+    if dist < 0.0 {
+        -h
+    } else {
+        h
+    }
+}
+
+/// Time of instant `m` of `n` (s after exposure start): the step midpoint.
+pub fn instant(trajectory: &Trajectory, m: u32, n: u32) -> f64 {
+    trajectory.duration() * (m as f64 + 0.5) / n as f64
+}
+
+/// The homography table: `n` instants, for upload.
+pub fn homographies(
+    cam: &Camera,
+    target: &Target,
+    trajectory: &Trajectory,
+    n: u32,
+) -> Vec<GpuHomography> {
+    (0..n)
+        .map(|m| {
+            let h = homography(cam, target, &trajectory.pose_at(instant(trajectory, m, n)));
+            let r = |v: DVec3, w: f64| [v.x as f32, v.y as f32, v.z as f32, w as f32];
+            GpuHomography {
+                h0: r(h.row(0), 0.0),
+                h1: r(h.row(1), 0.0),
+                h2: r(h.row(2), h.determinant().abs()),
+            }
+        })
+        .collect()
+}
+
+/// The pixel box outside which the target is never seen during the exposure
+/// (the whole image for the unbounded checker, or when a target corner passes
+/// behind the camera): the projections of the target's corners at every
+/// instant, widened by one pixel against rounding.
+pub fn target_bbox(cam: &Camera, target: &Target, trajectory: &Trajectory, n: u32) -> [u32; 4] {
+    let full = [0, 0, cam.width, cam.height];
+    let (ha, hb) = match &target.kind {
+        TargetKind::Checker { .. } => return full,
+        TargetKind::Blobs { .. } => {
+            let b = target.board().unwrap_or_else(crate::board::Board::thesis);
+            (b.half_width_m(), b.half_width_m())
+        }
+        TargetKind::Image {
+            width_m, texture, ..
+        } => (0.5 * width_m, 0.5 * width_m / texture.aspect()),
+    };
+    let corners = [(-ha, -hb), (ha, -hb), (ha, hb), (-ha, hb)].map(|(a, b)| target.point(a, b));
+    let (mut x0, mut y0, mut x1, mut y1) = (f64::MAX, f64::MAX, f64::MIN, f64::MIN);
+    for m in 0..n {
+        let pose = trajectory.pose_at(instant(trajectory, m, n));
+        for c in corners {
+            let Some((x, y)) = super::target::project(cam, &pose, c) else {
+                return full;
+            };
+            x0 = x0.min(x);
+            y0 = y0.min(y);
+            x1 = x1.max(x);
+            y1 = y1.max(y);
+        }
+    }
+    let clampx = |v: f64| v.clamp(0.0, cam.width as f64) as u32;
+    let clampy = |v: f64| v.clamp(0.0, cam.height as f64) as u32;
+    if !(x0.is_finite() && y0.is_finite() && x1.is_finite() && y1.is_finite()) {
+        return full;
+    }
+    [
+        clampx(x0.floor() - 1.0),
+        clampy(y0.floor() - 1.0),
+        clampx(x1.ceil() + 1.0),
+        clampy(y1.ceil() + 1.0),
+    ]
+}
 
 fn gcd(mut a: u32, mut b: u32) -> u32 {
     while b != 0 {
@@ -166,43 +279,29 @@ pub fn pcg(v: u32) -> u32 {
     (word >> 22) ^ word
 }
 
-/// Per-pixel Cranley-Patterson shifts in [0, 1) (same in WGSL).
+/// Per-pixel Cranley-Patterson shifts of x and y, in [0, 1) (same in WGSL).
 #[inline]
-pub fn shifts(i: u32, j: u32, seed: u32) -> [f32; 3] {
+pub fn shifts(i: u32, j: u32, seed: u32) -> (f32, f32) {
     let h1 = pcg(i.wrapping_add(pcg(j.wrapping_add(pcg(seed)))));
     let h2 = pcg(h1);
-    let h3 = pcg(h2);
     let f = |h: u32| (h >> 8) as f32 * (1.0 / 16_777_216.0);
-    [f(h1), f(h2), f(h3)]
-}
-
-/// Converts a pose table for upload: f32, consecutive quaternions sign-aligned.
-pub fn gpu_poses(table: &[Pose]) -> Vec<GpuPose> {
-    let mut prev = glam::DQuat::IDENTITY;
-    table
-        .iter()
-        .map(|(q, c)| {
-            let q = if q.dot(prev) < 0.0 { -*q } else { *q };
-            prev = q;
-            GpuPose {
-                q: [q.x as f32, q.y as f32, q.z as f32, q.w as f32],
-                c: [c.x as f32, c.y as f32, c.z as f32, 0.0],
-            }
-        })
-        .collect()
+    (f(h1), f(h2))
 }
 
 /// The parameter block for a whole image (`range` set to all rows and samples).
-pub fn params(cam: &Camera, target: &Target, n: u32, segments: u32, seed: u32) -> RenderParams {
-    let f = target.frame();
-    let v4 = |v: glam::DVec3, w: f64| [v.x as f32, v.y as f32, v.z as f32, w as f32];
+pub fn params(cam: &Camera, target: &Target, n: u32, bbox: [u32; 4], seed: u32) -> RenderParams {
     let (kind, tex) = match &target.kind {
-        TargetKind::Checker { size } => (KIND_CHECKER, [*size as f32, 0.0, 0.0, 0.0]),
+        TargetKind::Checker { size } => {
+            (KIND_CHECKER, [*size as f32, (1.0 / size) as f32, 0.0, 0.0])
+        }
         TargetKind::Blobs { .. } => {
             // The shader and its CPU twin draw a 4 x 4 grid (see the test below).
             let b = target.board().unwrap_or_else(crate::board::Board::thesis);
             let (sq, pitch, half) = (b.square_m, b.pitch_m(), b.half_width_m());
-            (KIND_BLOBS, [sq as f32, pitch as f32, half as f32, 0.0])
+            (
+                KIND_BLOBS,
+                [sq as f32, pitch as f32, half as f32, (1.0 / pitch) as f32],
+            )
         }
         TargetKind::Image {
             width_m, texture, ..
@@ -220,29 +319,19 @@ pub fn params(cam: &Camera, target: &Target, n: u32, segments: u32, seed: u32) -
             )
         }
     };
-    let (fx, fy) = (cam.fx_px(), cam.fy_px());
     let (g1, g2) = generators(n);
     let bg = target.background;
     RenderParams {
-        cam: [fx as f32, fy as f32, cam.cx as f32, cam.cy as f32],
-        cam2: [
-            cam.skew as f32,
-            (1.0 / (fx * fy).sqrt()) as f32,
-            LOD_SCALE,
-            0.0,
-        ],
-        origin: v4(f.origin, f.normal.dot(f.origin)),
-        e1: v4(f.e1, 0.0),
-        e2: v4(f.e2, 0.0),
-        normal: v4(f.normal, 0.0),
         background: [bg[0], bg[1], bg[2], 0.0],
         tex,
         colour_a: [BLOB_RED[0], BLOB_RED[1], BLOB_RED[2], 0.0],
         colour_b: [BOARD_WHITE[0], BOARD_WHITE[1], BOARD_WHITE[2], 0.0],
+        lod: [LOD_SCALE, (1.0 / n as f64) as f32, 0.0, 0.0],
         dims: [cam.width, cam.height, kind, n],
-        lattice: [g1, g2, segments, seed],
+        lattice: [g1, g2, 0, seed],
         range: [0, 0, n, 0],
         range2: [0, cam.height, 0, 0],
+        bbox,
     }
 }
 
@@ -279,7 +368,7 @@ mod tests {
             assert!(sy.iter().enumerate().all(|(i, &v)| v == i as u64), "n={n}");
         }
         let s = shifts(3, 4, 0);
-        assert!(s.iter().all(|&x| (0.0..1.0).contains(&x)));
+        assert!((0.0..1.0).contains(&s.0) && (0.0..1.0).contains(&s.1));
         assert_ne!(shifts(3, 4, 0), shifts(4, 3, 0));
     }
 
@@ -291,7 +380,13 @@ mod tests {
         let b = crate::board::Board::thesis();
         assert_eq!((b.cols, b.rows), (4, 4));
         let t = Target::blobs(0.5, 3.0);
-        let p = params(&crate::model::camera::Camera::thesis(), &t, 64, 256, 0);
+        let p = params(
+            &crate::model::camera::Camera::thesis(),
+            &t,
+            64,
+            [0, 0, 1, 1],
+            0,
+        );
         let h = b.scaled(0.5);
         assert_eq!(p.tex[0], h.square_m as f32);
         assert_eq!(p.tex[1], h.pitch_m() as f32);

@@ -1,14 +1,16 @@
 //! Ground-truth motion-blur renderer (SPEC section 4).
 //!
 //! A textured planar [`Target`] seen by a [`Camera`] moving along a
-//! [`Trajectory`] during one exposure (box shutter). Each pixel is the mean of
-//! `N` samples over its area and the exposure time (a 3-D rank-1 lattice with
-//! a per-pixel random shift, see [`kernel`]); each sample intersects the ray
-//! through its sensor point, from the pose at its instant, with the target
-//! plane and evaluates the target in linear light. `N` is chosen from the
-//! trajectory: at least `quality.min_samples()`, and enough that consecutive
-//! time samples of any pixel are at most `quality.max_spacing_px()` apart on
-//! the image (from the largest image path length over the sensor).
+//! [`Trajectory`] during one exposure (box shutter). Each pixel is the mean
+//! over its area and the exposure time. Time: `N` instants (step midpoints,
+//! the same for every pixel), at each one the homography from pixel to target
+//! coordinates ([`kernel`]); `N` is chosen from the trajectory so that
+//! consecutive instants are at most `quality.max_spacing_px()` apart on the
+//! image (from the largest image path length over the sensor). Area, per
+//! [`Integrator`]: `analytic` (checker, blob board; the default for them)
+//! averages the target over the pixel's footprint in closed form at each
+//! instant; `lattice` (any target; images) supersamples area and time with a
+//! rank-1 lattice and a per-pixel shift, at least `quality.min_samples()`.
 //!
 //! The GPU kernel is `shaders/render.wgsl` ([`gpu`]); its CPU twin ([`cpu`]) is
 //! used when no adapter exists (announced once on stderr). [`maps`] gives the
@@ -43,7 +45,7 @@ pub const MAX_PIXELS: u64 = 1 << 26;
 pub const MAX_PIXEL_SAMPLES: u64 = 1 << 40;
 
 /// Largest sample count per pixel accepted (a longer blur is an error).
-pub const MAX_SAMPLES: u32 = 1 << 22;
+pub const MAX_SAMPLES: u32 = 1 << 20;
 
 /// Sampling quality.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -79,6 +81,16 @@ impl Quality {
             Quality::Fast => 0.5,
             Quality::Custom { max_spacing_px, .. } => max_spacing_px,
         }
+    }
+
+    /// Instants per pixel of the analytic integrator for a largest image path
+    /// of `max_path_px`: the spacing rule alone (the area needs no samples).
+    pub fn instants_for(&self, max_path_px: f64) -> Result<u32> {
+        Quality::Custom {
+            min_samples: 1,
+            max_spacing_px: self.max_spacing_px(),
+        }
+        .samples_for(max_path_px)
     }
 
     /// Samples per pixel for a largest image path of `max_path_px`.
@@ -146,6 +158,47 @@ impl fmt::Display for Quality {
     }
 }
 
+/// How a pixel's area is integrated.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Integrator {
+    /// `analytic` for the checker and the blob board, `lattice` for images.
+    #[default]
+    Auto,
+    /// One sample per instant at the pixel centre, the area in closed form
+    /// (procedural targets only; see `shaders/render.wgsl`).
+    Analytic,
+    /// Supersampling of area and time (a rank-1 lattice; any target).
+    Lattice,
+}
+
+impl FromStr for Integrator {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self> {
+        match s {
+            "auto" => Ok(Integrator::Auto),
+            "analytic" => Ok(Integrator::Analytic),
+            "lattice" => Ok(Integrator::Lattice),
+            _ => Err(Error::invalid(
+                "integrator",
+                format!(
+                    "{}: expected auto, analytic or lattice",
+                    crate::error::quote(s)
+                ),
+            )),
+        }
+    }
+}
+
+impl fmt::Display for Integrator {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Integrator::Auto => "auto",
+            Integrator::Analytic => "analytic",
+            Integrator::Lattice => "lattice",
+        })
+    }
+}
+
 /// One frame to render.
 #[derive(Debug, Clone)]
 pub struct RenderJob {
@@ -163,6 +216,8 @@ pub struct RenderJob {
     pub seed: u32,
     /// Also compute the per-pixel blur maps.
     pub with_maps: bool,
+    /// Area integration.
+    pub integrator: Integrator,
 }
 
 impl RenderJob {
@@ -176,6 +231,7 @@ impl RenderJob {
             backend: Backend::Auto,
             seed: 0,
             with_maps: true,
+            integrator: Integrator::Auto,
         }
     }
 }
@@ -221,7 +277,23 @@ pub fn render_frame(job: &RenderJob) -> Result<RenderOutput> {
         ));
     }
     let lmax = maps::max_path_px(cam, &job.target, &job.trajectory);
-    let n = job.quality.samples_for(lmax)?;
+    let is_image = matches!(job.target.kind, TargetKind::Image { .. });
+    let analytic = match job.integrator {
+        Integrator::Auto => !is_image,
+        Integrator::Analytic if is_image => {
+            return Err(Error::invalid(
+                "integrator",
+                "analytic integrates the checker and the blob board; images need lattice",
+            ))
+        }
+        Integrator::Analytic => true,
+        Integrator::Lattice => false,
+    };
+    let n = if analytic {
+        job.quality.instants_for(lmax)?
+    } else {
+        job.quality.samples_for(lmax)?
+    };
     let pixels = cam.width as u64 * cam.height as u64;
     if pixels > MAX_PIXELS || pixels * n as u64 > MAX_PIXEL_SAMPLES {
         return Err(Error::invalid(
@@ -233,19 +305,19 @@ pub fn render_frame(job: &RenderJob) -> Result<RenderOutput> {
             ),
         ));
     }
-    let segments = ((lmax / 0.02).ceil() as usize).clamp(256, 1 << 16);
-    let poses = kernel::gpu_poses(&job.trajectory.table(segments));
-    let params = kernel::params(cam, &job.target, n, segments as u32, job.seed);
+    let homs = kernel::homographies(cam, &job.target, &job.trajectory, n);
+    let bbox = kernel::target_bbox(cam, &job.target, &job.trajectory, n);
+    let params = kernel::params(cam, &job.target, n, bbox, job.seed);
     let tex = kernel::texture_of(&job.target);
     let (rgb, backend_used) = match job.backend.resolve("render", "renderer", &ANNOUNCED)? {
         Resolved::Gpu(ctx) => (
-            gpu::render(ctx, &params, &poses, tex)?,
+            gpu::render(ctx, &params, &homs, tex, analytic)?,
             format!("gpu: {}", ctx.description),
         ),
         Resolved::Cpu(threads) => {
             let t = threads.unwrap_or_else(rayon::current_num_threads);
             (
-                cpu::render(&params, &poses, tex, threads),
+                cpu::render(&params, &homs, tex, analytic, threads),
                 format!("cpu ({t} threads)"),
             )
         }
