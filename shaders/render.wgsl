@@ -180,15 +180,15 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
 const TINY: f32 = 0.001;
 
 // Integral from 0 of the square wave s (+1 on [0, S), -1 on [S, 2S), period
-// 2S): a triangle wave in [0, S].
-fn tri(x: f32, sz: f32) -> f32 {
-    let y = x - floor(x / (2.0 * sz)) * (2.0 * sz);
+// 2S): a triangle wave in [0, S]. `is` = 1/S.
+fn tri(x: f32, sz: f32, is: f32) -> f32 {
+    let y = x - floor(x * (0.5 * is)) * (2.0 * sz);
     return select(2.0 * sz - y, y, y < sz);
 }
 
-// Integral from 0 of tri, for y in [0, 4S).
-fn tri_int(y: f32, sz: f32) -> f32 {
-    let per = floor(y / (2.0 * sz));
+// Integral from 0 of tri, for y >= 0.
+fn tri_int(y: f32, sz: f32, is: f32) -> f32 {
+    let per = floor(y * (0.5 * is));
     let r = y - per * 2.0 * sz;
     var v = 0.5 * r * r;
     if (r >= sz) {
@@ -198,33 +198,34 @@ fn tri_int(y: f32, sz: f32) -> f32 {
 }
 
 // Mean of tri over [c - q, c + q].
-fn tri_mean(c: f32, q: f32, sz: f32) -> f32 {
+fn tri_mean(c: f32, q: f32, sz: f32, is: f32) -> f32 {
     if (q < TINY * sz) {
-        return tri(c, sz);
+        return tri(c, sz, is);
     }
     if (q < 0.25 * sz) {
         // One kink at most: the nearest multiple of S (slope change +2 at
         // even multiples, -2 at odd ones).
-        let k = round(c / sz);
+        let k = round(c * is);
         let d = abs(c - k * sz);
-        var m = tri(c, sz);
+        var m = tri(c, sz, is);
         if (d < q) {
             let delta = select(-2.0, 2.0, (i32(k) & 1) == 0);
             m = m + delta * (q - d) * (q - d) / (4.0 * q);
         }
         return m;
     }
-    let base = floor((c - q) / (2.0 * sz)) * (2.0 * sz);
-    return (tri_int(c + q - base, sz) - tri_int(c - q - base, sz)) / (2.0 * q);
+    let base = floor((c - q) * (0.5 * is)) * (2.0 * sz);
+    return (tri_int(c + q - base, sz, is) - tri_int(c - q - base, sz, is)) / (2.0 * q);
 }
 
 // Mean of the square wave s over x + U(-p, p) + U(-q, q), p >= q.
-fn square_mean(x: f32, p: f32, q: f32, sz: f32) -> f32 {
-    if (p < TINY * sz) {
-        let k = i32(floor(x / sz));
-        return select(-1.0, 1.0, (k & 1) == 0);
+fn square_mean(x: f32, p: f32, q: f32, sz: f32, is: f32) -> f32 {
+    // No edge within reach (most footprints), or a point footprint: s(x).
+    let k = round(x * is);
+    if (abs(x - k * sz) >= p + q || p < TINY * sz) {
+        return select(-1.0, 1.0, (i32(floor(x * is)) & 1) == 0);
     }
-    return (tri_mean(x + p, q, sz) - tri_mean(x - p, q, sz)) / (2.0 * p);
+    return (tri_mean(x + p, q, sz, is) - tri_mean(x - p, q, sz, is)) / (2.0 * p);
 }
 
 // Mean of max(c, 0) over [c - q, c + q].
@@ -291,7 +292,8 @@ fn footprint_mean(h: Homography, px: f32, py: f32) -> vec3<f32> {
     let qb = 0.5 * min(dbx, dby);
     if (P.dims.z == 0u) {
         let sz = P.tex.x;
-        let m = square_mean(a, pa, qa, sz) * square_mean(b, pb, qb, sz);
+        let is = P.tex.y;
+        let m = square_mean(a, pa, qa, sz, is) * square_mean(b, pb, qb, sz, is);
         return vec3<f32>(0.5 + 0.5 * m);
     }
     let ca = board_axis(a, pa, qa);

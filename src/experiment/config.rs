@@ -77,23 +77,17 @@ impl Default for ExperimentConfig {
             start_distance_m: 6.0,
             min_distance_m: 1.5,
             resolution: [640, 480],
-            quality: "fast".into(),
+            quality: "default".into(),
             max_frames_per_policy: 0,
         }
     }
 }
 
 impl ExperimentConfig {
-    /// The `mmbm demo` configuration: the defaults with at most 24 rendered
-    /// frames per policy and the `64:0.5` render preset (64 samples per
-    /// pixel minimum, time samples at most 0.5 px apart), sized to finish in
-    /// a few minutes on 2 cores with lavapipe.
+    /// The `mmbm demo` configuration: the defaults (every kept frame of every
+    /// policy rendered at the `default` preset).
     pub fn demo() -> Self {
-        ExperimentConfig {
-            max_frames_per_policy: 24,
-            quality: "64:0.5".into(),
-            ..Self::default()
-        }
+        Self::default()
     }
 
     /// Loads a TOML file; missing fields take the defaults.

@@ -44,12 +44,38 @@ pub fn write_exr(
     })
 }
 
+/// Most samples (pixels x channels, all layers) an EXR may declare to be read.
+pub const MAX_EXR_SAMPLES: u128 = 1 << 28;
+
 /// Named channels of an EXR layer: `(name, values)`, row-major.
 pub type ExrChannels = Vec<(String, Vec<f32>)>;
 
 /// Reads every f32 (or f16, converted) channel of the first layer of an EXR:
 /// `(width, height, [(name, values)])`.
 pub fn read_exr(path: &Path) -> Result<(usize, usize, ExrChannels)> {
+    // The header first: a file that claims more samples than any mmbm output
+    // has is refused before anything is allocated for it.
+    let meta = exr::meta::MetaData::read_from_file(path, false).map_err(|e| Error::Image {
+        path: path.into(),
+        message: e.to_string(),
+    })?;
+    let samples: u128 = meta
+        .headers
+        .iter()
+        .map(|h| {
+            h.layer_size.width() as u128
+                * h.layer_size.height() as u128
+                * h.channels.list.len() as u128
+        })
+        .sum();
+    if samples > MAX_EXR_SAMPLES {
+        return Err(Error::Image {
+            path: path.into(),
+            message: format!(
+                "the header declares {samples} samples, more than the {MAX_EXR_SAMPLES} mmbm reads"
+            ),
+        });
+    }
     let img = read_all_flat_layers_from_file(path).map_err(|e| Error::Image {
         path: path.into(),
         message: e.to_string(),

@@ -156,8 +156,8 @@ pub fn render(
 /// Feature-relative width below which a footprint is a point.
 const TINY: f32 = 0.001;
 
-fn tri(x: f32, sz: f32) -> f32 {
-    let y = x - (x / (2.0 * sz)).floor() * (2.0 * sz);
+fn tri(x: f32, sz: f32, is: f32) -> f32 {
+    let y = x - (x * (0.5 * is)).floor() * (2.0 * sz);
     if y < sz {
         y
     } else {
@@ -165,8 +165,8 @@ fn tri(x: f32, sz: f32) -> f32 {
     }
 }
 
-fn tri_int(y: f32, sz: f32) -> f32 {
-    let per = (y / (2.0 * sz)).floor();
+fn tri_int(y: f32, sz: f32, is: f32) -> f32 {
+    let per = (y * (0.5 * is)).floor();
     let r = y - per * 2.0 * sz;
     let v = if r >= sz {
         0.5 * sz * sz + 2.0 * sz * (r - sz) - 0.5 * (r * r - sz * sz)
@@ -176,31 +176,37 @@ fn tri_int(y: f32, sz: f32) -> f32 {
     per * sz * sz + v
 }
 
-fn tri_mean(c: f32, q: f32, sz: f32) -> f32 {
+fn tri_mean(c: f32, q: f32, sz: f32, is: f32) -> f32 {
     if q < TINY * sz {
-        return tri(c, sz);
+        return tri(c, sz, is);
     }
     if q < 0.25 * sz {
-        let k = (c / sz).round();
+        let k = (c * is).round();
         let d = (c - k * sz).abs();
-        let mut m = tri(c, sz);
+        let mut m = tri(c, sz, is);
         if d < q {
             let delta = if (k as i32) & 1 == 0 { 2.0 } else { -2.0 };
             m += delta * (q - d) * (q - d) / (4.0 * q);
         }
         return m;
     }
-    let base = ((c - q) / (2.0 * sz)).floor() * (2.0 * sz);
-    (tri_int(c + q - base, sz) - tri_int(c - q - base, sz)) / (2.0 * q)
+    let base = ((c - q) * (0.5 * is)).floor() * (2.0 * sz);
+    (tri_int(c + q - base, sz, is) - tri_int(c - q - base, sz, is)) / (2.0 * q)
 }
 
-/// Mean of the square wave over `x + U(-p, p) + U(-q, q)`, `p >= q`.
-pub fn square_mean(x: f32, p: f32, q: f32, sz: f32) -> f32 {
-    if p < TINY * sz {
-        let k = (x / sz).floor() as i32;
-        return if k & 1 == 0 { 1.0 } else { -1.0 };
+/// Mean of the square wave over `x + U(-p, p) + U(-q, q)`, `p >= q`
+/// (`sz` = S, `is` = 1/S).
+pub fn square_mean(x: f32, p: f32, q: f32, sz: f32, is: f32) -> f32 {
+    // No edge within reach (most footprints), or a point footprint: s(x).
+    let k = (x * is).round();
+    if (x - k * sz).abs() >= p + q || p < TINY * sz {
+        return if ((x * is).floor() as i32) & 1 == 0 {
+            1.0
+        } else {
+            -1.0
+        };
     }
-    (tri_mean(x + p, q, sz) - tri_mean(x - p, q, sz)) / (2.0 * p)
+    (tri_mean(x + p, q, sz, is) - tri_mean(x - p, q, sz, is)) / (2.0 * p)
 }
 
 fn ramp_mean(c: f32, q: f32, tiny: f32) -> f32 {
@@ -258,8 +264,8 @@ fn footprint_mean(prm: &RenderParams, h: &GpuHomography, px: f32, py: f32) -> Ve
     let (pa, qa) = (0.5 * dax.max(day), 0.5 * dax.min(day));
     let (pb, qb) = (0.5 * dbx.max(dby), 0.5 * dbx.min(dby));
     if prm.dims[2] == KIND_CHECKER {
-        let sz = prm.tex[0];
-        let m = square_mean(a, pa, qa, sz) * square_mean(b, pb, qb, sz);
+        let (sz, is) = (prm.tex[0], prm.tex[1]);
+        let m = square_mean(a, pa, qa, sz, is) * square_mean(b, pb, qb, sz, is);
         return Vec3::splat(0.5 + 0.5 * m);
     }
     let (ba, ca) = board_axis(prm, a, pa, qa);
@@ -281,4 +287,74 @@ pub fn pixel_sum_analytic(p: &RenderParams, homs: &[GpuHomography], i: u32, j: u
         acc += footprint_mean(p, &homs[k as usize], px, py);
     }
     acc
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Brute force: E[f(x + U(-p, p) + U(-q, q))] on a fine 2-D grid (f64).
+    fn brute(f: impl Fn(f64) -> f64, x: f64, p: f64, q: f64) -> f64 {
+        let n = 800;
+        let mut s = 0.0;
+        for i in 0..n {
+            for j in 0..n {
+                let u = -p + 2.0 * p * (i as f64 + 0.5) / n as f64;
+                let v = -q + 2.0 * q * (j as f64 + 0.5) / n as f64;
+                s += f(x + u + v);
+            }
+        }
+        s / (n * n) as f64
+    }
+
+    #[test]
+    fn square_mean_matches_brute_force() {
+        let sz = 0.02f64;
+        let sq = |y: f64| {
+            if (y / sz).floor() as i64 % 2 == 0 {
+                1.0
+            } else {
+                -1.0
+            }
+        };
+        // Footprints from a point to several squares, near and far from edges,
+        // at both signs of x (the regimes of tri_mean).
+        for &(x, p, q) in &[
+            (0.0105, 0.001, 0.0),
+            (0.0195, 0.0012, 0.0004),
+            (-0.0403, 0.002, 0.0019),
+            (0.5012, 0.004, 0.003),
+            (0.013, 0.009, 0.006),
+            (-0.27, 0.03, 0.011),
+            (0.0101, 0.000_001, 0.0),
+        ] {
+            let got = square_mean(x as f32, p as f32, q as f32, sz as f32, (1.0 / sz) as f32);
+            let want = brute(sq, x, p, q);
+            assert!(
+                (got as f64 - want).abs() < 2e-3,
+                "x {x} p {p} q {q}: {got} vs {want}"
+            );
+        }
+    }
+
+    #[test]
+    fn trapezoid_cdf_matches_brute_force() {
+        let step = |y: f64| if y <= 0.0 { 1.0 } else { 0.0 };
+        for &(x, p, q) in &[
+            (0.0, 1.0, 0.5),
+            (0.7, 1.0, 0.5),
+            (-1.2, 1.0, 0.5),
+            (0.3, 1.0, 0.0),
+            (0.2, 0.5, 0.5),
+            (-0.05, 0.3, 0.001),
+        ] {
+            let got = trap_cdf(x as f32, p as f32, q as f32, 1e-6);
+            // P(U + V <= x) = E[step(U + V - x)]
+            let want = brute(step, -x, p, q);
+            assert!(
+                (got as f64 - want).abs() < 2e-3,
+                "x {x} p {p} q {q}: {got} vs {want}"
+            );
+        }
+    }
 }

@@ -1,32 +1,33 @@
-//! Renderer throughput (printed, never asserted): pixel-samples per second
-//! on the GPU (whatever adapter is in use, e.g. lavapipe) and on the CPU twin
-//! with one thread and with all threads, at 320x240, 640x480 and 1920x1080;
-//! then the cost of a default-quality frame against blur length.
+//! Renderer cost (printed, never asserted): ms per 640x480 frame at the
+//! `default` preset for the two scenes of the render-speed goal (the full-view
+//! `checker:0.02` at 1 m, the blob board at 5 m), at three blur lengths, on
+//! the GPU (whatever adapter is in use, e.g. lavapipe) and the CPU twin (all
+//! threads), with both area integrators; and the equivalent throughput in
+//! pixel-samples (pixels x instants, or x samples for the lattice) per second.
 
-use glam::DVec3;
 use mmbm::error::Result;
 use mmbm::model::camera::Camera;
 use mmbm::model::motion::Twist;
-use mmbm::render::{maps, render_frame, Backend, Quality, RenderJob, Target, Trajectory};
+use mmbm::render::{
+    maps, render_frame, Backend, Integrator, Quality, RenderJob, Target, Trajectory,
+};
 use std::time::Instant;
 
-fn job(w: u32, h: u32, scale: f64, quality: Quality, backend: Backend) -> Result<RenderJob> {
-    let cam = Camera::thesis().with_resolution(w, h);
-    let tw = Twist::new(
-        DVec3::new(0.4, -0.6, 0.3) * scale,
-        DVec3::new(0.05, 0.0, 0.1) * scale,
-    );
-    let mut j = RenderJob::new(
-        cam,
-        Trajectory::from_twist(tw, 0.05)?,
-        Target::checker(0.05, 2.0),
-    );
-    j.quality = quality;
-    j.backend = backend;
+/// The goal's motion: w = (0.3, -0.2, 0.5) rad/s, exposure scaled so that the
+/// largest image path over the sensor is `path_px`.
+fn job(target: &Target, path_px: f64) -> Result<RenderJob> {
+    let cam = Camera::thesis().with_resolution(640, 480);
+    let tw = Twist::rotation(0.3, -0.2, 0.5);
+    let probe = Trajectory::from_twist(tw, 0.05)?;
+    let l0 = maps::max_path_px(&cam, target, &probe);
+    let te = 0.05 * path_px / l0;
+    let mut j = RenderJob::new(cam, Trajectory::from_twist(tw, te)?, target.clone());
+    j.quality = Quality::Default;
     j.with_maps = false;
     Ok(j)
 }
 
+/// Best of `reps` wall times (s) and the samples per pixel.
 fn time(j: &RenderJob, reps: usize) -> Result<(f64, u32)> {
     let mut best = f64::INFINITY;
     let mut n = 0;
@@ -46,58 +47,45 @@ pub fn bench() -> Result<()> {
         Ok(c) => println!("render bench, GPU: {}", c.description),
         Err(e) => println!("render bench, no GPU ({e})"),
     }
-    println!("  64 samples/pixel, checker, best of 2 (M pixel-samples/s):");
+    println!("  640x480, default preset, best of 2; ms per frame (M pixel-samples/s)");
     println!(
-        "  {:>10} {:>10} {:>10} {:>10}",
-        "size", "gpu", "cpu x1", "cpu all"
+        "  {:<22} {:<9} {:>7} {:>6} {:>18} {:>18}",
+        "scene", "integr.", "path px", "N", "gpu", "cpu twin"
     );
-    let q = Quality::Custom {
-        min_samples: 64,
-        max_spacing_px: 1e9,
-    };
-    for (w, h) in [(320, 240), (640, 480), (1920, 1080)] {
-        let mut row = format!("  {:>10}", format!("{w}x{h}"));
-        let samples = (w * h) as f64 * 64.0;
-        let backends = [
-            (gpu.is_ok(), Backend::Gpu),
-            (true, Backend::Cpu { threads: Some(1) }),
-            (true, Backend::Cpu { threads: None }),
-        ];
-        for (ok, b) in backends {
-            if !ok {
-                row += &format!(" {:>10}", "-");
-                continue;
+    let scenes = [
+        ("checker:0.02 at 1 m", Target::checker(0.02, 1.0)),
+        ("blob board at 5 m", Target::blobs(1.0, 5.0)),
+    ];
+    for (name, target) in &scenes {
+        for integrator in [Integrator::Analytic, Integrator::Lattice] {
+            for path in [2.0, 20.0, 80.0] {
+                let mut j = job(target, path)?;
+                j.integrator = integrator;
+                let cell = |b: Backend, ok: bool| -> Result<(String, u32)> {
+                    if !ok {
+                        return Ok((format!("{:>18}", "-"), 0));
+                    }
+                    let jb = RenderJob {
+                        backend: b,
+                        ..j.clone()
+                    };
+                    let (t, n) = time(&jb, 2)?;
+                    let mps = 640.0 * 480.0 * n as f64 / t * 1e-6;
+                    Ok((format!("{:>9.0} ({:>6.0})", t * 1e3, mps), n))
+                };
+                let (g, _) = cell(Backend::Gpu, gpu.is_ok())?;
+                let (c, n) = cell(Backend::Cpu { threads: None }, true)?;
+                println!(
+                    "  {:<22} {:<9} {:>7.0} {:>6} {} {}",
+                    name,
+                    integrator.to_string(),
+                    path,
+                    n,
+                    g,
+                    c
+                );
             }
-            let (t, _) = time(&job(w, h, 1.0, q, b)?, 2)?;
-            row += &format!(" {:>10.1}", samples / t * 1e-6);
         }
-        println!("{row}");
-    }
-    println!("  cost vs blur length, 320x240, default quality:");
-    println!(
-        "  {:>10} {:>8} {:>10} {:>10}",
-        "max px", "N", "gpu ms", "cpu ms"
-    );
-    for scale in [0.25, 1.0, 4.0, 16.0] {
-        let j = job(
-            320,
-            240,
-            scale,
-            Quality::Default,
-            Backend::Cpu { threads: None },
-        )?;
-        let l = maps::max_path_px(&j.camera, &j.target, &j.trajectory);
-        let g = if gpu.is_ok() {
-            let jg = RenderJob {
-                backend: Backend::Gpu,
-                ..j.clone()
-            };
-            format!("{:>10.1}", time(&jg, 1)?.0 * 1e3)
-        } else {
-            format!("{:>10}", "-")
-        };
-        let (tc, n) = time(&j, 1)?;
-        println!("  {:>10.1} {:>8} {} {:>10.1}", l, n, g, tc * 1e3);
     }
     Ok(())
 }
