@@ -323,8 +323,8 @@ fn an_interrupt_removes_temporary_files() {
         "no temporary file appeared: {:?}",
         leftovers(d.path(), &[])
     );
-    let st = Command::new("kill")
-        .args(["-INT", &child.id().to_string()])
+    let st = Command::new("sh")
+        .args(["-c", &format!("kill -INT {}", child.id())])
         .status()
         .unwrap();
     assert!(st.success());
