@@ -22,7 +22,7 @@
 //! | 3 | [`field`], [`tables`] | the flow-field kernel (GPU + CPU twin); thesis tables |
 //! | 4 | [`series`], [`render`] | MMBM of a log (CPU and GPU batch); the blur renderer |
 //! | 5 | [`trigger`] | trigger policies |
-//! | 6 | [`experiment`] | the thesis experiment end to end |
+//! | 6 | [`experiment`], [`dataset`] | the thesis experiment end to end; blur datasets at scale |
 //!
 //! The `mmbm` binary (`src/cli/`, benchmarks included) sits on top.
 #![deny(unsafe_code)]
@@ -30,6 +30,7 @@
 
 pub mod assess;
 pub mod board;
+pub mod dataset;
 pub mod error;
 pub mod experiment;
 pub mod field;

@@ -110,6 +110,13 @@ proptest! {
     }
 
     #[test]
+    fn dataset_toml(bytes in inputs(b"count = 24\nseed = 3\nmotion = [\"sim:fast\"]\nexposure_s = [0.01, 0.05]\n")) {
+        let d = tempfile::tempdir().unwrap();
+        let p = write(d.path(), "ds.toml", &bytes);
+        names_file(mmbm::dataset::DatasetConfig::load(&p), "ds.toml")?;
+    }
+
+    #[test]
     fn images(bytes in inputs(&std::fs::read(fixture("tests/fixtures/bars.png")).unwrap())) {
         let d = tempfile::tempdir().unwrap();
         let p = write(d.path(), "img.png", &bytes);

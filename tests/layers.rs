@@ -28,6 +28,7 @@ const LAYERS: &[(&str, u32)] = &[
     ("render", 4),
     ("trigger", 5),
     ("experiment", 6),
+    ("dataset", 6),
 ];
 
 fn layer(m: &str) -> Option<u32> {

@@ -4,6 +4,7 @@ mod args;
 mod assess;
 mod bench;
 mod blobs;
+mod dataset;
 mod demo;
 mod eval;
 mod experiment;
@@ -68,6 +69,8 @@ enum Command {
     Demo(demo::DemoArgs),
     /// Trigger decisions in real time from an IMU stream (stdin, UDP, replay).
     Live(live::LiveArgs),
+    /// Blur datasets: sharp/blurred pairs, flow and blur maps, sharded on SLURM or Kubernetes.
+    Dataset(dataset::DatasetArgs),
 }
 
 /// Parses arguments, runs, prints errors; returns the exit code.
@@ -95,6 +98,7 @@ pub fn main() -> i32 {
         Command::Experiment(a) => experiment::run(a),
         Command::Demo(a) => demo::run(a),
         Command::Live(a) => live::run(a),
+        Command::Dataset(a) => dataset::run(a),
     };
     match r {
         Ok(()) => 0,

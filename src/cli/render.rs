@@ -135,19 +135,8 @@ fn pair(s: &str, what: &str) -> Result<[f64; 2]> {
 }
 
 fn write_image(p: &Path, o: &RenderOutput) -> Result<()> {
-    if check_ext(p, &["exr", "png"], "output")? == "exr" {
-        let n = (o.width * o.height) as usize;
-        let ch = |c: usize| (0..n).map(|i| o.rgb[3 * i + c]).collect::<Vec<f32>>();
-        let (r, g, b) = (ch(0), ch(1), ch(2));
-        write_exr(
-            p,
-            o.width as usize,
-            o.height as usize,
-            &[("R", &r), ("G", &g), ("B", &b)],
-        )
-    } else {
-        write_png_linear_rgb(p, o.width, o.height, &o.rgb)
-    }
+    check_ext(p, &["exr", "png"], "output")?;
+    o.write_image(p)
 }
 
 pub fn run(args: RenderArgs) -> Result<()> {
@@ -250,16 +239,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
     all_or_nothing(|| {
         write_image(&a.out, &out)?;
         if let (Some(p), Some(m)) = (&a.maps, &out.maps) {
-            write_exr(
-                p,
-                m.width as usize,
-                m.height as usize,
-                &[
-                    ("path_px", &m.path_px),
-                    ("disp_px", &m.disp_px),
-                    ("speed_px_s", &m.speed_px_s),
-                ],
-            )?;
+            m.write_exr(p)?;
             let mm = m.means();
             eprintln!(
                 "exposure MMBM: mean path {:.3} px, mean displacement {:.3} px, mean speed {:.2} px/s = {:.4} mm/s ({:.1}% of pixels tracked)",

@@ -42,6 +42,20 @@ pub struct BlurMeans {
 }
 
 impl BlurMaps {
+    /// Writes the maps as a float EXR (channels `path_px`, `disp_px`, `speed_px_s`).
+    pub fn write_exr(&self, path: &std::path::Path) -> crate::error::Result<()> {
+        crate::io::images::write_exr(
+            path,
+            self.width as usize,
+            self.height as usize,
+            &[
+                ("path_px", &self.path_px),
+                ("disp_px", &self.disp_px),
+                ("speed_px_s", &self.speed_px_s),
+            ],
+        )
+    }
+
     /// Sensor means, f64 accumulation.
     pub fn means(&self) -> BlurMeans {
         let mut s = [0.0f64; 3];

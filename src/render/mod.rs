@@ -255,6 +255,32 @@ pub struct RenderOutput {
     pub backend_used: String,
 }
 
+impl RenderOutput {
+    /// Writes the image: `.exr` (linear float R, G, B) or `.png` (sRGB 8-bit),
+    /// by extension.
+    pub fn write_image(&self, path: &std::path::Path) -> Result<()> {
+        let is_exr = path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("exr"));
+        if !is_exr {
+            return crate::io::images::write_png_linear_rgb(
+                path,
+                self.width,
+                self.height,
+                &self.rgb,
+            );
+        }
+        let n = (self.width * self.height) as usize;
+        let ch = |c: usize| (0..n).map(|i| self.rgb[3 * i + c]).collect::<Vec<f32>>();
+        crate::io::images::write_exr(
+            path,
+            self.width as usize,
+            self.height as usize,
+            &[("R", &ch(0)), ("G", &ch(1)), ("B", &ch(2))],
+        )
+    }
+}
+
 static ANNOUNCED: AtomicBool = AtomicBool::new(false);
 
 /// Renders one frame.

@@ -1,0 +1,146 @@
+//! `mmbm dataset`: blur datasets, sharded on SLURM job arrays or Kubernetes
+//! Indexed Jobs.
+
+use clap::Args;
+use mmbm::dataset::{self, DatasetConfig, Shard};
+use mmbm::error::{Error, Result};
+use std::path::PathBuf;
+
+/// Generate a blur dataset: sharp/blurred pairs, flow and blur maps, a manifest.
+#[derive(Args, Debug)]
+#[command(
+    after_help = "Each item i (0-based) depends only on the configuration and i, so any split
+of the work gives the same bytes. Item files: DIR/items/NNNNNNNN/{blurred,sharp}.{exr,png}
+(linear EXR, sRGB PNG), flow.exr (flow.u, flow.v at exposure start, px/s), maps.exr (path_px,
+disp_px, speed_px_s), item.json (its manifest line: every parameter, the instantaneous MMBM at
+exposure start and the exposure MMBM, file sizes and SHA-256). A rerun skips complete items.
+
+Sharding: --shard K/N (K from 1) makes the items with i mod N = K-1 and writes
+DIR/manifest.part-K-of-N.jsonl; without --shard, a SLURM job array (SLURM_ARRAY_TASK_ID,
+SLURM_ARRAY_TASK_COUNT, SLURM_ARRAY_TASK_MIN) or a Kubernetes Indexed Job
+(JOB_COMPLETION_INDEX, with --shard-count N) picks the shard; otherwise the whole set is made
+and DIR/manifest.jsonl written. --merge joins the parts into DIR/manifest.jsonl.
+
+Examples:
+  mmbm dataset --print-config > ds.toml
+  mmbm dataset --config ds.toml --out data/
+  mmbm dataset --config ds.toml --out data/ --shard 2/8
+  mmbm dataset --merge --out data/ && mmbm dataset --verify --out data/
+  sbatch --array=1-8 examples/dataset.sbatch     (see examples/dataset-job.yaml for Kubernetes)"
+)]
+pub struct DatasetArgs {
+    /// TOML configuration (missing keys take the defaults; see --print-config).
+    #[arg(long, value_name = "FILE")]
+    pub config: Option<PathBuf>,
+    /// Dataset directory.
+    #[arg(long, value_name = "DIR", required_unless_present = "print_config")]
+    pub out: Option<PathBuf>,
+    /// Make shard K of N (K from 1).
+    #[arg(long, value_name = "K/N")]
+    pub shard: Option<String>,
+    /// Number of shards of a Kubernetes Indexed Job (with JOB_COMPLETION_INDEX).
+    #[arg(long, value_name = "N")]
+    pub shard_count: Option<u64>,
+    /// Join DIR/manifest.part-K-of-N.jsonl into DIR/manifest.jsonl.
+    #[arg(long, conflicts_with_all = ["config", "shard", "verify", "print_config"])]
+    pub merge: bool,
+    /// Check DIR against DIR/manifest.jsonl (files, sizes, SHA-256, indices).
+    #[arg(long, conflicts_with_all = ["config", "shard", "print_config"])]
+    pub verify: bool,
+    /// Print the default configuration as TOML and exit.
+    #[arg(long)]
+    pub print_config: bool,
+    /// No progress bar.
+    #[arg(long)]
+    pub quiet: bool,
+}
+
+/// The shard from `--shard`, else from a scheduler's environment, else all.
+fn shard(a: &DatasetArgs) -> Result<(Shard, &'static str)> {
+    if let Some(s) = &a.shard {
+        return Ok((Shard::parse(s)?, "--shard"));
+    }
+    let env = |k: &str| std::env::var(k).ok().filter(|v| !v.is_empty());
+    let num = |k: &str, v: String| {
+        v.trim()
+            .parse::<u64>()
+            .map_err(|_| Error::invalid(k, format!("'{v}' is not a whole number")))
+    };
+    if let Some(id) = env("SLURM_ARRAY_TASK_ID") {
+        let id = num("SLURM_ARRAY_TASK_ID", id)?;
+        let count = env("SLURM_ARRAY_TASK_COUNT").ok_or_else(|| {
+            Error::invalid(
+                "SLURM_ARRAY_TASK_COUNT",
+                "not set (needed with SLURM_ARRAY_TASK_ID)",
+            )
+        })?;
+        let count = num("SLURM_ARRAY_TASK_COUNT", count)?;
+        let min = match env("SLURM_ARRAY_TASK_MIN") {
+            Some(m) => num("SLURM_ARRAY_TASK_MIN", m)?,
+            None => 0,
+        };
+        let k = id.checked_sub(min).ok_or_else(|| {
+            Error::invalid(
+                "SLURM_ARRAY_TASK_ID",
+                format!("{id} is below SLURM_ARRAY_TASK_MIN {min}"),
+            )
+        })?;
+        return Ok((Shard::new(k + 1, count)?, "SLURM job array"));
+    }
+    if let Some(idx) = env("JOB_COMPLETION_INDEX") {
+        let idx = num("JOB_COMPLETION_INDEX", idx)?;
+        let n = a.shard_count.ok_or_else(|| {
+            Error::invalid(
+                "--shard-count",
+                "JOB_COMPLETION_INDEX is set (Kubernetes Indexed Job): give the Job's completions as --shard-count N",
+            )
+        })?;
+        return Ok((Shard::new(idx + 1, n)?, "Kubernetes Indexed Job"));
+    }
+    Ok((Shard::ALL, "no shard"))
+}
+
+pub fn run(a: DatasetArgs) -> Result<()> {
+    if a.print_config {
+        print!("{}", DatasetConfig::default().to_toml()?);
+        return Ok(());
+    }
+    let out = a
+        .out
+        .clone()
+        .ok_or_else(|| Error::invalid("dataset", "--out DIR is required"))?;
+    if a.merge {
+        let n = dataset::merge(&out)?;
+        eprintln!(
+            "merged {n} items into {}",
+            out.join("manifest.jsonl").display()
+        );
+        return Ok(());
+    }
+    if a.verify {
+        let n = dataset::verify(&out)?;
+        eprintln!(
+            "{}: {n} items, every file present and matching",
+            out.display()
+        );
+        return Ok(());
+    }
+    let cfg = match &a.config {
+        Some(p) => DatasetConfig::load(p)?,
+        None => DatasetConfig::default(),
+    };
+    let (sh, from) = shard(&a)?;
+    let s = dataset::run(&cfg, &out, sh, !a.quiet)?;
+    eprintln!(
+        "shard {}/{} ({from}): {} items ({} made, {} already complete) in {:.1} s ({:.1} items/min); wrote {}",
+        sh.k,
+        sh.n,
+        s.items,
+        s.made,
+        s.items - s.made,
+        s.seconds,
+        if s.seconds > 0.0 { s.made as f64 / s.seconds * 60.0 } else { 0.0 },
+        out.join(sh.manifest_name()).display()
+    );
+    Ok(())
+}

@@ -1,0 +1,291 @@
+//! One dataset item: its parameters (drawn from the configuration and the
+//! item's own seed) and the files made from them.
+
+use super::config::{DatasetConfig, MotionSource};
+use crate::error::{Error, Result};
+use crate::field::flow_field;
+use crate::io::gyro::{read_log, GyroOptions, GyroSample};
+use crate::io::images::write_exr;
+use crate::metric::{mmbm, Method, Scene};
+use crate::model::camera::Camera;
+use crate::model::motion::{Plane, Twist};
+use crate::render::{self, Backend, Quality, RenderJob, RenderOutput, Target, Trajectory};
+use crate::sim::{simulate, GaitConfig};
+use glam::DVec3;
+use rand::{Rng, SeedableRng};
+use serde::{Deserialize, Serialize};
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+/// Seconds of simulated walk before a simulated exposure may start.
+const SIM_SETTLE_S: f64 = 1.0;
+
+/// Every parameter of one item (the manifest's `params`): enough to make it
+/// again, given the texture folder and the logs.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ItemParams {
+    /// Item index.
+    pub index: u64,
+    /// The item's seed (renderer shifts, simulated walk).
+    pub seed: u64,
+    /// Texture file name in the texture folder.
+    pub texture: String,
+    /// Texture width on the target, m.
+    pub texture_width_m: f64,
+    /// Motion source (`sim:GAIT` or `log:PATH`).
+    pub motion: String,
+    /// Exposure start on the motion's clock, s.
+    pub start_s: f64,
+    /// Exposure, s.
+    pub exposure_s: f64,
+    /// Target distance at exposure start, m.
+    pub distance_m: f64,
+    /// Target tilt about x and y, degrees.
+    pub tilt_deg: [f64; 2],
+    /// Image size, px.
+    pub resolution: [u32; 2],
+    /// Render preset.
+    pub quality: String,
+    /// Linear velocity used.
+    pub use_velocity: bool,
+}
+
+/// The seed of item `i` (SplitMix64 of the master seed and `i`).
+pub fn item_seed(master: u64, i: u64) -> u64 {
+    let mut z = master ^ i.wrapping_mul(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}
+
+/// Inputs shared by all items: texture names and decoded logs.
+#[derive(Debug, Clone)]
+pub struct Sources {
+    /// The texture folder.
+    pub textures_dir: PathBuf,
+    /// Texture file names, sorted.
+    pub textures: Vec<String>,
+    logs: HashMap<PathBuf, Vec<GyroSample>>,
+}
+
+impl Sources {
+    /// Lists the textures (each checked to be a readable image) and reads
+    /// the logs of `cfg` (each checked to outlast the longest exposure).
+    pub fn open(cfg: &DatasetConfig) -> Result<Self> {
+        let dir = &cfg.textures;
+        let rd = std::fs::read_dir(dir).map_err(|e| Error::io(dir, e))?;
+        let mut textures = Vec::new();
+        for e in rd {
+            let e = e.map_err(|e| Error::io(dir, e))?;
+            let name = e.file_name().to_string_lossy().into_owned();
+            let ext = name.rsplit('.').next().unwrap_or("").to_ascii_lowercase();
+            if ["png", "jpg", "jpeg"].contains(&ext.as_str()) {
+                let p = dir.join(&name);
+                image::image_dimensions(&p).map_err(|e| Error::Image {
+                    path: p.clone(),
+                    message: format!("not a readable image: {e}"),
+                })?;
+                textures.push(name);
+            }
+        }
+        textures.sort();
+        if textures.is_empty() {
+            return Err(Error::invalid(
+                dir.display().to_string(),
+                "no texture images (.png, .jpg, .jpeg) in this folder",
+            ));
+        }
+        let mut logs = HashMap::new();
+        for m in &cfg.motion {
+            if let MotionSource::Log(p) = MotionSource::parse(m)? {
+                let s = read_log(&p, GyroOptions::default())?;
+                let span = s.last().map_or(0.0, |l| l.t) - s.first().map_or(0.0, |f| f.t);
+                if span < cfg.exposure_s[1] {
+                    return Err(Error::invalid(
+                        p.display().to_string(),
+                        format!(
+                            "the log spans {span:.4} s, shorter than the longest exposure ({} s)",
+                            cfg.exposure_s[1]
+                        ),
+                    ));
+                }
+                logs.insert(p, s);
+            }
+        }
+        Ok(Sources {
+            textures_dir: dir.clone(),
+            textures,
+            logs,
+        })
+    }
+}
+
+/// Draws the parameters of item `i` (depends only on `cfg` and `i`).
+pub fn plan(cfg: &DatasetConfig, src: &Sources, i: u64) -> Result<ItemParams> {
+    let seed = item_seed(cfg.seed, i);
+    let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
+    let mut draw = |r: [f64; 2]| {
+        let u: f64 = rng.gen();
+        r[0] + (r[1] - r[0]) * u
+    };
+    let exposure_s = draw(cfg.exposure_s);
+    let distance_m = draw(cfg.distance_m);
+    let tilt_deg = [draw(cfg.tilt_deg), draw(cfg.tilt_deg)];
+    let ti = (draw([0.0, 1.0]) * src.textures.len() as f64) as usize;
+    let mi = (draw([0.0, 1.0]) * cfg.motion.len() as f64) as usize;
+    let u_start = draw([0.0, 1.0]);
+    let texture = src.textures[ti.min(src.textures.len() - 1)].clone();
+    let motion = cfg.motion[mi.min(cfg.motion.len() - 1)].clone();
+    let (start_s, has_velocity) = match MotionSource::parse(&motion)? {
+        MotionSource::Sim(_) => (SIM_SETTLE_S + u_start, true),
+        MotionSource::Log(p) => {
+            let s = src.logs.get(&p).ok_or_else(|| {
+                Error::invalid("motion", format!("log {} was not opened", p.display()))
+            })?;
+            let (a, b) = (s[0].t, s[s.len() - 1].t - exposure_s);
+            (
+                a + (b - a) * u_start,
+                s.iter().all(|x| x.velocity.is_some()),
+            )
+        }
+    };
+    let cam = camera(cfg.resolution);
+    let fov_w = distance_m * cam.width as f64 * cam.pitch_x_mm / cam.focal_mm;
+    Ok(ItemParams {
+        index: i,
+        seed,
+        texture,
+        texture_width_m: cfg.fill * fov_w,
+        motion,
+        start_s,
+        exposure_s,
+        distance_m,
+        tilt_deg,
+        resolution: cfg.resolution,
+        quality: cfg.quality.clone(),
+        use_velocity: cfg.use_velocity && has_velocity,
+    })
+}
+
+fn camera(res: [u32; 2]) -> Camera {
+    Camera::thesis().with_resolution(res[0], res[1])
+}
+
+/// The samples an item's motion is a window of.
+fn samples(p: &ItemParams, src: &Sources) -> Result<Vec<GyroSample>> {
+    match MotionSource::parse(&p.motion)? {
+        MotionSource::Sim(g) => simulate(
+            &GaitConfig::preset(g),
+            SIM_SETTLE_S + 1.0 + p.exposure_s + 0.5,
+            600.0,
+            p.seed,
+        ),
+        MotionSource::Log(path) => match src.logs.get(&path) {
+            Some(s) => Ok(s.clone()),
+            None => read_log(&path, GyroOptions::default()),
+        },
+    }
+}
+
+/// The twist at time `t`: samples interpolated linearly (as the trajectory does).
+fn twist_at(s: &[GyroSample], t: f64, use_velocity: bool) -> Twist {
+    let j = s.partition_point(|x| x.t < t).clamp(1, s.len().max(2) - 1);
+    let (a, b) = (&s[j - 1], &s[j.min(s.len() - 1)]);
+    let f = if b.t > a.t {
+        ((t - a.t) / (b.t - a.t)).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let v = |x: &GyroSample| {
+        if use_velocity {
+            x.velocity.unwrap_or(DVec3::ZERO)
+        } else {
+            DVec3::ZERO
+        }
+    };
+    Twist::new(a.omega.lerp(b.omega, f), v(a).lerp(v(b), f))
+}
+
+/// What an item measured, for the manifest.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct ItemMeasures {
+    /// Instantaneous MMBM at exposure start (exact cubature), mm/s.
+    pub mmbm_start_mm_s: f64,
+    /// The same in px/s.
+    pub mmbm_start_px_s: f64,
+    /// Exposure MMBM (the blur maps' mean speed), px/s.
+    pub mmbm_exposure_px_s: f64,
+    /// The same in mm/s.
+    pub mmbm_exposure_mm_s: f64,
+    /// Mean image path length over the exposure (blur length), px.
+    pub blur_path_px: f64,
+}
+
+/// The files of an item, by name.
+pub const FILES: [&str; 6] = [
+    "blurred.exr",
+    "blurred.png",
+    "sharp.exr",
+    "sharp.png",
+    "flow.exr",
+    "maps.exr",
+];
+
+fn write_rgb(dir: &Path, stem: &str, o: &RenderOutput) -> Result<()> {
+    o.write_image(&dir.join(format!("{stem}.exr")))?;
+    o.write_image(&dir.join(format!("{stem}.png")))
+}
+
+/// Makes item `p` into `dir` (which must exist): the [`FILES`]. Rendered on
+/// the CPU twin: deterministic per pixel, so the same build gives the same
+/// bytes on machines of the same architecture and C library.
+pub fn make(p: &ItemParams, src: &Sources, dir: &Path) -> Result<ItemMeasures> {
+    let cam = camera(p.resolution);
+    let s = samples(p, src)?;
+    let traj = Trajectory::from_log(&s, p.start_s, p.exposure_s, p.use_velocity)?;
+    let tex = src.textures_dir.join(&p.texture);
+    let spec = format!("image:{}:{}", tex.display(), p.texture_width_m);
+    let mut target = Target::parse(&spec, p.distance_m)?;
+    target.tilt_deg = p.tilt_deg;
+    let mut job = RenderJob::new(cam, traj, target.clone());
+    job.quality = p.quality.parse::<Quality>()?;
+    job.backend = Backend::Cpu { threads: None };
+    job.seed = p.seed as u32;
+    job.with_maps = true;
+    let blurred = render::render_frame(&job)?;
+    let sharp = render::render_sharp(&job)?;
+    let maps = blurred
+        .maps
+        .as_ref()
+        .ok_or_else(|| Error::invalid("item", "the renderer returned no blur maps"))?;
+    let f = target.frame();
+    let scene = Scene {
+        camera: cam,
+        plane: Some(Plane {
+            normal: f.normal,
+            d: f.normal.dot(f.origin),
+        }),
+    };
+    let tw = twist_at(&s, p.start_s, p.use_velocity);
+    let flow = flow_field(&scene, &tw, 0, 0, Backend::Cpu { threads: None })?;
+    let start = mmbm(&scene, &tw, "exact:1e-9".parse::<Method>()?)?;
+    write_rgb(dir, "blurred", &blurred)?;
+    write_rgb(dir, "sharp", &sharp)?;
+    let (w, h) = (flow.width as usize, flow.height as usize);
+    write_exr(
+        &dir.join("flow.exr"),
+        w,
+        h,
+        &[("flow.u", &flow.u), ("flow.v", &flow.v)],
+    )?;
+    maps.write_exr(&dir.join("maps.exr"))?;
+    let m = maps.means();
+    Ok(ItemMeasures {
+        mmbm_start_mm_s: start.mm_s,
+        mmbm_start_px_s: start.px_s,
+        mmbm_exposure_px_s: m.speed_px_s,
+        mmbm_exposure_mm_s: m.speed_px_s * cam.pitch_x_mm,
+        blur_path_px: m.path_px,
+    })
+}
