@@ -119,3 +119,35 @@ fn bad_config_is_a_clear_error() {
         .to_string()
         .contains("unknown"));
 }
+
+#[test]
+fn several_seeds_are_pooled_in_the_headline() {
+    let d = tempfile::tempdir().unwrap();
+    let cfg = ExperimentConfig {
+        walks: vec!["moderate".into()],
+        seeds: vec![3, 4],
+        duration_s: 4.0,
+        policies: vec!["fixed:5".into(), "threshold:0.4".into()],
+        resolution: [160, 120],
+        quality: "16:1.0".into(),
+        start_distance_m: 3.0,
+        ..ExperimentConfig::default()
+    };
+    let o = experiment::run(&cfg, d.path(), false).unwrap();
+    let names: Vec<&str> = o.walks.iter().map(|w| w.name.as_str()).collect();
+    assert_eq!(names, ["moderate-s3", "moderate-s4"]);
+    let csv = std::fs::read_to_string(d.path().join("frames.csv")).unwrap();
+    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    let col = header.iter().position(|h| *h == "seed").unwrap();
+    let mut seeds: Vec<&str> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').nth(col).unwrap())
+        .collect();
+    seeds.dedup();
+    assert_eq!(seeds, ["3", "4"]);
+    let md = std::fs::read_to_string(d.path().join("report.md")).unwrap();
+    assert!(md.contains("## Headline: sharp frames per second"), "{md}");
+    assert!(md.contains("seeds [3, 4]"), "{md}");
+    assert!(md.contains("| moderate | threshold:0.4 |"), "{md}");
+}

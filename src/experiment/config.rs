@@ -19,6 +19,9 @@ pub struct ExperimentConfig {
     pub rate_hz: f64,
     /// Simulation seed.
     pub seed: u64,
+    /// Several simulation seeds (each walk simulated once per seed; the
+    /// headline pools them). Empty: `seed` alone.
+    pub seeds: Vec<u64>,
     /// A real gyro log (CSV of SPEC section 5) instead of the simulation.
     pub gyro: Option<PathBuf>,
     /// Forward speed (m/s) used for the target distance when the log has no velocity.
@@ -54,6 +57,7 @@ impl Default for ExperimentConfig {
             duration_s: 18.0,
             rate_hz: 600.0,
             seed: 1,
+            seeds: Vec::new(),
             gyro: None,
             speed_m_s: 0.17,
             policies: [
@@ -84,6 +88,23 @@ impl Default for ExperimentConfig {
 }
 
 impl ExperimentConfig {
+    /// The seeds to run: `seeds`, or `seed` when `seeds` is empty.
+    pub fn seed_list(&self) -> Vec<u64> {
+        if self.seeds.is_empty() {
+            vec![self.seed]
+        } else {
+            self.seeds.clone()
+        }
+    }
+
+    /// The `mmbm demo --full` configuration: the demo over seeds 1 to 5.
+    pub fn demo_full() -> Self {
+        ExperimentConfig {
+            seeds: (1..=5).collect(),
+            ..Self::default()
+        }
+    }
+
     /// The `mmbm demo` configuration: the defaults (every kept frame of every
     /// policy rendered at the `default` preset).
     pub fn demo() -> Self {
@@ -109,6 +130,15 @@ impl ExperimentConfig {
         use crate::error::positive;
         positive("duration_s", self.duration_s)?;
         positive("rate_hz", self.rate_hz)?;
+        let mut seeds = self.seeds.clone();
+        seeds.sort_unstable();
+        seeds.dedup();
+        if seeds.len() != self.seeds.len() || seeds.len() > 100 {
+            return Err(Error::invalid(
+                "seeds",
+                format!("{:?}: at most 100 seeds, each once", self.seeds),
+            ));
+        }
         positive("exposure_s", self.exposure_s)?;
         positive("start_distance_m", self.start_distance_m)?;
         positive("min_distance_m", self.min_distance_m)?;

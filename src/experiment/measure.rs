@@ -53,6 +53,8 @@ pub struct FrameMeasure {
 pub struct FrameRecord {
     /// Walk name.
     pub walk: String,
+    /// The walk's simulation seed (0 for a log).
+    pub seed: u64,
     /// The trigger decision and exposure.
     pub frame: Frame,
     /// Measurements on the rendered frame.

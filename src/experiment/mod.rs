@@ -11,6 +11,7 @@
 //! both the true motion and the measurement (its simulated gyro noise is part
 //! of the truth), and the board's distance follows the log's forward velocity.
 
+pub mod benefit;
 pub mod config;
 pub mod figures;
 pub mod measure;

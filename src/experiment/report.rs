@@ -12,7 +12,7 @@ use std::fmt::Write as _;
 /// Columns of `frames.csv` (the first six are the contract).
 pub const FRAMES_HEADER: &str = "policy,trigger_t,blur_px,jnbm,blobs_found,blobs_ok,walk,exposure_start,exposure_end,\
 mmbm_trigger_mm_s,mmbm_exposure_mm_s,kept,rendered,distance_m,disp_px,cpbd,blur_effect,laplacian_var,\
-blobs_matched,samples_per_pixel,render_ms,pose_err_m,pose_err_deg,quality";
+blobs_matched,samples_per_pixel,render_ms,pose_err_m,pose_err_deg,quality,seed";
 
 fn num(x: f64) -> String {
     if x.is_finite() {
@@ -32,7 +32,7 @@ pub fn frames_csv(records: &[FrameRecord], quality: &str) -> String {
         let g = |x: Option<f64>| x.map_or(String::new(), num);
         let _ = writeln!(
             s,
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
             f.policy,
             f.trigger_t,
             g(m.map(|m| m.blur_px)),
@@ -57,6 +57,7 @@ pub fn frames_csv(records: &[FrameRecord], quality: &str) -> String {
             g(m.map(|m| m.pose_err_m)),
             g(m.map(|m| m.pose_err_deg)),
             if m.is_some() { quality } else { "" },
+            r.seed,
         );
     }
     s
@@ -358,6 +359,14 @@ pub fn report_md(
     s += &format!(
         "Rendered {rendered} frames in {seconds:.1} s (mean render {mean_ms:.0} ms per frame, quality preset `{}`).\n\n",
         cfg.quality
+    );
+    let policies: Vec<String> = walks
+        .first()
+        .map(|w| w.runs.iter().map(|(p, _)| p.clone()).collect())
+        .unwrap_or_default();
+    s += &super::benefit::headline_md(
+        &super::benefit::headlines(walks, records, &policies),
+        &policies,
     );
     s += &findings(stats);
     s += "\n## Table 5.1: instantaneous MMBM at the trigger vs the exposure average\n\n";

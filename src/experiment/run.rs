@@ -41,10 +41,17 @@ pub fn run(cfg: &ExperimentConfig, out: &Path, progress: bool) -> Result<Outcome
     } else {
         cfg.walks.clone()
     };
-    let walks: Vec<Walk> = names
-        .iter()
-        .map(|w| make_walk(cfg, w, &scene))
-        .collect::<Result<_>>()?;
+    let seeds = cfg.seed_list();
+    let several = seeds.len() > 1 && cfg.gyro.is_none();
+    let mut walks: Vec<Walk> = Vec::new();
+    for w in &names {
+        for &seed in seeds
+            .iter()
+            .take(if cfg.gyro.is_some() { 1 } else { seeds.len() })
+        {
+            walks.push(make_walk(cfg, w, seed, several, &scene)?);
+        }
+    }
 
     // Plan the renders.
     let mut plan = Vec::new();
@@ -97,6 +104,7 @@ pub fn run(cfg: &ExperimentConfig, out: &Path, progress: bool) -> Result<Outcome
             for (fi, f) in frames.iter().enumerate() {
                 records.push(FrameRecord {
                     walk: w.name.clone(),
+                    seed: w.seed,
                     frame: f.clone(),
                     measure: measures.remove(&(wi, pi, fi)),
                 });

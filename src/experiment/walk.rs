@@ -13,8 +13,13 @@ use std::str::FromStr;
 /// One walk (simulated or a real log) with its MMBM series and every policy's frames.
 #[derive(Debug, Clone)]
 pub struct Walk {
-    /// `moderate`, `slow`, `fast` or the log's file name.
+    /// `moderate`, `slow`, `fast` or the log's file name; with several seeds,
+    /// `moderate-s2` etc.
     pub name: String,
+    /// The gait (or the log's file name), shared by the seeds of one walk.
+    pub gait: String,
+    /// Simulation seed (0 for a log).
+    pub seed: u64,
     /// The gyro samples (true motion and measurement).
     pub samples: Vec<GyroSample>,
     /// Rotation-only MMBM per sample (8x6 grid), mm/s.
@@ -25,8 +30,15 @@ pub struct Walk {
     pub runs: Vec<(String, Vec<Frame>)>,
 }
 
-/// Builds a walk from the configuration: the simulation of `gait`, or the log.
-pub fn make_walk(cfg: &ExperimentConfig, walk: &str, scene: &Scene) -> Result<Walk> {
+/// Builds a walk from the configuration: the simulation of `gait` with
+/// `seed`, or the log. `suffix` adds the seed to the name (several seeds).
+pub fn make_walk(
+    cfg: &ExperimentConfig,
+    walk: &str,
+    seed: u64,
+    suffix: bool,
+    scene: &Scene,
+) -> Result<Walk> {
     let (name, samples) = match &cfg.gyro {
         Some(p) => (
             p.file_name()
@@ -38,7 +50,7 @@ pub fn make_walk(cfg: &ExperimentConfig, walk: &str, scene: &Scene) -> Result<Wa
             let g = GaitConfig::preset(gait);
             (
                 walk.to_string(),
-                simulate(&g, cfg.duration_s, cfg.rate_hz, cfg.seed)?,
+                simulate(&g, cfg.duration_s, cfg.rate_hz, seed)?,
             )
         }
     };
@@ -62,8 +74,15 @@ pub fn make_walk(cfg: &ExperimentConfig, walk: &str, scene: &Scene) -> Result<Wa
         let frames = trigger::run(&samples, &mmbm, policy.as_mut(), &timing)?;
         runs.push((p.clone(), frames));
     }
+    let seed = if cfg.gyro.is_some() { 0 } else { seed };
     Ok(Walk {
-        name,
+        name: if suffix && cfg.gyro.is_none() {
+            format!("{name}-s{seed}")
+        } else {
+            name.clone()
+        },
+        gait: name,
+        seed,
         samples,
         mmbm,
         distance,

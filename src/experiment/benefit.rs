@@ -1,0 +1,375 @@
+//! The headline: sharp frames per second and ground-truth blur per policy,
+//! paired against the fixed-rate baseline, with bootstrap confidence
+//! intervals.
+//!
+//! A sharp frame is a kept, rendered frame in which all 16 blobs were found
+//! at their true places. Every walk (one per gait and seed) is cut into
+//! [`BLOCK_S`]-second blocks; a block holds, per policy, its sharp frames and
+//! the blur of its rendered frames. The statistics are ratios of sums over
+//! blocks (sharp frames / seconds, blur sum / frames), and the 95 % interval
+//! is the percentile interval of [`RESAMPLES`] resamplings of the blocks with
+//! replacement (seeded with [`BOOTSTRAP_SEED`]). Resampling blocks (all
+//! policies together) keeps the pairing: the policies share the walk's motion
+//! within a block. Blocks of 2 s hold about two gait cycles, so the
+//! dependence between frames is mostly inside them.
+
+use super::measure::FrameRecord;
+use super::walk::Walk;
+use crate::stats::percentile;
+use rand::{Rng, SeedableRng};
+
+/// Block length, s.
+pub const BLOCK_S: f64 = 2.0;
+/// Bootstrap resamples.
+pub const RESAMPLES: usize = 2000;
+/// Seed of the bootstrap's random numbers.
+pub const BOOTSTRAP_SEED: u64 = 20_261_123;
+
+/// A point estimate with its 95 % bootstrap interval.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Estimate {
+    /// On all blocks.
+    pub value: f64,
+    /// 2.5th percentile of the resamples.
+    pub lo: f64,
+    /// 97.5th percentile of the resamples.
+    pub hi: f64,
+}
+
+/// One policy's headline on one gait (all its seeds pooled).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Headline {
+    /// Gait (or log) name.
+    pub gait: String,
+    /// Policy string.
+    pub policy: String,
+    /// Seeds pooled.
+    pub seeds: Vec<u64>,
+    /// Blocks resampled.
+    pub blocks: usize,
+    /// Sharp frames per second.
+    pub sharp_fps: Estimate,
+    /// Sharp frames per second over the baseline's (None without a baseline).
+    pub ratio: Option<Estimate>,
+    /// Mean ground-truth blur of the rendered frames, px.
+    pub blur_px: Estimate,
+    /// Rendered frames (all kept frames rendered?).
+    pub rendered: usize,
+    /// Kept frames.
+    pub kept: usize,
+}
+
+/// Per block and policy: (sharp frames, blur sum, rendered frames); and the block's seconds.
+struct Block {
+    seconds: f64,
+    per_policy: Vec<(f64, f64, f64)>,
+}
+
+/// The baseline policy: `fixed:5` if run, else the first `fixed:*`.
+pub fn baseline(policies: &[String]) -> Option<usize> {
+    policies
+        .iter()
+        .position(|p| p == "fixed:5")
+        .or_else(|| policies.iter().position(|p| p.starts_with("fixed:")))
+}
+
+fn estimate(value: f64, mut draws: Vec<f64>) -> Estimate {
+    draws.retain(|x| x.is_finite());
+    if draws.is_empty() {
+        return Estimate {
+            value,
+            lo: f64::NAN,
+            hi: f64::NAN,
+        };
+    }
+    draws.sort_by(f64::total_cmp);
+    Estimate {
+        value,
+        lo: percentile(&draws, 2.5).unwrap_or(f64::NAN),
+        hi: percentile(&draws, 97.5).unwrap_or(f64::NAN),
+    }
+}
+
+/// The headline of every gait and policy (policies in configuration order).
+pub fn headlines(walks: &[Walk], records: &[FrameRecord], policies: &[String]) -> Vec<Headline> {
+    let mut gaits: Vec<&str> = Vec::new();
+    for w in walks {
+        if !gaits.contains(&w.gait.as_str()) {
+            gaits.push(&w.gait);
+        }
+    }
+    let base = baseline(policies);
+    let mut out = Vec::new();
+    for gait in gaits {
+        let ws: Vec<&Walk> = walks.iter().filter(|w| w.gait == gait).collect();
+        let mut blocks = Vec::new();
+        for w in &ws {
+            let (t0, t1) = (
+                w.samples.first().map_or(0.0, |s| s.t),
+                w.samples.last().map_or(0.0, |s| s.t),
+            );
+            let n = (((t1 - t0) / BLOCK_S).ceil() as usize).max(1);
+            let first = blocks.len();
+            for b in 0..n {
+                let a = t0 + b as f64 * BLOCK_S;
+                blocks.push(Block {
+                    seconds: (t1.min(a + BLOCK_S) - a).max(0.0),
+                    per_policy: vec![(0.0, 0.0, 0.0); policies.len()],
+                });
+            }
+            for r in records.iter().filter(|r| r.walk == w.name) {
+                let (Some(pi), Some(m)) = (
+                    policies.iter().position(|p| *p == r.frame.policy),
+                    r.measure.as_ref(),
+                ) else {
+                    continue;
+                };
+                if !r.frame.kept {
+                    continue;
+                }
+                let b = (((r.frame.trigger_t - t0) / BLOCK_S) as usize).min(n - 1);
+                let c = &mut blocks[first + b].per_policy[pi];
+                c.0 += f64::from(u8::from(m.blobs_ok));
+                c.1 += m.blur_px;
+                c.2 += 1.0;
+            }
+        }
+        let stat = |idx: &[usize], pi: usize| {
+            let (mut ok, mut secs, mut blur, mut n) = (0.0, 0.0, 0.0, 0.0);
+            for &k in idx {
+                let c = blocks[k].per_policy[pi];
+                ok += c.0;
+                blur += c.1;
+                n += c.2;
+                secs += blocks[k].seconds;
+            }
+            (ok / secs, blur / n)
+        };
+        let all: Vec<usize> = (0..blocks.len()).collect();
+        let mut rng = rand::rngs::StdRng::seed_from_u64(BOOTSTRAP_SEED);
+        let samples: Vec<Vec<usize>> = (0..RESAMPLES)
+            .map(|_| {
+                (0..blocks.len())
+                    .map(|_| rng.gen_range(0..blocks.len()))
+                    .collect()
+            })
+            .collect();
+        let mut seeds: Vec<u64> = ws.iter().map(|w| w.seed).collect();
+        seeds.sort_unstable();
+        for (pi, p) in policies.iter().enumerate() {
+            let (fps, blur) = stat(&all, pi);
+            let draws: Vec<(f64, f64)> = samples.iter().map(|s| stat(s, pi)).collect();
+            let ratio = base.map(|bi| {
+                let (bf, _) = stat(&all, bi);
+                let rd = samples
+                    .iter()
+                    .map(|s| stat(s, pi).0 / stat(s, bi).0)
+                    .collect();
+                estimate(fps / bf, rd)
+            });
+            let recs = records
+                .iter()
+                .filter(|r| &r.frame.policy == p && ws.iter().any(|w| w.name == r.walk));
+            let (mut rendered, mut kept) = (0, 0);
+            for r in recs {
+                kept += usize::from(r.frame.kept);
+                rendered += usize::from(r.frame.kept && r.measure.is_some());
+            }
+            out.push(Headline {
+                gait: gait.to_string(),
+                policy: p.clone(),
+                seeds: seeds.clone(),
+                blocks: blocks.len(),
+                sharp_fps: estimate(fps, draws.iter().map(|d| d.0).collect()),
+                ratio,
+                blur_px: estimate(blur, draws.iter().map(|d| d.1).collect()),
+                rendered,
+                kept,
+            });
+        }
+    }
+    out
+}
+
+fn ci(e: &Estimate, digits: usize) -> String {
+    if e.lo.is_finite() {
+        format!("{:.d$} [{:.d$}, {:.d$}]", e.value, e.lo, e.hi, d = digits)
+    } else {
+        format!("{:.d$}", e.value, d = digits)
+    }
+}
+
+/// The headline section of the report (its numbers and its sentences both
+/// computed from `hs`).
+pub fn headline_md(hs: &[Headline], policies: &[String]) -> String {
+    let mut s = String::from("## Headline: sharp frames per second\n\n");
+    let Some(first) = hs.first() else {
+        return s + "No frames.\n\n";
+    };
+    let base = baseline(policies).map(|b| policies[b].clone());
+    s += &format!(
+        "Sharp frame = kept, rendered, all 16 blobs found at their true places. Mean over the walk's {:.0}-s \
+         blocks pooled over seeds {:?} ({} blocks per gait), with 95 % percentile bootstrap intervals from {} \
+         resamplings of the blocks (bootstrap seed {}){}.\n\n",
+        BLOCK_S,
+        first.seeds,
+        first.blocks,
+        RESAMPLES,
+        BOOTSTRAP_SEED,
+        match &base {
+            Some(b) => format!("; the ratio is paired against `{b}` block by block"),
+            None => "; no fixed-rate baseline was run, so no ratio".into(),
+        }
+    );
+    s += "| walk | policy | sharp frames/s [95 % CI] | vs baseline [95 % CI] | mean blur px [95 % CI] | rendered / kept |\n";
+    s += "|---|---|---|---|---|---|\n";
+    for h in hs {
+        s += &format!(
+            "| {} | {} | {} | {} | {} | {} / {} |\n",
+            h.gait,
+            h.policy,
+            ci(&h.sharp_fps, 2),
+            h.ratio
+                .as_ref()
+                .map_or("-".into(), |r| format!("{}x", ci(r, 2))),
+            ci(&h.blur_px, 2),
+            h.rendered,
+            h.kept
+        );
+    }
+    s.push('\n');
+    // The best causal policy per gait, by the ratio's point estimate.
+    let mut gaits: Vec<&str> = hs.iter().map(|h| h.gait.as_str()).collect();
+    gaits.dedup();
+    for g in gaits {
+        let best = hs
+            .iter()
+            .filter(|h| h.gait == g && Some(&h.policy) != base.as_ref())
+            .filter(|h| crate::trigger::parse_policy(&h.policy).is_ok_and(|p| p.is_causal()))
+            .filter_map(|h| h.ratio.map(|r| (h, r)))
+            .max_by(|a, b| a.1.value.total_cmp(&b.1.value));
+        if let (Some((h, r)), Some(b)) = (best, &base) {
+            let goal = if r.value >= 1.5 && r.lo > 1.0 {
+                "meets the 1.5x goal, with the interval's lower bound above 1".to_string()
+            } else if r.lo > 1.0 {
+                format!("is better than `{b}` (lower bound above 1) but short of the 1.5x goal")
+            } else if r.hi < 1.0 {
+                format!("is worse than `{b}` (upper bound below 1)")
+            } else {
+                format!("is not distinguishable from `{b}` (the interval contains 1)")
+            };
+            s += &format!(
+                "- {g}: the best causal policy, `{}`, gets {:.2}x the sharp frames per second of `{b}` \
+                 (95 % CI {:.2}-{:.2}): it {goal}.\n",
+                h.policy, r.value, r.lo, r.hi
+            );
+        }
+    }
+    s.push('\n');
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::experiment::measure::FrameMeasure;
+    use crate::io::gyro::GyroSample;
+    use crate::trigger::Frame;
+
+    fn walk(seed: u64) -> Walk {
+        let samples = (0..=200)
+            .map(|k| GyroSample {
+                t: k as f64 * 0.1,
+                omega: glam::DVec3::ZERO,
+                velocity: None,
+                depth: None,
+            })
+            .collect();
+        Walk {
+            name: format!("w-s{seed}"),
+            gait: "w".into(),
+            seed,
+            samples,
+            mmbm: vec![],
+            distance: vec![],
+            runs: vec![],
+        }
+    }
+
+    fn record(seed: u64, policy: &str, t: f64, ok: bool, blur: f64) -> FrameRecord {
+        FrameRecord {
+            walk: format!("w-s{seed}"),
+            seed,
+            frame: Frame {
+                policy: policy.into(),
+                index: 0,
+                trigger_t: t,
+                exposure_start: t,
+                exposure_end: t + 0.07,
+                mmbm_trigger_mm_s: 0.0,
+                mmbm_exposure_mm_s: 0.0,
+                kept: true,
+            },
+            measure: Some(FrameMeasure {
+                distance_m: 3.0,
+                blur_px: blur,
+                disp_px: blur,
+                jnbm: 0.5,
+                cpbd: 0.5,
+                blur_effect: 0.3,
+                laplacian_var: 1.0,
+                blobs_found: 16,
+                blobs_matched: 16,
+                blobs_ok: ok,
+                pose_err_m: 0.0,
+                pose_err_deg: 0.0,
+                samples_per_pixel: 1,
+                render_ms: 1.0,
+            }),
+        }
+    }
+
+    #[test]
+    fn paired_ratio_and_intervals() {
+        let policies = vec!["fixed:5".to_string(), "threshold:0.4".to_string()];
+        let walks = vec![walk(1), walk(2)];
+        // Same pattern in every 2-s block: fixed 10 frames, 5 sharp (2.5/s,
+        // blur 4 px); threshold 8 frames, all sharp (4/s, blur 2 px).
+        let mut recs = Vec::new();
+        for seed in [1, 2] {
+            for k in 0..100 {
+                recs.push(record(seed, "fixed:5", k as f64 * 0.2, k % 2 == 0, 4.0));
+            }
+            for k in 0..80 {
+                recs.push(record(seed, "threshold:0.4", k as f64 * 0.25, true, 2.0));
+            }
+        }
+        let hs = headlines(&walks, &recs, &policies);
+        assert_eq!(hs.len(), 2);
+        assert_eq!(hs[0].blocks, 20);
+        let (f, t) = (&hs[0], &hs[1]);
+        assert!((f.sharp_fps.value - 2.5).abs() < 1e-12);
+        assert!((t.sharp_fps.value - 4.0).abs() < 1e-12);
+        let r = t.ratio.unwrap();
+        // Identical blocks: every resample gives the same ratio.
+        assert!(
+            (r.value - 1.6).abs() < 1e-12
+                && (r.lo - 1.6).abs() < 1e-12
+                && (r.hi - 1.6).abs() < 1e-12
+        );
+        assert!((t.blur_px.value - 2.0).abs() < 1e-12);
+        let md = headline_md(&hs, &policies);
+        assert!(md.contains("`threshold:0.4`, gets 1.60x"), "{md}");
+        assert!(md.contains("meets the 1.5x goal"), "{md}");
+
+        // Uneven blocks: the interval widens around the pooled value.
+        let mut recs2 = recs.clone();
+        recs2.retain(|r| {
+            !(r.frame.policy == "threshold:0.4" && r.seed == 1 && r.frame.trigger_t < 6.0)
+        });
+        let hs = headlines(&walks, &recs2, &policies);
+        let r = hs[1].ratio.unwrap();
+        assert!(r.lo < r.value && r.value < r.hi, "{r:?}");
+        assert!(r.value < 1.6 && r.hi > 1.5, "{r:?}");
+    }
+}
