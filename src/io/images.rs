@@ -53,6 +53,8 @@ pub type ExrChannels = Vec<(String, Vec<f32>)>;
 /// Reads every f32 (or f16, converted) channel of the first layer of an EXR:
 /// `(width, height, [(name, values)])`.
 pub fn read_exr(path: &Path) -> Result<(usize, usize, ExrChannels)> {
+    // A missing or unreadable file is an I/O error (as for every input).
+    std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
     // The header first: a file that claims more samples than any mmbm output
     // has is refused before anything is allocated for it.
     let meta = exr::meta::MetaData::read_from_file(path, false).map_err(|e| Error::Image {

@@ -1,0 +1,301 @@
+"""mmbm: camera motion blur from NumPy.
+
+The MMBM metric (mean image-plane flow speed over the sensor, mm/s), per-pixel
+flow fields (px/s), a ground-truth motion-blur renderer, gait simulation and
+trigger policies, over the Rust library of the ``mmbm`` command-line tool.
+
+Units: angular velocity rad/s, linear velocity m/s, distances m, times s,
+flow px/s, MMBM mm/s (divide by the pixel pitch for px/s). Camera frame: x
+right, y down, z along the optical axis. Long work releases the GIL. Errors
+raise ``ValueError`` (bad values) or ``OSError`` (files) with the library's
+message.
+
+>>> import mmbm, numpy as np
+>>> float(mmbm.metric([1.0, 1.0, 1.0], method="exact:1e-9"))  # doctest: +ELLIPSIS
+6.25637772...
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
+
+import numpy as np
+
+from . import _mmbm
+
+__all__ = [
+    "Camera",
+    "metric",
+    "series",
+    "read_gyro",
+    "flow_field",
+    "render",
+    "simulate",
+    "trigger",
+    "read_exr",
+]
+
+PathLike = Union[str, "os.PathLike[str]"]
+ArrayLike = Any
+
+
+@dataclass(frozen=True)
+class Camera:
+    """A pinhole camera (the keys of mmbm's camera files).
+
+    ``focal_mm``: focal length, mm; ``pitch_x_mm``, ``pitch_y_mm``: pixel
+    pitch, mm; ``width``, ``height``: sensor size, px; ``cx``, ``cy``:
+    principal point, px from the top-left corner (default: the centre);
+    ``skew``: px. ``Camera()`` is the thesis camera (4.2548 mm, 4.65 um,
+    640 x 480).
+    """
+
+    focal_mm: float = 4.2548
+    pitch_x_mm: float = 0.00465
+    pitch_y_mm: float = 0.00465
+    width: int = 640
+    height: int = 480
+    cx: Optional[float] = None
+    cy: Optional[float] = None
+    skew: float = 0.0
+
+    def __post_init__(self) -> None:
+        if self.cx is None:
+            object.__setattr__(self, "cx", self.width / 2.0)
+        if self.cy is None:
+            object.__setattr__(self, "cy", self.height / 2.0)
+        _mmbm.camera_check(self._tuple())
+
+    @classmethod
+    def from_file(cls, path: PathLike) -> "Camera":
+        """Reads a camera file (TOML or JSON, as ``mmbm --camera FILE``)."""
+        f, px, py, w, h, cx, cy, skew = _mmbm.camera_from_file(os.fspath(path))
+        return cls(f, px, py, w, h, cx, cy, skew)
+
+    def with_resolution(self, width: int, height: int) -> "Camera":
+        """Same focal length and pitch, another size, principal point at the centre."""
+        return Camera(self.focal_mm, self.pitch_x_mm, self.pitch_y_mm, width, height, None, None, self.skew)
+
+    def _tuple(self) -> Tuple[float, float, float, int, int, float, float, float]:
+        return (
+            float(self.focal_mm),
+            float(self.pitch_x_mm),
+            float(self.pitch_y_mm),
+            int(self.width),
+            int(self.height),
+            float(self.cx),  # type: ignore[arg-type]
+            float(self.cy),  # type: ignore[arg-type]
+            float(self.skew),
+        )
+
+
+def _cam(camera: Optional[Camera]) -> Tuple[float, float, float, int, int, float, float, float]:
+    return (camera or Camera())._tuple()
+
+
+def _rows3(x: ArrayLike, name: str) -> np.ndarray:
+    a = np.ascontiguousarray(np.asarray(x, dtype=np.float64))
+    if a.ndim == 1:
+        a = a.reshape(1, -1)
+    if a.ndim != 2 or a.shape[1] != 3:
+        raise ValueError(f"{name}: expected shape (3,) or (N, 3), got {np.shape(x)}")
+    return a
+
+
+def _plane(depth: Optional[float], plane: Optional[Sequence[float]]) -> Optional[np.ndarray]:
+    if depth is not None and plane is not None:
+        raise ValueError("give depth or plane, not both")
+    if depth is not None:
+        return np.array([0.0, 0.0, 1.0, float(depth)])
+    if plane is not None:
+        p = np.asarray(plane, dtype=np.float64).ravel()
+        if p.shape != (4,):
+            raise ValueError("plane: expected (nx, ny, nz, d)")
+        return p
+    return None
+
+
+def metric(
+    omega: ArrayLike,
+    velocity: Optional[ArrayLike] = None,
+    depth: Optional[float] = None,
+    plane: Optional[Sequence[float]] = None,
+    method: str = "riemann:8x6",
+    camera: Optional[Camera] = None,
+) -> np.ndarray:
+    """MMBM in mm/s of twists: ``omega`` (rad/s) of shape (3,) or (N, 3),
+    ``velocity`` (m/s) broadcast against it; translation needs ``depth`` (m,
+    a fronto-parallel plane) or ``plane`` = (nx, ny, nz, d) with n.X = d.
+    ``method``: ``riemann[:NUxNV]`` (the thesis's MMBM*), ``gauss[:N]``,
+    ``exact[:TOL]``. Returns shape () for one twist, (N,) for N."""
+    one = np.ndim(omega) == 1 and (velocity is None or np.ndim(velocity) == 1)
+    w = _rows3(omega, "omega")
+    v = _rows3(np.zeros(3) if velocity is None else velocity, "velocity")
+    w, v = np.broadcast_arrays(w, v)
+    out = _mmbm.metric(_cam(camera), np.ascontiguousarray(w), np.ascontiguousarray(v), _plane(depth, plane), method)
+    return out.reshape(()) if one else out
+
+
+def series(
+    t: ArrayLike,
+    omega: ArrayLike,
+    velocity: Optional[ArrayLike] = None,
+    depth: Optional[ArrayLike] = None,
+    plane: Optional[Sequence[float]] = None,
+    method: str = "riemann:8x6",
+    camera: Optional[Camera] = None,
+) -> np.ndarray:
+    """MMBM (mm/s) of every sample of a log: ``t`` (s, increasing, shape
+    (N,)), ``omega`` (N, 3) rad/s, optional ``velocity`` (N, 3) m/s with a
+    per-sample ``depth`` (N,) m or a ``plane``. The same as ``mmbm series``.
+    Arrays from ``telemetry_parser`` work as they are (see the README)."""
+    tt = np.ascontiguousarray(np.asarray(t, dtype=np.float64).ravel())
+    if not (np.all(np.isfinite(tt)) and np.all(np.diff(tt) > 0)):
+        raise ValueError("t: times must be finite and strictly increasing (s)")
+    w = _rows3(omega, "omega")
+    if w.shape[0] != tt.shape[0]:
+        raise ValueError(f"omega has {w.shape[0]} rows for {tt.shape[0]} times")
+    v = None if velocity is None else _rows3(velocity, "velocity")
+    if v is not None and v.shape[0] != tt.shape[0]:
+        raise ValueError(f"velocity has {v.shape[0]} rows for {tt.shape[0]} times")
+    d = None
+    if depth is not None:
+        d = np.ascontiguousarray(np.broadcast_to(np.asarray(depth, dtype=np.float64), tt.shape))
+    return _mmbm.series(_cam(camera), tt, w, v, d, _plane(None, plane), method)
+
+
+def read_gyro(
+    path: PathLike,
+    time_unit: str = "s",
+    angle_unit: str = "rad",
+    imu_rotation: Optional[Sequence[float]] = None,
+    time_offset: float = 0.0,
+    topic: Optional[str] = None,
+) -> Dict[str, np.ndarray]:
+    """Reads a gyro log (CSV ``t,wx,wy,wz[,vx,vy,vz][,depth]`` or a ROS 2
+    MCAP file with ``topic``): ``{"t": (N,) s, "omega": (N, 3) rad/s[,
+    "velocity": (N, 3) m/s][, "depth": (N,) m]}``, in the camera frame."""
+    rot = None if imu_rotation is None else ",".join(repr(float(x)) for x in np.ravel(imu_rotation))
+    return _mmbm.read_gyro(os.fspath(path), time_unit, angle_unit, rot, float(time_offset), topic)
+
+
+def flow_field(
+    omega: ArrayLike,
+    velocity: Optional[ArrayLike] = None,
+    depth: Optional[float] = None,
+    plane: Optional[Sequence[float]] = None,
+    camera: Optional[Camera] = None,
+    backend: str = "cpu",
+) -> np.ndarray:
+    """The image-plane flow (px/s) at every pixel centre: float32 array of
+    shape (H, W, 2), ``[..., 0]`` along x (right), ``[..., 1]`` along y
+    (down). ``backend``: ``cpu`` (the CPU twin), ``gpu`` or ``auto``."""
+    w = [float(x) for x in np.asarray(omega, dtype=np.float64).ravel()]
+    v = [0.0, 0.0, 0.0] if velocity is None else [float(x) for x in np.asarray(velocity, dtype=np.float64).ravel()]
+    if len(w) != 3 or len(v) != 3:
+        raise ValueError("omega and velocity: expected 3 values each")
+    return _mmbm.flow_field(_cam(camera), w, v, _plane(depth, plane), backend)
+
+
+def render(
+    omega: Optional[ArrayLike] = None,
+    velocity: Optional[ArrayLike] = None,
+    exposure: float = 0.05,
+    target: str = "checker:0.02",
+    distance: float = 1.0,
+    tilt: Sequence[float] = (0.0, 0.0),
+    offset: Sequence[float] = (0.0, 0.0),
+    background: Optional[Sequence[float]] = None,
+    gyro: Optional[Dict[str, np.ndarray]] = None,
+    at: Optional[float] = None,
+    use_velocity: bool = False,
+    resolution: Optional[Tuple[int, int]] = None,
+    quality: str = "default",
+    integrator: str = "auto",
+    backend: str = "cpu",
+    seed: int = 0,
+    maps: bool = True,
+    sharp: bool = False,
+    camera: Optional[Camera] = None,
+) -> Tuple[np.ndarray, Optional[Dict[str, np.ndarray]]]:
+    """Ground-truth motion blur of a planar target, as ``mmbm render``.
+
+    Motion: a constant twist (``omega`` rad/s, ``velocity`` m/s) for
+    ``exposure`` s, or a window of a log (``gyro`` = a ``read_gyro`` dict,
+    exposure starting at ``at`` s). Target: ``checker:S``, ``blobs[:SCALE]``
+    or ``image:PATH:WIDTH_M`` at ``distance`` m, ``tilt`` (deg about x, y),
+    ``offset`` (m), ``background`` (linear RGB). Returns ``(image, maps)``:
+    linear RGB float32 (H, W, 3) and, with ``maps``, ``{"path_px",
+    "disp_px", "speed_px_s"}`` (H, W) float32. ``sharp=True`` renders the
+    frame at exposure start instead."""
+    cam = camera or Camera()
+    if resolution is not None:
+        cam = cam.with_resolution(int(resolution[0]), int(resolution[1]))
+    w = None if omega is None else [float(x) for x in np.asarray(omega, dtype=np.float64).ravel()]
+    v = [0.0, 0.0, 0.0] if velocity is None else [float(x) for x in np.asarray(velocity, dtype=np.float64).ravel()]
+    bg = None if background is None else [float(x) for x in background]
+    g = None
+    if gyro is not None:
+        g = {k: np.asarray(gyro[k], dtype=np.float64) for k in ("t", "omega", "velocity") if k in gyro}
+    return _mmbm.render(
+        cam._tuple(),
+        target,
+        float(distance),
+        [float(x) for x in tilt],
+        [float(x) for x in offset],
+        bg,
+        float(exposure),
+        w,
+        v,
+        g,
+        None if at is None else float(at),
+        bool(use_velocity),
+        quality,
+        integrator,
+        backend,
+        int(seed),
+        bool(maps),
+        bool(sharp),
+    )
+
+
+def simulate(
+    gait: str = "moderate",
+    duration: float = 16.0,
+    seed: int = 0,
+    rate: float = 600.0,
+    config: Optional[PathLike] = None,
+) -> Dict[str, np.ndarray]:
+    """A seeded legged-gait log, as ``mmbm simulate``: ``{"t": (N,) s,
+    "omega": (N, 3) rad/s, "velocity": (N, 3) m/s}``. ``gait``: slow,
+    moderate or fast; ``config``: a gait TOML file over the preset."""
+    return _mmbm.simulate(gait, float(duration), float(rate), int(seed), None if config is None else os.fspath(config))
+
+
+def trigger(
+    t: ArrayLike,
+    mmbm: ArrayLike,
+    policy: Union[str, Sequence[str]],
+    exposure: float,
+    delay: float = 0.0025,
+    readout: float = 0.0125,
+    min_interval: float = 0.2,
+) -> List[Dict[str, Any]]:
+    """Runs trigger policies (``fixed:5``, ``threshold:0.4``, ``oracle:0.4``,
+    ...; see ``mmbm trigger --help``) on an MMBM series (``t`` s, ``mmbm``
+    mm/s): one dict per frame with ``policy``, ``trigger_t``,
+    ``exposure_start``, ``exposure_end`` (s), ``mmbm_trigger_mm_s``,
+    ``mmbm_exposure_mm_s`` and ``kept``, as ``mmbm trigger``'s CSV rows."""
+    policies = [policy] if isinstance(policy, str) else list(policy)
+    tt = np.ascontiguousarray(np.asarray(t, dtype=np.float64).ravel())
+    mm = np.ascontiguousarray(np.asarray(mmbm, dtype=np.float64).ravel())
+    if tt.shape != mm.shape:
+        raise ValueError(f"t has {tt.size} values, mmbm {mm.size}")
+    return _mmbm.trigger(tt, mm, policies, float(exposure), float(delay), float(readout), float(min_interval))
+
+
+def read_exr(path: PathLike) -> Dict[str, np.ndarray]:
+    """Reads a float EXR (mmbm's outputs): ``{channel: (H, W) float32}``."""
+    return _mmbm.read_exr(os.fspath(path))

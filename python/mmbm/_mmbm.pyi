@@ -1,0 +1,60 @@
+# Type stubs of the native module (python/src/lib.rs). The public API, with
+# docstrings and units, is mmbm/__init__.py.
+from typing import Any, Dict, List, Optional, Sequence, Tuple
+
+import numpy as np
+import numpy.typing as npt
+
+CamTuple = Tuple[float, float, float, int, int, float, float, float]
+F64 = npt.NDArray[np.float64]
+F32 = npt.NDArray[np.float32]
+
+def camera_from_file(path: str) -> CamTuple: ...
+def camera_thesis() -> CamTuple: ...
+def camera_check(cam: CamTuple) -> None: ...
+def metric(cam: CamTuple, omega: F64, velocity: F64, plane_: Optional[F64], method: str) -> F64: ...
+def series(
+    cam: CamTuple,
+    t: F64,
+    omega: F64,
+    velocity: Optional[F64],
+    depth: Optional[F64],
+    plane_: Optional[F64],
+    method: str,
+) -> F64: ...
+def read_gyro(
+    path: str,
+    time_unit: str,
+    angle_unit: str,
+    imu_rotation: Optional[str],
+    time_offset: float,
+    topic: Optional[str],
+) -> Dict[str, F64]: ...
+def flow_field(
+    cam: CamTuple, omega: Sequence[float], velocity: Sequence[float], plane_: Optional[F64], backend_: str
+) -> F32: ...
+def render(
+    cam: CamTuple,
+    target: str,
+    distance: float,
+    tilt: Sequence[float],
+    offset: Sequence[float],
+    background: Optional[Sequence[float]],
+    exposure: float,
+    omega: Optional[Sequence[float]],
+    velocity: Sequence[float],
+    gyro: Optional[Dict[str, F64]],
+    at: Optional[float],
+    use_velocity: bool,
+    quality: str,
+    integrator: str,
+    backend_: str,
+    seed: int,
+    maps: bool,
+    sharp: bool,
+) -> Tuple[F32, Optional[Dict[str, F32]]]: ...
+def simulate(gait: str, duration: float, rate: float, seed: int, config: Optional[str]) -> Dict[str, F64]: ...
+def trigger(
+    t: F64, mmbm_mm_s: F64, policies: List[str], exposure: float, delay: float, readout: float, min_interval: float
+) -> List[Dict[str, Any]]: ...
+def read_exr(path: str) -> Dict[str, F32]: ...

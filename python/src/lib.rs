@@ -1,0 +1,494 @@
+//! `mmbm._mmbm`: the native half of the Python package. Thin: every function
+//! takes contiguous float64 NumPy arrays whose shapes the Python half
+//! (`mmbm/__init__.py`) has already checked and broadcast, calls the mmbm
+//! library with the GIL released, and returns NumPy arrays. Library errors
+//! become `OSError` (files) or `ValueError` (everything else).
+
+use glam::DVec3;
+use mmbm::gpu::Backend;
+use mmbm::io::gyro::{parse_rotation, GyroOptions, GyroSample};
+use mmbm::metric::{Method, Scene};
+use mmbm::model::camera::Camera;
+use mmbm::model::motion::{Plane, Twist};
+use mmbm::render::{Integrator, Quality, RenderJob, Target, Trajectory};
+use numpy::ndarray::{Array1, Array2, Array3};
+use numpy::{IntoPyArray, PyReadonlyArray1, PyReadonlyArray2};
+use pyo3::exceptions::{PyOSError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use std::path::PathBuf;
+
+/// The camera as the Python half passes it.
+type CamTuple = (f64, f64, f64, u32, u32, f64, f64, f64);
+
+fn err(e: mmbm::Error) -> PyErr {
+    match e {
+        mmbm::Error::Io { .. } => PyOSError::new_err(e.to_string()),
+        _ => PyValueError::new_err(e.to_string()),
+    }
+}
+
+fn camera(c: CamTuple) -> PyResult<Camera> {
+    let (focal_mm, pitch_x_mm, pitch_y_mm, width, height, cx, cy, skew) = c;
+    let cam = Camera {
+        focal_mm,
+        pitch_x_mm,
+        pitch_y_mm,
+        width,
+        height,
+        cx,
+        cy,
+        skew,
+    };
+    cam.validate().map_err(err)?;
+    Ok(cam)
+}
+
+fn cam_tuple(c: &Camera) -> CamTuple {
+    (
+        c.focal_mm,
+        c.pitch_x_mm,
+        c.pitch_y_mm,
+        c.width,
+        c.height,
+        c.cx,
+        c.cy,
+        c.skew,
+    )
+}
+
+fn plane(p: Option<PyReadonlyArray1<f64>>) -> PyResult<Option<Plane>> {
+    let Some(p) = p else { return Ok(None) };
+    let v = p.as_slice()?;
+    if v.len() != 4 {
+        return Err(PyValueError::new_err("plane: expected (nx, ny, nz, d)"));
+    }
+    Ok(Some(Plane {
+        normal: DVec3::new(v[0], v[1], v[2]),
+        d: v[3],
+    }))
+}
+
+fn rows3(a: &PyReadonlyArray2<f64>) -> PyResult<Vec<DVec3>> {
+    let v = a.as_array();
+    if v.ncols() != 3 {
+        return Err(PyValueError::new_err("expected an (N, 3) array"));
+    }
+    Ok(v.rows()
+        .into_iter()
+        .map(|r| DVec3::new(r[0], r[1], r[2]))
+        .collect())
+}
+
+/// Reads a camera file (TOML or JSON): the tuple the Python `Camera` holds.
+#[pyfunction]
+fn camera_from_file(path: PathBuf) -> PyResult<CamTuple> {
+    Ok(cam_tuple(&Camera::load(&path).map_err(err)?))
+}
+
+/// The thesis camera.
+#[pyfunction]
+fn camera_thesis() -> CamTuple {
+    cam_tuple(&Camera::thesis())
+}
+
+/// Validates a camera tuple.
+#[pyfunction]
+fn camera_check(cam: CamTuple) -> PyResult<()> {
+    camera(cam).map(|_| ())
+}
+
+/// MMBM (mm/s) of each row of `omega` with the matching row of `velocity`.
+#[pyfunction]
+#[pyo3(signature = (cam, omega, velocity, plane_, method))]
+fn metric<'py>(
+    py: Python<'py>,
+    cam: CamTuple,
+    omega: PyReadonlyArray2<'py, f64>,
+    velocity: PyReadonlyArray2<'py, f64>,
+    plane_: Option<PyReadonlyArray1<'py, f64>>,
+    method: &str,
+) -> PyResult<Bound<'py, numpy::PyArray1<f64>>> {
+    let scene = Scene {
+        camera: camera(cam)?,
+        plane: plane(plane_)?,
+    };
+    let method: Method = method.parse().map_err(err)?;
+    let (w, v) = (rows3(&omega)?, rows3(&velocity)?);
+    let out = py
+        .detach(|| {
+            w.iter()
+                .zip(&v)
+                .map(|(w, v)| mmbm::mmbm(&scene, &Twist::new(*w, *v), method).map(|m| m.mm_s))
+                .collect::<mmbm::Result<Vec<f64>>>()
+        })
+        .map_err(err)?;
+    Ok(Array1::from(out).into_pyarray(py))
+}
+
+/// MMBM (mm/s) of a log: samples `t`, `omega`, optional `velocity` and `depth`.
+#[pyfunction]
+#[pyo3(signature = (cam, t, omega, velocity, depth, plane_, method))]
+#[allow(clippy::too_many_arguments)]
+fn series<'py>(
+    py: Python<'py>,
+    cam: CamTuple,
+    t: PyReadonlyArray1<'py, f64>,
+    omega: PyReadonlyArray2<'py, f64>,
+    velocity: Option<PyReadonlyArray2<'py, f64>>,
+    depth: Option<PyReadonlyArray1<'py, f64>>,
+    plane_: Option<PyReadonlyArray1<'py, f64>>,
+    method: &str,
+) -> PyResult<Bound<'py, numpy::PyArray1<f64>>> {
+    let w = rows3(&omega)?;
+    let v = velocity.as_ref().map(rows3).transpose()?;
+    let d = depth
+        .as_ref()
+        .map(|d| d.as_slice().map(|s| s.to_vec()))
+        .transpose()?;
+    let t = t.as_slice()?.to_vec();
+    let samples: Vec<GyroSample> = t
+        .iter()
+        .enumerate()
+        .map(|(k, &t)| GyroSample {
+            t,
+            omega: w[k],
+            velocity: v.as_ref().map(|v| v[k]),
+            depth: d.as_ref().map(|d| d[k]),
+        })
+        .collect();
+    let opts = mmbm::series::SeriesOptions {
+        scene: Scene {
+            camera: camera(cam)?,
+            plane: plane(plane_)?,
+        },
+        method: method.parse().map_err(err)?,
+        use_velocity: v.is_some(),
+    };
+    let out = py
+        .detach(|| mmbm::series::mmbm_series_with(&samples, &opts))
+        .map_err(err)?;
+    Ok(Array1::from(out).into_pyarray(py))
+}
+
+/// Reads a gyro log (CSV or MCAP): `{t, omega[, velocity][, depth]}`.
+#[pyfunction]
+#[pyo3(signature = (path, time_unit, angle_unit, imu_rotation, time_offset, topic))]
+fn read_gyro<'py>(
+    py: Python<'py>,
+    path: PathBuf,
+    time_unit: &str,
+    angle_unit: &str,
+    imu_rotation: Option<&str>,
+    time_offset: f64,
+    topic: Option<String>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let opts = GyroOptions {
+        time_unit: time_unit.parse().map_err(err)?,
+        angle_unit: angle_unit.parse().map_err(err)?,
+        imu_to_camera: match imu_rotation {
+            Some(r) => parse_rotation(r).map_err(err)?,
+            None => glam::DMat3::IDENTITY,
+        },
+        time_offset,
+        topic,
+    };
+    let s = py
+        .detach(|| mmbm::io::gyro::read_log(&path, opts))
+        .map_err(err)?;
+    samples_dict(py, &s)
+}
+
+fn samples_dict<'py>(py: Python<'py>, s: &[GyroSample]) -> PyResult<Bound<'py, PyDict>> {
+    let n = s.len();
+    let d = PyDict::new(py);
+    d.set_item(
+        "t",
+        Array1::from_iter(s.iter().map(|x| x.t)).into_pyarray(py),
+    )?;
+    let vec3 =
+        |f: &dyn Fn(&GyroSample) -> DVec3| Array2::from_shape_fn((n, 3), |(i, j)| f(&s[i])[j]);
+    d.set_item("omega", vec3(&|x| x.omega).into_pyarray(py))?;
+    if n > 0 && s.iter().all(|x| x.velocity.is_some()) {
+        d.set_item(
+            "velocity",
+            vec3(&|x| x.velocity.unwrap_or_default()).into_pyarray(py),
+        )?;
+    }
+    if n > 0 && s.iter().all(|x| x.depth.is_some()) {
+        let v = Array1::from_iter(s.iter().map(|x| x.depth.unwrap_or(f64::NAN)));
+        d.set_item("depth", v.into_pyarray(py))?;
+    }
+    Ok(d)
+}
+
+fn backend(b: &str) -> PyResult<Backend> {
+    match b {
+        "auto" => Ok(Backend::Auto),
+        "gpu" => Ok(Backend::Gpu),
+        "cpu" => Ok(Backend::Cpu { threads: None }),
+        _ => Err(PyValueError::new_err(format!(
+            "backend '{b}': expected auto, gpu or cpu"
+        ))),
+    }
+}
+
+/// The flow field (px/s) at every pixel centre: `(H, W, 2)` float32.
+#[pyfunction]
+#[pyo3(signature = (cam, omega, velocity, plane_, backend_))]
+fn flow_field<'py>(
+    py: Python<'py>,
+    cam: CamTuple,
+    omega: [f64; 3],
+    velocity: [f64; 3],
+    plane_: Option<PyReadonlyArray1<'py, f64>>,
+    backend_: &str,
+) -> PyResult<Bound<'py, numpy::PyArray3<f32>>> {
+    let scene = Scene {
+        camera: camera(cam)?,
+        plane: plane(plane_)?,
+    };
+    let tw = Twist::new(DVec3::from(omega), DVec3::from(velocity));
+    let b = backend(backend_)?;
+    let f = py
+        .detach(|| mmbm::field::flow_field(&scene, &tw, 0, 0, b))
+        .map_err(err)?;
+    let (w, h) = (f.width as usize, f.height as usize);
+    let a = Array3::from_shape_fn((h, w, 2), |(y, x, c)| {
+        if c == 0 {
+            f.u[y * w + x]
+        } else {
+            f.v[y * w + x]
+        }
+    });
+    Ok(a.into_pyarray(py))
+}
+
+/// Renders a frame: `(image (H, W, 3) float32 linear, maps dict or None)`.
+#[pyfunction]
+#[pyo3(signature = (cam, target, distance, tilt, offset, background, exposure, omega, velocity,
+    gyro, at, use_velocity, quality, integrator, backend_, seed, maps, sharp))]
+#[allow(clippy::too_many_arguments)]
+fn render<'py>(
+    py: Python<'py>,
+    cam: CamTuple,
+    target: &str,
+    distance: f64,
+    tilt: [f64; 2],
+    offset: [f64; 2],
+    background: Option<[f64; 3]>,
+    exposure: f64,
+    omega: Option<[f64; 3]>,
+    velocity: [f64; 3],
+    gyro: Option<Bound<'py, PyDict>>,
+    at: Option<f64>,
+    use_velocity: bool,
+    quality: &str,
+    integrator: &str,
+    backend_: &str,
+    seed: u32,
+    maps: bool,
+    sharp: bool,
+) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+    let camera = camera(cam)?;
+    let trajectory = match (omega, gyro) {
+        (Some(w), None) => {
+            Trajectory::from_twist(Twist::new(DVec3::from(w), DVec3::from(velocity)), exposure)
+                .map_err(err)?
+        }
+        (None, Some(g)) => {
+            let at = at.ok_or_else(|| PyValueError::new_err("at: required with gyro"))?;
+            let samples = dict_samples(&g)?;
+            Trajectory::from_log(&samples, at, exposure, use_velocity).map_err(err)?
+        }
+        _ => {
+            return Err(PyValueError::new_err(
+                "motion: give either omega or gyro (with at)",
+            ))
+        }
+    };
+    let mut t = Target::parse(target, distance).map_err(err)?;
+    t.tilt_deg = tilt;
+    t.offset = offset;
+    if let Some(b) = background {
+        t.background = [b[0] as f32, b[1] as f32, b[2] as f32];
+    }
+    t.validate_for(&camera).map_err(err)?;
+    let job = RenderJob {
+        camera,
+        trajectory,
+        target: t,
+        quality: quality.parse::<Quality>().map_err(err)?,
+        backend: backend(backend_)?,
+        seed,
+        integrator: integrator.parse::<Integrator>().map_err(err)?,
+        with_maps: maps,
+    };
+    let out = py
+        .detach(|| {
+            if sharp {
+                mmbm::render::render_sharp(&job)
+            } else {
+                mmbm::render::render_frame(&job)
+            }
+        })
+        .map_err(err)?;
+    let (w, h) = (out.width as usize, out.height as usize);
+    let img = Array3::from_shape_vec((h, w, 3), out.rgb)
+        .map_err(|e| PyValueError::new_err(e.to_string()))?
+        .into_pyarray(py)
+        .into_any();
+    let m = match out.maps {
+        Some(m) => {
+            let d = PyDict::new(py);
+            for (k, v) in [
+                ("path_px", m.path_px),
+                ("disp_px", m.disp_px),
+                ("speed_px_s", m.speed_px_s),
+            ] {
+                let a = Array2::from_shape_vec((h, w), v)
+                    .map_err(|e| PyValueError::new_err(e.to_string()))?;
+                d.set_item(k, a.into_pyarray(py))?;
+            }
+            d.into_any()
+        }
+        None => py.None().into_bound(py),
+    };
+    Ok((img, m))
+}
+
+/// Samples from a `{t, omega[, velocity][, depth]}` dict of arrays.
+fn dict_samples(g: &Bound<'_, PyDict>) -> PyResult<Vec<GyroSample>> {
+    let get = |k: &str| g.get_item(k);
+    let t: Vec<f64> = get("t")?
+        .ok_or_else(|| PyValueError::new_err("gyro: missing 't'"))?
+        .extract()?;
+    let w: Vec<[f64; 3]> = get("omega")?
+        .ok_or_else(|| PyValueError::new_err("gyro: missing 'omega'"))?
+        .extract()?;
+    let v: Option<Vec<[f64; 3]>> = get("velocity")?.map(|x| x.extract()).transpose()?;
+    if w.len() != t.len() || v.as_ref().is_some_and(|v| v.len() != t.len()) {
+        return Err(PyValueError::new_err("gyro: arrays of different lengths"));
+    }
+    Ok(t.iter()
+        .enumerate()
+        .map(|(k, &t)| GyroSample {
+            t,
+            omega: DVec3::from(w[k]),
+            velocity: v.as_ref().map(|v| DVec3::from(v[k])),
+            depth: None,
+        })
+        .collect())
+}
+
+/// A simulated gait log: `{t, omega, velocity}`.
+#[pyfunction]
+#[pyo3(signature = (gait, duration, rate, seed, config))]
+fn simulate<'py>(
+    py: Python<'py>,
+    gait: &str,
+    duration: f64,
+    rate: f64,
+    seed: u64,
+    config: Option<PathBuf>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let g: mmbm::sim::Gait = gait.parse().map_err(err)?;
+    let cfg = match config {
+        Some(p) => mmbm::sim::GaitConfig::load(&p, g).map_err(err)?,
+        None => mmbm::sim::GaitConfig::preset(g),
+    };
+    let s = py
+        .detach(|| mmbm::sim::simulate(&cfg, duration, rate, seed))
+        .map_err(err)?;
+    samples_dict(py, &s)
+}
+
+/// Runs policies on an MMBM series: a list of frame dicts.
+#[pyfunction]
+#[pyo3(signature = (t, mmbm_mm_s, policies, exposure, delay, readout, min_interval))]
+#[allow(clippy::too_many_arguments)]
+fn trigger<'py>(
+    py: Python<'py>,
+    t: PyReadonlyArray1<'py, f64>,
+    mmbm_mm_s: PyReadonlyArray1<'py, f64>,
+    policies: Vec<String>,
+    exposure: f64,
+    delay: f64,
+    readout: f64,
+    min_interval: f64,
+) -> PyResult<Vec<Bound<'py, PyDict>>> {
+    let t = t.as_slice()?.to_vec();
+    let m = mmbm_mm_s.as_slice()?.to_vec();
+    let samples: Vec<GyroSample> = t
+        .iter()
+        .map(|&t| GyroSample {
+            t,
+            omega: DVec3::ZERO,
+            velocity: None,
+            depth: None,
+        })
+        .collect();
+    let timing = mmbm::trigger::CameraTiming {
+        delay,
+        exposure,
+        readout,
+        min_interval,
+    };
+    let mut frames = Vec::new();
+    for p in &policies {
+        let f = py
+            .detach(|| {
+                let mut policy = mmbm::trigger::parse_policy(p)?;
+                mmbm::trigger::run(&samples, &m, policy.as_mut(), &timing)
+            })
+            .map_err(err)?;
+        frames.extend(f);
+    }
+    frames
+        .iter()
+        .map(|f| {
+            let d = PyDict::new(py);
+            d.set_item("policy", &f.policy)?;
+            d.set_item("index", f.index)?;
+            d.set_item("trigger_t", f.trigger_t)?;
+            d.set_item("exposure_start", f.exposure_start)?;
+            d.set_item("exposure_end", f.exposure_end)?;
+            d.set_item("mmbm_trigger_mm_s", f.mmbm_trigger_mm_s)?;
+            d.set_item("mmbm_exposure_mm_s", f.mmbm_exposure_mm_s)?;
+            d.set_item("kept", f.kept)?;
+            Ok(d)
+        })
+        .collect()
+}
+
+/// Reads a float EXR: `{channel: (H, W) float32}`.
+#[pyfunction]
+fn read_exr<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bound<'py, PyDict>> {
+    let (w, h, chans) = py
+        .detach(|| mmbm::io::images::read_exr(&path))
+        .map_err(err)?;
+    let d = PyDict::new(py);
+    for (name, v) in chans {
+        let a =
+            Array2::from_shape_vec((h, w), v).map_err(|e| PyValueError::new_err(e.to_string()))?;
+        d.set_item(name, a.into_pyarray(py))?;
+    }
+    Ok(d)
+}
+
+/// The native module.
+#[pymodule]
+fn _mmbm(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(camera_from_file, m)?)?;
+    m.add_function(wrap_pyfunction!(camera_thesis, m)?)?;
+    m.add_function(wrap_pyfunction!(camera_check, m)?)?;
+    m.add_function(wrap_pyfunction!(metric, m)?)?;
+    m.add_function(wrap_pyfunction!(series, m)?)?;
+    m.add_function(wrap_pyfunction!(read_gyro, m)?)?;
+    m.add_function(wrap_pyfunction!(flow_field, m)?)?;
+    m.add_function(wrap_pyfunction!(render, m)?)?;
+    m.add_function(wrap_pyfunction!(simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(trigger, m)?)?;
+    m.add_function(wrap_pyfunction!(read_exr, m)?)?;
+    Ok(())
+}
