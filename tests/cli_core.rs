@@ -65,7 +65,31 @@ fn eval_json_contract() {
         "gauss:8",
         "--json",
     ]);
-    assert!(v["mmbm_mm_s"].as_f64().unwrap() > 0.0);
+    // Against an independent midpoint sum of SPEC eq. 3.20 over the sensor
+    // (1280 x 960 cells, f64), with the tilted plane's per-pixel depth.
+    let (f, p, w, h) = (4.2548, 0.00465, 640.0, 480.0);
+    let (wx, wy, wz, vx, vy, vz) = (-0.1, 0.2, 0.0, 0.0, 0.0, 1.0);
+    let (n, d) = ([0.0, -0.3, 1.0], 2.0);
+    let (nu, nv) = (1280, 960);
+    let mut sum = 0.0;
+    for j in 0..nv {
+        for i in 0..nu {
+            let u = ((i as f64 + 0.5) / nu as f64 - 0.5) * w * p;
+            let v = ((j as f64 + 0.5) / nv as f64 - 0.5) * h * p;
+            let z = d / (n[0] * u / f + n[1] * v / f + n[2]);
+            let du =
+                wz * v - wy * f - (wy / f) * u * u + (wx / f) * u * v - (f / z) * vx + (u / z) * vz;
+            let dv = -wz * u + wx * f - (wy / f) * u * v + (wx / f) * v * v - (f / z) * vy
+                + (v / z) * vz;
+            sum += du.hypot(dv);
+        }
+    }
+    let reference = sum / (nu * nv) as f64;
+    let got = v["mmbm_mm_s"].as_f64().unwrap();
+    assert!(
+        (got - reference).abs() < 1e-5 * reference,
+        "{got} vs {reference}"
+    );
 }
 
 #[test]

@@ -27,14 +27,37 @@ fn calibration(g: Gait, seed: u64) -> (f64, f64, f64, f64) {
 
 #[test]
 fn calibration_figures() {
-    for g in [Gait::Slow, Gait::Moderate, Gait::Fast] {
-        let (peak, b4, b2, max) = calibration(g, 7);
+    // The README quotes these figures (seed 7); they must be what the
+    // simulator gives, to the digits printed there.
+    let readme =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/README.md")).unwrap();
+    let text = readme.split_whitespace().collect::<Vec<_>>().join(" ");
+    let (slow, moderate, fast) = (
+        calibration(Gait::Slow, 7),
+        calibration(Gait::Moderate, 7),
+        calibration(Gait::Fast, 7),
+    );
+    for (g, c) in [("slow", slow), ("moderate", moderate), ("fast", fast)] {
         println!(
-            "{g}: typical step peak {peak:.3} mm/s, max {max:.3}, below 0.4: {:.1} %, below 0.2: {:.1} %",
-            100.0 * b4,
-            100.0 * b2
+            "{g}: typical step peak {:.3} mm/s, max {:.3}, below 0.4: {:.1} %, below 0.2: {:.1} %",
+            c.0,
+            c.3,
+            100.0 * c.1,
+            100.0 * c.2
         );
     }
+    let quoted = format!(
+        "Calibration (rotation-only MMBM, 8x6, 60 s, seed 7): moderate walk typical peak {:.2} mm/s (max {:.2}), \
+         {:.1} % of the time below 0.4; slow {:.2} mm/s, {:.1} %; fast {:.2} mm/s, {:.0} %.",
+        moderate.0,
+        moderate.3,
+        100.0 * moderate.1,
+        slow.0,
+        100.0 * slow.1,
+        fast.0,
+        100.0 * fast.1
+    );
+    assert!(text.contains(&quoted), "README does not say: {quoted}");
 }
 
 #[test]

@@ -29,6 +29,10 @@ pub struct EvalArgs {
     /// Print one JSON object instead of text.
     #[arg(long)]
     pub json: bool,
+    /// Also give the expected blur length over an exposure of S seconds, px
+    /// (MMBM x S / pixel pitch, SPEC section 3).
+    #[arg(long, value_name = "S")]
+    pub exposure: Option<f64>,
     #[command(flatten)]
     pub camera: CameraArgs,
 }
@@ -39,6 +43,9 @@ pub fn run(a: EvalArgs) -> Result<()> {
         camera: a.camera.camera()?,
         plane: a.scene.plane()?,
     };
+    if let Some(te) = a.exposure {
+        mmbm::error::positive("--exposure (s)", te)?;
+    }
     let tw = Twist::new(a.omega, a.velocity.unwrap_or(DVec3::ZERO));
     let m = match method {
         Method::Gpu { width, height } => {
@@ -57,6 +64,10 @@ pub fn run(a: EvalArgs) -> Result<()> {
         if let Some(e) = m.error_estimate {
             o["error_estimate"] = serde_json::json!(e);
         }
+        if let Some(te) = a.exposure {
+            o["exposure_s"] = serde_json::json!(te);
+            o["blur_px"] = serde_json::json!(m.px_s * te);
+        }
         println!("{o}");
     } else {
         print!("MMBM = {:.10} mm/s = {:.6} px/s  ({method}", m.mm_s, m.px_s);
@@ -64,6 +75,9 @@ pub fn run(a: EvalArgs) -> Result<()> {
             print!(", error estimate {e:.2e} mm/s");
         }
         println!(")");
+        if let Some(te) = a.exposure {
+            println!("blur over {te} s: {:.4} px", m.px_s * te);
+        }
     }
     Ok(())
 }

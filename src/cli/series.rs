@@ -67,6 +67,10 @@ pub struct SeriesArgs {
     /// Output CSV (default: stdout).
     #[arg(long, value_name = "FILE")]
     pub out: Option<PathBuf>,
+    /// Add a blur_px column: the expected blur length over an exposure of S
+    /// seconds starting at each sample, px (MMBM x S / pitch, SPEC section 3).
+    #[arg(long, value_name = "S")]
+    pub exposure: Option<f64>,
     /// Include the log's vx,vy,vz (needs a depth column, --depth or --plane).
     #[arg(long)]
     pub use_velocity: bool,
@@ -97,16 +101,25 @@ pub fn run(a: SeriesArgs) -> Result<()> {
         _ => Box::new(move |b: &[mmbm::io::gyro::GyroSample]| series::eval_batch_cpu(b, &opts)),
     };
     let pitch = opts.scene.camera.pitch_x_mm;
+    if let Some(te) = a.exposure {
+        mmbm::error::positive("--exposure (s)", te)?;
+    }
     let n = match &a.out {
         Some(p) => {
             let mut n = 0;
             mmbm::io::atomic::write_atomic(p, |w| {
-                n = series::run(reader, &mut eval, pitch, w)?;
+                n = series::run(reader, &mut eval, pitch, a.exposure, w)?;
                 Ok(())
             })?;
             n
         }
-        None => series::run(reader, &mut eval, pitch, std::io::stdout().lock())?,
+        None => series::run(
+            reader,
+            &mut eval,
+            pitch,
+            a.exposure,
+            std::io::stdout().lock(),
+        )?,
     };
     eprintln!("{n} samples, method {method}");
     Ok(())

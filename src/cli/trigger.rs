@@ -14,7 +14,8 @@ use std::path::PathBuf;
 /// Run trigger policies on a gyro log: CSV of frames, summary.
 #[derive(Args, Debug)]
 #[command(
-    after_help = "Policies (X in mm/s, or pNN = NN-th percentile of the log's MMBM; FPS at most 1000):
+    after_help = "Policies (X in mm/s, or pNN = NN-th percentile of the whole log's MMBM, an offline calibration that
+looks at the future, so not causal: `mmbm live` refuses it; FPS at most 1000):
   fixed:FPS[@PHASE]  threshold:X  adaptive[:X[:FPS]]  oracle:X[:H]  forecast:X[:H]
   gate:X[:FPS[@PHASE]]  deadline:FPS[:X]
 

@@ -265,6 +265,34 @@ pub fn headline_md(hs: &[Headline], policies: &[String]) -> String {
             );
         }
     }
+    // The forecast's share of the oracle's gain (blur) over the thesis rule,
+    // for every forecast:X run beside threshold:X and oracle:X.
+    for h in hs.iter().filter(|h| h.policy.starts_with("forecast:")) {
+        let x = h.policy["forecast:".len()..]
+            .split(':')
+            .next()
+            .unwrap_or("");
+        let find = |name: String| hs.iter().find(|o| o.gait == h.gait && o.policy == name);
+        if let (Some(t), Some(o)) = (find(format!("threshold:{x}")), find(format!("oracle:{x}"))) {
+            let gain = t.blur_px.value - o.blur_px.value;
+            if gain > 0.0 {
+                s += &format!(
+                    "- {}: `{}` recovers {:.0} % of the oracle's blur reduction over `{}` (mean blur {:.2} px against \
+                     {:.2} for the thesis rule and {:.2} for `{}`), with {} kept frames against the oracle's {}.\n",
+                    h.gait,
+                    h.policy,
+                    100.0 * (t.blur_px.value - h.blur_px.value) / gain,
+                    t.policy,
+                    h.blur_px.value,
+                    t.blur_px.value,
+                    o.blur_px.value,
+                    o.policy,
+                    h.kept,
+                    o.kept
+                );
+            }
+        }
+    }
     s.push('\n');
     s
 }

@@ -125,10 +125,20 @@ pub type BatchFn<'a> = dyn FnMut(&[GyroSample]) -> Result<Vec<f64>> + 'a;
 /// Streams `reader` through `eval` in batches of [`BATCH`] and writes the CSV.
 /// Parsing runs on a second thread, overlapped with evaluation and
 /// formatting (shortest round-trip floats via `ryu`). Returns the number of samples.
-pub fn run<W: Write>(reader: GyroReader, eval: &mut BatchFn, pitch_mm: f64, out: W) -> Result<u64> {
+pub fn run<W: Write>(
+    reader: GyroReader,
+    eval: &mut BatchFn,
+    pitch_mm: f64,
+    exposure_s: Option<f64>,
+    out: W,
+) -> Result<u64> {
     let mut out = std::io::BufWriter::with_capacity(1 << 16, out);
     let werr = |e: std::io::Error| Error::io("<series output>", e);
-    out.write_all(b"t,mmbm_mm_s,mmbm_px_s\n").map_err(werr)?;
+    out.write_all(match exposure_s {
+        Some(_) => b"t,mmbm_mm_s,mmbm_px_s,blur_px\n".as_slice(),
+        None => b"t,mmbm_mm_s,mmbm_px_s\n".as_slice(),
+    })
+    .map_err(werr)?;
     let (tx, rx) = std::sync::mpsc::sync_channel::<Result<Vec<GyroSample>>>(2);
     std::thread::scope(|scope| {
         scope.spawn(move || {
@@ -159,6 +169,7 @@ pub fn run<W: Write>(reader: GyroReader, eval: &mut BatchFn, pitch_mm: f64, out:
         });
         let mut n = 0;
         let (mut a, mut b, mut c) = (ryu::Buffer::new(), ryu::Buffer::new(), ryu::Buffer::new());
+        let mut d = ryu::Buffer::new();
         for batch in rx {
             let batch = batch?;
             if batch.is_empty() {
@@ -174,6 +185,11 @@ pub fn run<W: Write>(reader: GyroReader, eval: &mut BatchFn, pitch_mm: f64, out:
                         out.write_all(b",").map_err(werr)?;
                     }
                     out.write_all(x.as_bytes()).map_err(werr)?;
+                }
+                if let Some(te) = exposure_s {
+                    out.write_all(b",").map_err(werr)?;
+                    out.write_all(d.format(m / pitch_mm * te).as_bytes())
+                        .map_err(werr)?;
                 }
                 out.write_all(b"\n").map_err(werr)?;
             }
