@@ -23,38 +23,12 @@ fn mmbm(dir: &Path, args: &[&str]) -> Output {
 fn simulate_then_trigger() {
     let d = tempfile::tempdir().unwrap();
     let p = d.path();
-    mmbm(
-        p,
-        &[
-            "simulate",
-            "--gait",
-            "fast",
-            "--duration",
-            "4",
-            "--rate",
-            "500",
-            "--seed",
-            "3",
-            "--out",
-            "a.csv",
-        ],
-    );
-    mmbm(
-        p,
-        &[
-            "simulate",
-            "--gait",
-            "fast",
-            "--duration",
-            "4",
-            "--rate",
-            "500",
-            "--seed",
-            "3",
-            "--out",
-            "b.csv",
-        ],
-    );
+    for out in ["a.csv", "b.csv"] {
+        let args = "simulate --gait fast --duration 4 --rate 500 --seed 3 --out";
+        let mut argv: Vec<&str> = args.split(' ').collect();
+        argv.push(out);
+        mmbm(p, &argv);
+    }
     let a = std::fs::read_to_string(p.join("a.csv")).unwrap();
     assert_eq!(
         a,
