@@ -9,7 +9,6 @@ use super::texture::MipTexture;
 use crate::error::{Error, Result};
 use crate::gpu::{compute, GpuContext};
 use std::sync::OnceLock;
-use wgpu::util::DeviceExt;
 
 /// WGSL source of the kernel.
 pub const SHADER: &str = include_str!("../../shaders/render.wgsl");
@@ -23,6 +22,25 @@ struct Kernel {
     lattice: wgpu::ComputePipeline,
     analytic: wgpu::ComputePipeline,
 }
+
+/// The kernel's buffers, reused between frames (grown when too small).
+struct Buffers {
+    homs: Option<compute::Buf>,
+    texels: Option<compute::Buf>,
+    levels: Option<compute::Buf>,
+    params: Option<compute::Buf>,
+    out: Option<compute::Buf>,
+    read: Option<compute::Buf>,
+}
+
+static BUFFERS: std::sync::Mutex<Buffers> = std::sync::Mutex::new(Buffers {
+    homs: None,
+    texels: None,
+    levels: None,
+    params: None,
+    out: None,
+    read: None,
+});
 
 static KERNEL: OnceLock<std::result::Result<Kernel, String>> = OnceLock::new();
 
@@ -96,28 +114,84 @@ pub fn render(
         Some(t) => t.packed(),
         None => (vec![0.0f32; 4], vec![[0u32, 1, 1, 0]]),
     };
-    let storage = |label: &str, bytes: &[u8]| {
-        dev.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some(label),
-            contents: bytes,
-            usage: wgpu::BufferUsages::STORAGE,
-        })
+    // Buffers are kept between frames and grown when too small: no
+    // allocation per frame.
+    let mut slots = BUFFERS
+        .lock()
+        .map_err(|_| Error::Gpu("render: buffer cache poisoned".into()))?;
+    let sl = &mut *slots;
+    let homs_bytes: &[u8] = bytemuck::cast_slice(homs);
+    let tex_bytes: &[u8] = bytemuck::cast_slice(&texels);
+    let lev_bytes: &[u8] = bytemuck::cast_slice(&levels);
+    let params_size = std::mem::size_of::<RenderParams>() as u64;
+    compute::ensure(
+        ctx,
+        &mut sl.homs,
+        homs_bytes.len() as u64,
+        compute::STORAGE_DST,
+        "homographies",
+    )?;
+    compute::ensure(
+        ctx,
+        &mut sl.texels,
+        tex_bytes.len() as u64,
+        compute::STORAGE_DST,
+        "texels",
+    )?;
+    compute::ensure(
+        ctx,
+        &mut sl.levels,
+        lev_bytes.len() as u64,
+        compute::STORAGE_DST,
+        "mip levels",
+    )?;
+    compute::ensure(
+        ctx,
+        &mut sl.params,
+        params_size,
+        wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        "render params",
+    )?;
+    compute::ensure(
+        ctx,
+        &mut sl.out,
+        out_bytes,
+        compute::STORAGE_SRC | wgpu::BufferUsages::COPY_DST,
+        "render output",
+    )?;
+    compute::ensure(
+        ctx,
+        &mut sl.read,
+        out_bytes,
+        compute::READ,
+        "render readback",
+    )?;
+    let (Some(b_homs), Some(b_tex), Some(b_lev), Some(b_par), Some(b_out), Some(b_read)) = (
+        sl.homs.as_ref(),
+        sl.texels.as_ref(),
+        sl.levels.as_ref(),
+        sl.params.as_ref(),
+        sl.out.as_ref(),
+        sl.read.as_ref(),
+    ) else {
+        return Err(Error::Gpu("render: buffers missing".into()));
     };
-    let b_homs = storage("homographies", bytemuck::cast_slice(homs));
-    let b_tex = storage("texels", bytemuck::cast_slice(&texels));
-    let b_lev = storage("levels", bytemuck::cast_slice(&levels));
-    let b_out = dev.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("out"),
-        size: out_bytes,
-        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-        mapped_at_creation: false,
-    });
-    let b_par = dev.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("params"),
-        size: std::mem::size_of::<RenderParams>() as u64,
-        usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
+    let (b_homs, b_tex, b_lev, b_par, b_out, b_read) = (
+        &b_homs.buf,
+        &b_tex.buf,
+        &b_lev.buf,
+        &b_par.buf,
+        &b_out.buf,
+        &b_read.buf,
+    );
+    ctx.queue.write_buffer(b_homs, 0, homs_bytes);
+    ctx.queue.write_buffer(b_tex, 0, tex_bytes);
+    ctx.queue.write_buffer(b_lev, 0, lev_bytes);
+    {
+        let mut enc = dev.create_command_encoder(&Default::default());
+        enc.clear_buffer(b_out, 0, Some(out_bytes));
+        ctx.queue.submit([enc.finish()]);
+    }
     let bg = dev.create_bind_group(&wgpu::BindGroupDescriptor {
         label: Some("render"),
         layout: &k.bgl,
@@ -159,7 +233,7 @@ pub fn render(
         while k0 < n {
             let k1 = (k0 + kstep).min(n);
             let pr = with_range(p, row0, nr, k0, k1);
-            ctx.queue.write_buffer(&b_par, 0, bytemuck::bytes_of(&pr));
+            ctx.queue.write_buffer(b_par, 0, bytemuck::bytes_of(&pr));
             let mut enc = dev.create_command_encoder(&Default::default());
             {
                 let mut pass = enc.begin_compute_pass(&Default::default());
@@ -174,19 +248,13 @@ pub fn render(
         }
         row0 += nr;
     }
-    let b_read = dev.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("readback"),
-        size: out_bytes,
-        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
     let mut enc = dev.create_command_encoder(&Default::default());
-    enc.copy_buffer_to_buffer(&b_out, 0, &b_read, 0, out_bytes);
+    enc.copy_buffer_to_buffer(b_out, 0, b_read, 0, out_bytes);
     ctx.queue.submit([enc.finish()]);
     if let Some(e) = pollster::block_on(scope.pop()) {
         return Err(Error::Gpu(format!("render: {e}")));
     }
-    let bytes = compute::read_back(ctx, &b_read, out_bytes, "render readback")?;
+    let bytes = compute::read_back(ctx, b_read, out_bytes, "render readback")?;
     let sums: Vec<[f32; 4]> = bytemuck::pod_collect_to_vec(&bytes);
     let inv = 1.0 / n as f32;
     let mut out = Vec::with_capacity((npix * 3) as usize);
