@@ -7,7 +7,7 @@
 // the sensor; the field written out is px/s (+u right, +v down, skew included,
 // like Camera::mm_to_px_velocity). Sums are of the speed in mm/s.
 
-// Camera and sample grid. Must match `FlowParams` (64 bytes).
+// Camera and sample grid. Must match `FlowParams` (96 bytes).
 struct Params {
     f_mm: f32,          // focal length, mm
     pitch_x: f32,       // pixel pitch, mm
@@ -23,8 +23,13 @@ struct Params {
     tiles: u32,         // tiles per twist (flow_tiles)
     tiles_x: u32,       // workgroups along x per dispatch row
     write_field: u32,   // 1: write the field (one twist only)
+    dist_model: u32,    // lens distortion: 0 none, 1 OpenCV (k1 k2 p1 p2 | k3), 2 fisheye (k1..k4)
     pad0: u32,
+    dist: vec4<f32>,    // OpenCV: k1, k2, p1, p2; fisheye: k1, k2, k3, k4
+    dist_k3: f32,       // OpenCV: k3
     pad1: u32,
+    pad2: u32,
+    pad3: u32,
 }
 
 // One twist. Must match `TwistGpu` (48 bytes).
@@ -67,6 +72,105 @@ fn flow_mm(p: vec2<f32>, tw: Twist) -> vec2<f32> {
     return vec2<f32>(du, dv);
 }
 
+// Lens distortion (SPEC section 9) in normalised coordinates q = (x, y):
+// the Jacobian of the distortion map at q, and its inverse by Newton's method
+// (a fixed UNDISTORT_STEPS steps from the distorted point). Twins:
+// distort/jacobian/undistort in src/field/cpu.rs.
+const UNDISTORT_STEPS: u32 = 12u;
+
+// Fisheye: theta_d(theta) and its derivative.
+fn fisheye_theta_d(th: f32) -> vec2<f32> {
+    let k = params.dist;
+    let t2 = th * th;
+    let poly = 1.0 + t2 * (k.x + t2 * (k.y + t2 * (k.z + t2 * k.w)));
+    let d = 1.0 + t2 * (3.0 * k.x + t2 * (5.0 * k.y + t2 * (7.0 * k.z + t2 * 9.0 * k.w)));
+    return vec2<f32>(th * poly, d);
+}
+
+// Fisheye: s = theta_d / r and (ds/dr) / r at q (series near the axis).
+fn fisheye_scale(q: vec2<f32>) -> vec2<f32> {
+    let k = params.dist;
+    let r2 = q.x * q.x + q.y * q.y;
+    if (r2 < 1e-4) {
+        let c = k.x - 1.0 / 3.0;
+        let e = 0.2 - k.x + k.y;
+        return vec2<f32>(1.0 + r2 * (c + r2 * e), 2.0 * c + 4.0 * e * r2);
+    }
+    let r = sqrt(r2);
+    let th = atan(r);
+    let td = fisheye_theta_d(th);
+    let s = td.x / r;
+    return vec2<f32>(s, (td.y / (1.0 + r2) - s) / r2);
+}
+
+fn distort(q: vec2<f32>) -> vec2<f32> {
+    if (params.dist_model == 1u) {
+        let k = params.dist;
+        let r2 = q.x * q.x + q.y * q.y;
+        let radial = 1.0 + r2 * (k.x + r2 * (k.y + r2 * params.dist_k3));
+        return vec2<f32>(
+            q.x * radial + 2.0 * k.z * q.x * q.y + k.w * (r2 + 2.0 * q.x * q.x),
+            q.y * radial + k.z * (r2 + 2.0 * q.y * q.y) + 2.0 * k.w * q.x * q.y);
+    }
+    return fisheye_scale(q).x * q;
+}
+
+// Rows of the Jacobian: (dxd/dx, dxd/dy), (dyd/dx, dyd/dy).
+fn jacobian(q: vec2<f32>) -> array<vec2<f32>, 2> {
+    if (params.dist_model == 1u) {
+        let k = params.dist;
+        let r2 = q.x * q.x + q.y * q.y;
+        let radial = 1.0 + r2 * (k.x + r2 * (k.y + r2 * params.dist_k3));
+        let drad = k.x + r2 * (2.0 * k.y + r2 * 3.0 * params.dist_k3);
+        let off = 2.0 * q.x * q.y * drad + 2.0 * k.z * q.x + 2.0 * k.w * q.y;
+        return array<vec2<f32>, 2>(
+            vec2<f32>(radial + 2.0 * q.x * q.x * drad + 2.0 * k.z * q.y + 6.0 * k.w * q.x, off),
+            vec2<f32>(off, radial + 2.0 * q.y * q.y * drad + 6.0 * k.z * q.y + 2.0 * k.w * q.x));
+    }
+    let sg = fisheye_scale(q);
+    let off = sg.y * q.x * q.y;
+    return array<vec2<f32>, 2>(
+        vec2<f32>(sg.x + sg.y * q.x * q.x, off),
+        vec2<f32>(off, sg.x + sg.y * q.y * q.y));
+}
+
+fn undistort(qd: vec2<f32>) -> vec2<f32> {
+    if (params.dist_model == 2u) {
+        let rd = length(qd);
+        if (rd == 0.0) {
+            return qd;
+        }
+        var th = min(rd, 1.5);
+        for (var k = 0u; k < UNDISTORT_STEPS; k++) {
+            let td = fisheye_theta_d(th);
+            th = clamp(th - (td.x - rd) / td.y, 0.0, 1.5707);
+        }
+        return qd * (tan(th) / rd);
+    }
+    var q = qd;
+    for (var k = 0u; k < UNDISTORT_STEPS; k++) {
+        let e = distort(q) - qd;
+        let j = jacobian(q);
+        let det = j[0].x * j[1].y - j[0].y * j[1].x;
+        q -= vec2<f32>(j[1].y * e.x - j[0].y * e.y, -j[1].x * e.x + j[0].x * e.y) / det;
+    }
+    return q;
+}
+
+// The flow (mm/s on the distorted sensor) at the centre of grid cell (i, j):
+// the pinhole flow of its undistorted point through the distortion's Jacobian.
+fn sample_flow(i: u32, j: u32, tw: Twist) -> vec2<f32> {
+    let pd = sensor_point(i, j);
+    if (params.dist_model == 0u) {
+        return flow_mm(pd, tw);
+    }
+    let f = params.f_mm;
+    let q = undistort(pd / f);
+    let fl = flow_mm(q * f, tw);
+    let jm = jacobian(q);
+    return vec2<f32>(dot(jm[0], fl), dot(jm[1], fl));
+}
+
 // Sensor velocity (mm/s) to pixel velocity (px/s); like Camera::mm_to_px_velocity.
 fn px_velocity(d: vec2<f32>) -> vec2<f32> {
     return vec2<f32>(d.x / params.pitch_x + params.skew_over_f * d.y, d.y / params.pitch_y);
@@ -92,7 +196,7 @@ fn flow_tiles(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_in
         for (var k = 0u; k < CHUNK; k++) {
             let idx = base + k * WG;
             if (idx < n) {
-                let d = flow_mm(sensor_point(i, j), tw);
+                let d = sample_flow(i, j, tw);
                 acc += length(d);
                 if (params.write_field != 0u) {
                     field[idx] = px_velocity(d);
@@ -128,7 +232,7 @@ fn rows_per_twist(@builtin(global_invocation_id) gid: vec3<u32>) {
     for (var j = 0u; j < params.grid_h; j++) {
         var row = 0.0;
         for (var i = 0u; i < params.grid_w; i++) {
-            row += length(flow_mm(sensor_point(i, j), tw));
+            row += length(sample_flow(i, j, tw));
         }
         partials[t * params.grid_h + j] = row;
     }

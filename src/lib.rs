@@ -17,7 +17,7 @@
 //! | layer | modules | holds |
 //! |---|---|---|
 //! | 0 | [`error`], [`stats`] | the error enum; mean and percentile |
-//! | 1 | [`model`], [`io`], [`gpu`] | camera, motion, flow; files; the wgpu device and compute plumbing |
+//! | 1 | [`camera`], [`model`], [`io`], [`gpu`] | the camera (intrinsics, distortion, shutter, noise, lens); motion, flow; files; the wgpu device and compute plumbing |
 //! | 2 | [`metric`], [`board`], [`plot`], [`sim`], [`assess`] | MMBM rules; the thesis board, blobs, pose; figures; gait simulation; image blur metrics |
 //! | 3 | [`field`], [`tables`] | the flow-field kernel (GPU + CPU twin); thesis tables |
 //! | 4 | [`series`], [`render`] | MMBM of a log (CPU and GPU batch); the blur renderer |
@@ -30,6 +30,7 @@
 
 pub mod assess;
 pub mod board;
+pub mod camera;
 pub mod dataset;
 pub mod error;
 pub mod experiment;
@@ -46,7 +47,7 @@ pub mod stats;
 pub mod tables;
 pub mod trigger;
 
+pub use camera::Camera;
 pub use error::{Error, Result};
 pub use metric::{mmbm, Method, Mmbm, Scene};
-pub use model::camera::Camera;
 pub use model::motion::{Plane, Twist};

@@ -8,7 +8,7 @@ use glam::DVec3;
 use mmbm::gpu::Backend;
 use mmbm::io::gyro::{parse_rotation, GyroOptions, GyroSample};
 use mmbm::metric::{Method, Scene};
-use mmbm::model::camera::Camera;
+use mmbm::camera::Camera;
 use mmbm::model::motion::{Plane, Twist};
 use mmbm::render::{Integrator, Quality, RenderJob, Target, Trajectory};
 use numpy::ndarray::{Array1, Array2, Array3};
@@ -39,6 +39,7 @@ fn camera(c: CamTuple) -> PyResult<Camera> {
         cx,
         cy,
         skew,
+        ..Camera::thesis()
     };
     cam.validate().map_err(err)?;
     Ok(cam)

@@ -257,7 +257,7 @@ pub fn evaluate(blobs: &[Blob], expected_px: &[(f64, f64)], pitch_px: f64) -> Re
 mod tests {
     use super::*;
     use crate::board::{board_centres_px, Board};
-    use crate::model::camera::Camera;
+    use crate::camera::Camera;
 
     #[test]
     fn thesis_board_projection() {

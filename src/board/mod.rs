@@ -6,8 +6,8 @@
 pub mod blobs;
 pub mod pose;
 
+use crate::camera::Camera;
 use crate::error::{finite, positive, Error, Result};
-use crate::model::camera::Camera;
 use serde::Serialize;
 
 /// Linear RGB of the thesis board's red squares.

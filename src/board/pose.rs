@@ -4,8 +4,8 @@
 //! first). Used to check what the blob extraction is worth: the pose error
 //! against the true pose.
 
+use crate::camera::Camera;
 use crate::error::{Error, Result};
-use crate::model::camera::Camera;
 use glam::{DMat3, DVec3};
 
 /// Camera pose relative to a planar board.

@@ -2,12 +2,12 @@
 //! item's own seed) and the files made from them.
 
 use super::config::{DatasetConfig, MotionSource};
+use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::field::flow_field;
 use crate::io::gyro::{read_log, GyroOptions, GyroSample};
 use crate::io::images::write_exr;
 use crate::metric::{mmbm, Method, Scene};
-use crate::model::camera::Camera;
 use crate::model::motion::{Plane, Twist};
 use crate::render::{self, Backend, Quality, RenderJob, RenderOutput, Target, Trajectory};
 use crate::sim::{simulate, GaitConfig};

@@ -3,9 +3,9 @@
 
 use super::config::ExperimentConfig;
 use super::walk::Walk;
+use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::io::images::linear_to_srgb8;
-use crate::model::camera::Camera;
 use crate::render::{self, Backend, Quality, RenderJob, Target, Trajectory};
 use crate::trigger::Frame;
 use std::time::Instant;

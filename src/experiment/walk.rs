@@ -2,10 +2,10 @@
 //! series, the board's distance, and every policy's frames.
 
 use super::config::ExperimentConfig;
+use crate::camera::Camera;
 use crate::error::Result;
 use crate::io::gyro::{read_log, GyroOptions, GyroSample};
 use crate::metric::{Method, Scene};
-use crate::model::camera::Camera;
 use crate::sim::{simulate, Gait, GaitConfig};
 use crate::trigger::{self, parse_policy, CameraTiming, Frame};
 use std::str::FromStr;

@@ -1,10 +1,10 @@
 //! CPU twins of `shaders/field.wgsl`: the same f32 formula and summation
 //! order as the kernels (single-threaded and rayon), plus an f64 reference
-//! built from the library's own [`crate::model::flow::flow_at`] and [`Camera`] maps.
+//! built from the library's own [`crate::model::flow::flow_distorted`] and [`Camera`] maps.
 
 use super::kernel::{FlowParams, Grid, TwistGpu, CHUNK, TILE, WG};
-use crate::model::camera::Camera;
-use crate::model::flow::flow_at;
+use crate::camera::Camera;
+use crate::model::flow::flow_distorted;
 use crate::model::motion::{Plane, Twist};
 use rayon::prelude::*;
 
@@ -30,6 +30,119 @@ pub fn flow_mm(p: &FlowParams, tw: &TwistGpu, u: f32, v: f32) -> (f32, f32) {
     (du, dv)
 }
 
+/// Newton steps of the shader's `undistort` (`UNDISTORT_STEPS`).
+pub const UNDISTORT_STEPS: u32 = 12;
+
+/// Twin of the shader's `fisheye_theta_d`: `theta_d(theta)` and its derivative.
+#[inline(always)]
+fn fisheye_theta_d(p: &FlowParams, th: f32) -> (f32, f32) {
+    let k = p.dist;
+    let t2 = th * th;
+    let poly = 1.0 + t2 * (k[0] + t2 * (k[1] + t2 * (k[2] + t2 * k[3])));
+    let d = 1.0 + t2 * (3.0 * k[0] + t2 * (5.0 * k[1] + t2 * (7.0 * k[2] + t2 * 9.0 * k[3])));
+    (th * poly, d)
+}
+
+/// Twin of the shader's `fisheye_scale`: `s = theta_d / r` and `(ds/dr) / r`.
+#[inline(always)]
+fn fisheye_scale(p: &FlowParams, x: f32, y: f32) -> (f32, f32) {
+    let k = p.dist;
+    let r2 = x * x + y * y;
+    if r2 < 1e-4 {
+        let c = k[0] - 1.0 / 3.0;
+        let e = 0.2 - k[0] + k[1];
+        return (1.0 + r2 * (c + r2 * e), 2.0 * c + 4.0 * e * r2);
+    }
+    let r = r2.sqrt();
+    let (td, dtd) = fisheye_theta_d(p, r.atan());
+    let s = td / r;
+    (s, (dtd / (1.0 + r2) - s) / r2)
+}
+
+/// Twin of the shader's `distort` (normalised coordinates; model 1 or 2).
+#[inline(always)]
+pub fn distort(p: &FlowParams, x: f32, y: f32) -> (f32, f32) {
+    if p.dist_model == 1 {
+        let k = p.dist;
+        let r2 = x * x + y * y;
+        let radial = 1.0 + r2 * (k[0] + r2 * (k[1] + r2 * p.dist_k3));
+        return (
+            x * radial + 2.0 * k[2] * x * y + k[3] * (r2 + 2.0 * x * x),
+            y * radial + k[2] * (r2 + 2.0 * y * y) + 2.0 * k[3] * x * y,
+        );
+    }
+    let s = fisheye_scale(p, x, y).0;
+    (s * x, s * y)
+}
+
+/// Twin of the shader's `jacobian`: rows `(dxd/dx, dxd/dy), (dyd/dx, dyd/dy)`.
+#[inline(always)]
+pub fn jacobian(p: &FlowParams, x: f32, y: f32) -> [[f32; 2]; 2] {
+    if p.dist_model == 1 {
+        let k = p.dist;
+        let r2 = x * x + y * y;
+        let radial = 1.0 + r2 * (k[0] + r2 * (k[1] + r2 * p.dist_k3));
+        let drad = k[0] + r2 * (2.0 * k[1] + r2 * 3.0 * p.dist_k3);
+        let off = 2.0 * x * y * drad + 2.0 * k[2] * x + 2.0 * k[3] * y;
+        return [
+            [
+                radial + 2.0 * x * x * drad + 2.0 * k[2] * y + 6.0 * k[3] * x,
+                off,
+            ],
+            [
+                off,
+                radial + 2.0 * y * y * drad + 6.0 * k[2] * y + 2.0 * k[3] * x,
+            ],
+        ];
+    }
+    let (s, g) = fisheye_scale(p, x, y);
+    let off = g * x * y;
+    [[s + g * x * x, off], [off, s + g * y * y]]
+}
+
+/// Twin of the shader's `undistort`: `UNDISTORT_STEPS` Newton steps.
+#[inline(always)]
+pub fn undistort(p: &FlowParams, xd: f32, yd: f32) -> (f32, f32) {
+    if p.dist_model == 2 {
+        let rd = (xd * xd + yd * yd).sqrt();
+        if rd == 0.0 {
+            return (xd, yd);
+        }
+        let mut th = rd.min(1.5);
+        for _ in 0..UNDISTORT_STEPS {
+            let (td, dtd) = fisheye_theta_d(p, th);
+            th = (th - (td - rd) / dtd).clamp(0.0, 1.5707);
+        }
+        let s = th.tan() / rd;
+        return (xd * s, yd * s);
+    }
+    let (mut x, mut y) = (xd, yd);
+    for _ in 0..UNDISTORT_STEPS {
+        let (fx, fy) = distort(p, x, y);
+        let (ex, ey) = (fx - xd, fy - yd);
+        let j = jacobian(p, x, y);
+        let det = j[0][0] * j[1][1] - j[0][1] * j[1][0];
+        x -= (j[1][1] * ex - j[0][1] * ey) / det;
+        y -= (-j[1][0] * ex + j[0][0] * ey) / det;
+    }
+    (x, y)
+}
+
+/// Twin of the shader's `sample_flow`: the flow (mm/s on the distorted
+/// sensor) at the centre of grid cell `(i, j)`.
+#[inline(always)]
+pub fn sample_flow(p: &FlowParams, tw: &TwistGpu, i: u32, j: u32) -> (f32, f32) {
+    let (u, v) = sensor_point(p, i, j);
+    if p.dist_model == 0 {
+        return flow_mm(p, tw, u, v);
+    }
+    let f = p.f_mm;
+    let (x, y) = undistort(p, u / f, v / f);
+    let (a, b) = flow_mm(p, tw, x * f, y * f);
+    let jm = jacobian(p, x, y);
+    (jm[0][0] * a + jm[0][1] * b, jm[1][0] * a + jm[1][1] * b)
+}
+
 /// Twin of the shader's `px_velocity`: mm/s to px/s.
 #[inline(always)]
 pub fn px_velocity(p: &FlowParams, du: f32, dv: f32) -> [f32; 2] {
@@ -51,8 +164,7 @@ fn tile(p: &FlowParams, tw: &TwistGpu, tile: u32, field: &mut [[f32; 2]]) -> f32
             if base + off >= n {
                 break 'chunk;
             }
-            let (u, v) = sensor_point(p, i, j);
-            let (du, dv) = flow_mm(p, tw, u, v);
+            let (du, dv) = sample_flow(p, tw, i, j);
             *acc += (du * du + dv * dv).sqrt();
             if let Some(f) = field.get_mut(off as usize) {
                 *f = px_velocity(p, du, dv);
@@ -110,8 +222,7 @@ pub fn rows_per_twist(p: &FlowParams, tw: &TwistGpu) -> Vec<f32> {
         .map(|j| {
             let mut row = 0f32;
             for i in 0..p.grid_w {
-                let (u, v) = sensor_point(p, i, j);
-                let (du, dv) = flow_mm(p, tw, u, v);
+                let (du, dv) = sample_flow(p, tw, i, j);
                 row += (du * du + dv * dv).sqrt();
             }
             row
@@ -136,8 +247,8 @@ pub fn batch_means(grid: &Grid, twists: &[TwistGpu]) -> Vec<f64> {
 }
 
 /// f64 reference: the field (px/s) at the grid's cell centres from
-/// [`Camera::pixel_to_mm`], [`flow_at`] and [`Camera::mm_to_px_velocity`], and
-/// the mean speed (mm/s).
+/// [`Camera::pixel_to_mm`], [`flow_distorted`] (the library's f64 undistortion
+/// and Jacobian) and [`Camera::mm_to_px_velocity`], and the mean speed (mm/s).
 pub fn reference_f64(grid: &Grid, tw: &Twist, plane: Option<&Plane>) -> (Vec<[f64; 2]>, f64) {
     let c: &Camera = &grid.camera;
     let (sx, sy) = grid.step();
@@ -146,8 +257,8 @@ pub fn reference_f64(grid: &Grid, tw: &Twist, plane: Option<&Plane>) -> (Vec<[f6
     for j in 0..grid.height {
         let mut row = 0.0;
         for i in 0..grid.width {
-            let (u, v) = c.pixel_to_mm((i as f64 + 0.5) * sx, (j as f64 + 0.5) * sy);
-            let (du, dv) = flow_at(c.focal_mm, u, v, tw, plane);
+            let (ud, vd) = c.pixel_to_mm((i as f64 + 0.5) * sx, (j as f64 + 0.5) * sy);
+            let (du, dv) = flow_distorted(c, ud, vd, tw, plane).unwrap_or((f64::NAN, f64::NAN));
             row += du.hypot(dv);
             let (a, b) = c.mm_to_px_velocity(du, dv);
             field.push([a, b]);

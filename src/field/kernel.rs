@@ -1,8 +1,8 @@
 //! Host-side structs shared with `shaders/field.wgsl` (`Params`, `Twist`), with
 //! layout asserts, and the sample grid they describe.
 
+use crate::camera::Camera;
 use crate::error::{Error, Result};
-use crate::model::camera::Camera;
 use crate::model::motion::{Plane, Twist};
 use bytemuck::{Pod, Zeroable};
 
@@ -47,8 +47,16 @@ pub struct FlowParams {
     pub tiles_x: u32,
     /// 1 to write the field (one twist), else 0.
     pub write_field: u32,
-    /// Padding to 64 bytes.
-    pub pad: [u32; 2],
+    /// Lens distortion model: 0 none, 1 OpenCV, 2 fisheye.
+    pub dist_model: u32,
+    /// Padding (to align `dist`).
+    pub pad0: u32,
+    /// Distortion coefficients: OpenCV `k1, k2, p1, p2`; fisheye `k1..k4`.
+    pub dist: [f32; 4],
+    /// OpenCV `k3`.
+    pub dist_k3: f32,
+    /// Padding to 96 bytes.
+    pub pad: [u32; 3],
 }
 
 /// The shader's `Twist`: one camera twist and its scene's inverse depth.
@@ -64,7 +72,10 @@ pub struct TwistGpu {
     pub inv_depth: [f32; 4],
 }
 
-const _: () = assert!(std::mem::size_of::<FlowParams>() == 64);
+const _: () = assert!(std::mem::size_of::<FlowParams>() == 96);
+const _: () = assert!(std::mem::offset_of!(FlowParams, dist_model) == 56);
+const _: () = assert!(std::mem::offset_of!(FlowParams, dist) == 64);
+const _: () = assert!(std::mem::offset_of!(FlowParams, dist_k3) == 80);
 const _: () = assert!(std::mem::offset_of!(FlowParams, step_y) == 28);
 const _: () = assert!(std::mem::offset_of!(FlowParams, grid_w) == 32);
 const _: () = assert!(std::mem::offset_of!(FlowParams, write_field) == 52);
@@ -162,6 +173,7 @@ impl Grid {
         let c = &self.camera;
         let (sx, sy) = self.step();
         let tiles = self.tiles();
+        let (model, k) = c.distortion.coefficients();
         FlowParams {
             f_mm: c.focal_mm as f32,
             pitch_x: c.pitch_x_mm as f32,
@@ -177,7 +189,11 @@ impl Grid {
             tiles,
             tiles_x: tiles.min(MAX_DISPATCH),
             write_field: write_field as u32,
-            pad: [0; 2],
+            dist_model: model,
+            pad0: 0,
+            dist: [k[0] as f32, k[1] as f32, k[2] as f32, k[3] as f32],
+            dist_k3: k[4] as f32,
+            pad: [0; 3],
         }
     }
 }
@@ -222,6 +238,10 @@ mod tests {
         assert_eq!(shader_const(&m, "WG"), WG);
         assert_eq!(shader_const(&m, "CHUNK"), CHUNK);
         assert_eq!(shader_const(&m, "TILE"), TILE);
+        assert_eq!(
+            shader_const(&m, "UNDISTORT_STEPS"),
+            super::super::cpu::UNDISTORT_STEPS
+        );
         assert_eq!(m.entry_points.len(), 2);
         for ep in &m.entry_points {
             assert_eq!(ep.workgroup_size, [WG, 1, 1], "{}", ep.name);

@@ -4,7 +4,7 @@
 //! `#[target_feature]` function after checking that the feature is present.
 #![allow(unsafe_code)]
 
-use crate::model::camera::SensorRect;
+use crate::camera::SensorRect;
 use crate::model::flow::FlowPoly;
 
 /// True when the CPU has AVX2 and FMA.

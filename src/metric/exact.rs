@@ -8,7 +8,7 @@
 //! The per-region error estimate is `|K15xK15 - G7xG7|`, which is pessimistic
 //! for smooth regions (it is the error of the lower-order rule).
 
-use crate::model::camera::SensorRect;
+use crate::camera::SensorRect;
 use crate::model::flow::FlowPoly;
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
@@ -94,7 +94,12 @@ impl Ord for Region {
 
 /// Integrates `|flow|` over `r` (a sub-rectangle), returning the contribution
 /// to the mean (integral / `total_area`) with the Kronrod rule and its error.
-fn rule(poly: &FlowPoly, r: SensorRect, total_area: f64, nd: &[(f64, f64, f64); 15]) -> Region {
+fn rule<F: Fn(f64, f64) -> f64>(
+    speed: &F,
+    r: SensorRect,
+    total_area: f64,
+    nd: &[(f64, f64, f64); 15],
+) -> Region {
     let (cu, hu) = ((r.u0 + r.u1) * 0.5, (r.u1 - r.u0) * 0.5);
     let (cv, hv) = ((r.v0 + r.v1) * 0.5, (r.v1 - r.v0) * 0.5);
     let (mut k, mut g) = (0.0, 0.0);
@@ -102,7 +107,7 @@ fn rule(poly: &FlowPoly, r: SensorRect, total_area: f64, nd: &[(f64, f64, f64); 
         let v = cv + hv * yv;
         let (mut rk, mut rg) = (0.0, 0.0);
         for &(yu, ku, gu) in nd {
-            let s = poly.speed(cu + hu * yu, v);
+            let s = speed(cu + hu * yu, v);
             rk += ku * s;
             rg += gu * s;
         }
@@ -120,10 +125,16 @@ fn rule(poly: &FlowPoly, r: SensorRect, total_area: f64, nd: &[(f64, f64, f64); 
 /// Exact mean flow speed over `rect` (mm/s) to relative tolerance `tol`
 /// (absolute when the value is 0), at most ~2 million evaluations.
 pub fn exact(poly: &FlowPoly, rect: &SensorRect, tol: f64) -> ExactResult {
+    exact_with(|u, v| poly.speed(u, v), rect, tol)
+}
+
+/// [`exact`] for any speed function `speed(u, v)` (mm/s at sensor point
+/// `(u, v)` mm), e.g. through a lens distortion or over an exposure.
+pub fn exact_with<F: Fn(f64, f64) -> f64>(speed: F, rect: &SensorRect, tol: f64) -> ExactResult {
     const MAX_REGIONS: usize = 10_000;
     let nd = nodes();
     let area = rect.area();
-    let first = rule(poly, *rect, area, &nd);
+    let first = rule(&speed, *rect, area, &nd);
     let mut heap = BinaryHeap::new();
     let (mut value, mut error) = (first.value, first.error);
     heap.push(first);
@@ -138,7 +149,7 @@ pub fn exact(poly: &FlowPoly, rect: &SensorRect, tol: f64) -> ExactResult {
             let m = 0.5 * (r.v0 + r.v1);
             (SensorRect { v1: m, ..r }, SensorRect { v0: m, ..r })
         };
-        let (ra, rb) = (rule(poly, a, area, &nd), rule(poly, b, area, &nd));
+        let (ra, rb) = (rule(&speed, a, area, &nd), rule(&speed, b, area, &nd));
         evals += 450;
         value += ra.value + rb.value - worst.value;
         error += ra.error + rb.error - worst.error;

@@ -1,6 +1,7 @@
 //! Fixed real-time rules: the thesis's midpoint (Riemann) grid and tensor Gauss-Legendre.
 
-use crate::model::camera::SensorRect;
+use crate::camera::{Camera, SensorRect};
+use crate::error::{Error, Result};
 use crate::model::flow::FlowPoly;
 
 /// MMBM* (thesis eq. 4.1): the mean of the flow speed at the centres of an
@@ -51,11 +52,17 @@ pub fn gauss_legendre(n: usize) -> (Vec<f64>, Vec<f64>) {
 /// summing to 1 (so it returns a mean), stored as structure-of-arrays of the
 /// monomials `u, v, u^2, uv, v^2`, padded with zero-weight points to a
 /// multiple of 8, so that [`GridRule::mean_speed`] vectorises.
+///
+/// With lens distortion ([`GridRule::distorted`]) the nodes stay where they
+/// are on the (distorted) sensor, the monomials are those of their undistorted
+/// points and the distortion's Jacobian at each is kept: the speed at a node is
+/// `|J flow(u, v)|` (SPEC section 9).
 #[derive(Debug, Clone)]
 pub struct GridRule {
     m: [Vec<f64>; 5],
     w: Vec<f64>,
     len: usize,
+    jac: Option<Vec<[f64; 4]>>,
 }
 
 impl GridRule {
@@ -78,7 +85,33 @@ impl GridRule {
             m,
             w,
             len: points.len(),
+            jac: None,
         }
+    }
+
+    /// This rule's nodes seen through `cam`'s lens distortion (unchanged
+    /// without distortion). Errors when a node does not undistort.
+    pub fn distorted(self, cam: &Camera) -> Result<Self> {
+        if cam.distortion.is_none() {
+            return Ok(self);
+        }
+        let mut points = Vec::with_capacity(self.len);
+        let mut jac = Vec::with_capacity(self.len);
+        for k in 0..self.len {
+            let (ud, vd) = (self.m[0][k], self.m[1][k]);
+            let (u, v) = cam.undistort_mm(ud, vd).ok_or_else(|| {
+                Error::invalid(
+                    "distortion",
+                    format!("the sensor point ({ud:.4}, {vd:.4}) mm does not undistort"),
+                )
+            })?;
+            let j = cam.distortion_jacobian(u, v);
+            points.push((u, v));
+            jac.push([j[0][0], j[0][1], j[1][0], j[1][1]]);
+        }
+        let mut rule = Self::from_points(&points, &self.w[..self.len]);
+        rule.jac = Some(jac);
+        Ok(rule)
     }
 
     /// The midpoint (Riemann) rule: centres of `nu x nv` equal cells over `r`.
@@ -124,7 +157,17 @@ impl GridRule {
 
     /// The rule's estimate of the mean flow speed, mm/s.
     pub fn mean_speed(&self, poly: &FlowPoly) -> f64 {
-        super::avx2::rule_mean(&self.m, &self.w, poly)
+        match &self.jac {
+            None => super::avx2::rule_mean(&self.m, &self.w, poly),
+            Some(jac) => {
+                let mut sum = 0.0;
+                for (k, j) in jac.iter().enumerate() {
+                    let (a, b) = poly.eval(self.m[0][k], self.m[1][k]);
+                    sum += self.w[k] * (j[0] * a + j[1] * b).hypot(j[2] * a + j[3] * b);
+                }
+                sum
+            }
+        }
     }
 }
 

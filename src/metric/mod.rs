@@ -12,11 +12,11 @@ mod avx2;
 mod exact;
 mod grid;
 
-pub use exact::{exact, roll_mean_closed_form, ExactResult};
+pub use exact::{exact, exact_with, roll_mean_closed_form, ExactResult};
 pub use grid::{gauss, gauss_legendre, riemann, GridRule};
 
+use crate::camera::Camera;
 use crate::error::{Error, Result};
-use crate::model::camera::Camera;
 use crate::model::flow::FlowPoly;
 use crate::model::motion::{Plane, Twist};
 use std::fmt;
@@ -233,6 +233,9 @@ pub fn mmbm(scene: &Scene, tw: &Twist, method: Method) -> Result<Mmbm> {
 /// MMBM of a pre-expanded flow polynomial (no validation; the hot path).
 pub fn mmbm_poly(cam: &Camera, poly: &FlowPoly, method: Method) -> Result<Mmbm> {
     let rect = cam.sensor_rect();
+    if !cam.distortion.is_none() {
+        return mmbm_poly_distorted(cam, poly, method);
+    }
     let (mm_s, err, evals) = match method {
         Method::Riemann { nu, nv } => (riemann(poly, &rect, nu, nv), None, (nu * nv) as u64),
         Method::Gauss { nu, nv } => (gauss(poly, &rect, nu, nv), None, (nu * nv) as u64),
@@ -247,6 +250,10 @@ pub fn mmbm_poly(cam: &Camera, poly: &FlowPoly, method: Method) -> Result<Mmbm> 
             ))
         }
     };
+    finish(cam, mm_s, err, evals)
+}
+
+fn finish(cam: &Camera, mm_s: f64, err: Option<f64>, evals: u64) -> Result<Mmbm> {
     if !mm_s.is_finite() {
         return Err(Error::invalid(
             "motion",
@@ -259,6 +266,52 @@ pub fn mmbm_poly(cam: &Camera, poly: &FlowPoly, method: Method) -> Result<Mmbm> 
         error_estimate: err,
         evaluations: evals,
     })
+}
+
+/// The rules through lens distortion: the mean over the (distorted) sensor
+/// rectangle of `|J flow|` at each point's undistorted point (SPEC 9).
+fn mmbm_poly_distorted(cam: &Camera, poly: &FlowPoly, method: Method) -> Result<Mmbm> {
+    let rect = cam.sensor_rect();
+    let (mm_s, err, evals) = match method {
+        Method::Riemann { nu, nv } => (
+            GridRule::riemann(&rect, nu, nv)
+                .distorted(cam)?
+                .mean_speed(poly),
+            None,
+            (nu * nv) as u64,
+        ),
+        Method::Gauss { nu, nv } => (
+            GridRule::gauss(&rect, nu, nv)
+                .distorted(cam)?
+                .mean_speed(poly),
+            None,
+            (nu * nv) as u64,
+        ),
+        Method::Exact { tol } => {
+            let r = exact_with(|u, v| distorted_speed(cam, poly, u, v), &rect, tol);
+            (r.value, Some(r.error), r.evaluations)
+        }
+        Method::Gpu { .. } => {
+            return Err(Error::invalid(
+                "method",
+                "gpu is evaluated by crate::gpu, not by the CPU metric",
+            ))
+        }
+    };
+    finish(cam, mm_s, err, evals)
+}
+
+/// `|J flow|` (mm/s) at the distorted sensor point `(ud, vd)` mm; NaN where it
+/// does not undistort (the caller reports a non-finite result).
+fn distorted_speed(cam: &Camera, poly: &FlowPoly, ud: f64, vd: f64) -> f64 {
+    match cam.undistort_mm(ud, vd) {
+        Some((u, v)) => {
+            let (a, b) =
+                crate::camera::distortion::apply(&cam.distortion_jacobian(u, v), poly.eval(u, v));
+            a.hypot(b)
+        }
+        None => f64::NAN,
+    }
 }
 
 /// A prepared CPU method for many evaluations with one camera: the grid rules
@@ -277,8 +330,8 @@ impl Evaluator {
         camera.validate()?;
         let r = camera.sensor_rect();
         let rule = match method {
-            Method::Riemann { nu, nv } => Some(GridRule::riemann(&r, nu, nv)),
-            Method::Gauss { nu, nv } => Some(GridRule::gauss(&r, nu, nv)),
+            Method::Riemann { nu, nv } => Some(GridRule::riemann(&r, nu, nv).distorted(camera)?),
+            Method::Gauss { nu, nv } => Some(GridRule::gauss(&r, nu, nv).distorted(camera)?),
             Method::Exact { .. } => None,
             Method::Gpu { .. } => {
                 return Err(Error::invalid(
@@ -299,7 +352,13 @@ impl Evaluator {
     pub fn mean_speed(&self, poly: &FlowPoly) -> f64 {
         match (&self.rule, self.method) {
             (Some(rule), _) => rule.mean_speed(poly),
-            (None, Method::Exact { tol }) => exact(poly, &self.camera.sensor_rect(), tol).value,
+            (None, Method::Exact { tol }) if self.camera.distortion.is_none() => {
+                exact(poly, &self.camera.sensor_rect(), tol).value
+            }
+            (None, Method::Exact { tol }) => {
+                let c = &self.camera;
+                exact_with(|u, v| distorted_speed(c, poly, u, v), &c.sensor_rect(), tol).value
+            }
             _ => unreachable!("Evaluator::new accepts only CPU methods"),
         }
     }

@@ -12,6 +12,8 @@
 //! both components are quadratic polynomials in `(u, v)`: [`FlowPoly`] holds
 //! their 12 coefficients, the fast form used by the metric's inner loops.
 
+use crate::camera::distortion::apply;
+use crate::camera::Camera;
 use crate::model::motion::{Plane, Twist};
 
 /// Flow (mm/s) at sensor point `(u, v)` mm, straight from the formula above.
@@ -34,6 +36,26 @@ pub fn flow_mm(f: f64, u: f64, v: f64, tw: &Twist, inv_z: f64) -> (f64, f64) {
 pub fn flow_at(f: f64, u: f64, v: f64, tw: &Twist, plane: Option<&Plane>) -> (f64, f64) {
     let iz = plane.map_or(0.0, |p| p.inverse_depth(f, u, v));
     flow_mm(f, u, v, tw, iz)
+}
+
+/// Flow (mm/s on the distorted sensor) seen at the distorted sensor point
+/// `(ud, vd)` mm (SPEC section 9): the pinhole flow of its undistorted point
+/// pushed through the distortion's Jacobian. Without distortion this is
+/// exactly [`flow_at`]. `None` where undistortion does not converge.
+#[inline]
+pub fn flow_distorted(
+    cam: &Camera,
+    ud: f64,
+    vd: f64,
+    tw: &Twist,
+    plane: Option<&Plane>,
+) -> Option<(f64, f64)> {
+    if cam.distortion.is_none() {
+        return Some(flow_at(cam.focal_mm, ud, vd, tw, plane));
+    }
+    let (u, v) = cam.undistort_mm(ud, vd)?;
+    let fl = flow_at(cam.focal_mm, u, v, tw, plane);
+    Some(apply(&cam.distortion_jacobian(u, v), fl))
 }
 
 /// The flow as two quadratic polynomials in `(u, v)`: coefficients of

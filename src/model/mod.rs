@@ -1,11 +1,10 @@
-//! The physical model (SPEC sections 1-2): the camera's intrinsics
-//! ([`camera`]), its motion and the scene plane ([`motion`]), and the
+//! The physical model (SPEC sections 1-2): the camera (its own layer-1 folder,
+//! [`crate::camera`]), its motion and the scene plane ([`motion`]), and the
 //! instantaneous image-plane flow they produce ([`flow`]). Everything else in
-//! the crate builds on these; this layer imports nothing above `error`.
+//! the crate builds on these; this layer imports only `camera` and `error`.
 
-pub mod camera;
 pub mod flow;
 pub mod motion;
 
-pub use camera::Camera;
+pub use crate::camera::Camera;
 pub use motion::{Plane, Twist};

@@ -1,7 +1,7 @@
 //! Camera twist (angular + linear velocity in the camera frame) and the scene plane.
 
+use crate::camera::Camera;
 use crate::error::{finite, Error, Result};
-use crate::model::camera::Camera;
 use glam::DVec3;
 
 /// Instantaneous camera motion in the camera frame (x right, y down, z forward).

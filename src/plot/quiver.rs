@@ -2,8 +2,8 @@
 //! downsampled grid of pixels, each the image displacement over an exposure
 //! (px, optionally magnified by a stated factor), coloured by speed (px/s).
 
+use crate::camera::Camera;
 use crate::error::{Error, Result};
-use crate::model::camera::Camera;
 use plotters::prelude::*;
 use std::path::Path;
 

@@ -27,7 +27,7 @@ use super::target::{Target, TargetKind};
 use super::texture::MipTexture;
 use super::trajectory::Trajectory;
 use crate::board::{BLOB_RED, BOARD_WHITE};
-use crate::model::camera::Camera;
+use crate::camera::Camera;
 use bytemuck::{Pod, Zeroable};
 use glam::{DMat3, DVec3};
 
@@ -380,13 +380,7 @@ mod tests {
         let b = crate::board::Board::thesis();
         assert_eq!((b.cols, b.rows), (4, 4));
         let t = Target::blobs(0.5, 3.0);
-        let p = params(
-            &crate::model::camera::Camera::thesis(),
-            &t,
-            64,
-            [0, 0, 1, 1],
-            0,
-        );
+        let p = params(&crate::camera::Camera::thesis(), &t, 64, [0, 0, 1, 1], 0);
         let h = b.scaled(0.5);
         assert_eq!(p.tex[0], h.square_m as f32);
         assert_eq!(p.tex[1], h.pitch_m() as f32);

@@ -7,7 +7,7 @@
 
 use super::target::Target;
 use super::trajectory::{Pose, Trajectory};
-use crate::model::camera::Camera;
+use crate::camera::Camera;
 use glam::{DMat3, DVec3};
 use rayon::prelude::*;
 

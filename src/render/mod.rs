@@ -32,9 +32,9 @@ pub use psf::{psf, Psf};
 pub use target::{project, Target, TargetKind};
 pub use trajectory::{Pose, Trajectory};
 
+use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::gpu::Resolved;
-use crate::model::camera::Camera;
 use std::fmt;
 use std::str::FromStr;
 use std::sync::atomic::AtomicBool;

@@ -12,8 +12,8 @@
 use super::texture::MipTexture;
 use super::trajectory::Pose;
 use crate::board::Board;
+use crate::camera::Camera;
 use crate::error::{finite, positive, Error, Result};
-use crate::model::camera::Camera;
 use glam::{DMat3, DVec3};
 use std::path::PathBuf;
 use std::sync::Arc;

@@ -8,8 +8,8 @@
 //! same on the roll rate; 4.5: one slow-walk motion, rotation only vs full
 //! motion over depths) and are printed with every row.
 
+use crate::camera::Camera;
 use crate::metric::{mmbm, Method, Scene};
-use crate::model::camera::Camera;
 use crate::model::motion::{Plane, Twist};
 use crate::Result;
 use glam::DVec3;

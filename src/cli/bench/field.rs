@@ -1,10 +1,10 @@
 //! `mmbm bench --what gpu`: the flow kernels on the GPU against their CPU
 //! twins on one thread and on all cores. Times are printed, never asserted.
 
+use mmbm::camera::Camera;
 use mmbm::error::{Error, Result};
 use mmbm::field::cpu as flow_cpu;
 use mmbm::field::{FlowRunner, Grid, TwistGpu};
-use mmbm::model::camera::Camera;
 use mmbm::model::motion::Twist;
 use std::hint::black_box;
 use std::time::Instant;

@@ -5,8 +5,8 @@
 //! threads), with both area integrators; and the equivalent throughput in
 //! pixel-samples (pixels x instants, or x samples for the lattice) per second.
 
+use mmbm::camera::Camera;
 use mmbm::error::Result;
-use mmbm::model::camera::Camera;
 use mmbm::model::motion::Twist;
 use mmbm::render::{
     maps, render_frame, Backend, Integrator, Quality, RenderJob, Target, Trajectory,

@@ -1,0 +1,279 @@
+//! Camera intrinsics: focal length (mm), pixel pitch (mm), resolution,
+//! principal point and skew (pixels), and the real-camera parts of SPEC
+//! section 9 (distortion, rolling shutter, noise, lens). Coordinates follow
+//! SPEC section 1: x right, y down, z forward; sensor coordinates `(u, v)` in
+//! mm, which are `f` times the normalised coordinates `(x, y)`.
+
+use super::distortion::{Distortion, Jac};
+use super::lens::Lens;
+use super::noise::Noise;
+use super::shutter::Shutter;
+use crate::error::{finite, positive, Error, Result};
+use serde::{Deserialize, Serialize};
+
+/// A camera: pinhole intrinsics plus, optionally, lens distortion, a rolling
+/// shutter, sensor noise and a thin lens (all off by default: the thesis's
+/// ideal camera, whose results are bit-for-bit those without these fields).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Camera {
+    /// Focal length, mm.
+    pub focal_mm: f64,
+    /// Horizontal pixel pitch, mm.
+    pub pitch_x_mm: f64,
+    /// Vertical pixel pitch, mm.
+    pub pitch_y_mm: f64,
+    /// Sensor width, pixels.
+    pub width: u32,
+    /// Sensor height, pixels.
+    pub height: u32,
+    /// Principal point column, pixels (default `width / 2`).
+    pub cx: f64,
+    /// Principal point row, pixels (default `height / 2`).
+    pub cy: f64,
+    /// Skew in pixels (OpenCV's `K[0][1]`): pixel column `= fx*x + skew*y + cx`. Default 0.
+    #[serde(default)]
+    pub skew: f64,
+    /// Lens distortion (default none).
+    #[serde(default, skip_serializing_if = "Distortion::is_none")]
+    pub distortion: Distortion,
+    /// Shutter (default global).
+    #[serde(default, skip_serializing_if = "Shutter::is_global")]
+    pub shutter: Shutter,
+    /// Sensor noise (default none: noiseless linear images).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub noise: Option<Noise>,
+    /// Thin lens for defocus (default none: infinite depth of field).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lens: Option<Lens>,
+}
+
+impl Default for Camera {
+    fn default() -> Self {
+        Self::thesis()
+    }
+}
+
+/// Axis-aligned rectangle on the sensor, mm: `[u0, u1] x [v0, v1]`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SensorRect {
+    /// Left edge, mm.
+    pub u0: f64,
+    /// Right edge, mm.
+    pub u1: f64,
+    /// Top edge, mm.
+    pub v0: f64,
+    /// Bottom edge, mm.
+    pub v1: f64,
+}
+
+impl SensorRect {
+    /// Area, mm^2.
+    pub fn area(&self) -> f64 {
+        (self.u1 - self.u0) * (self.v1 - self.v0)
+    }
+}
+
+impl Camera {
+    /// The thesis camera: f = 4.2548 mm, 4.65 um pixels, 640 x 480, centred principal point.
+    pub fn thesis() -> Self {
+        Self::new(4.2548, 0.00465, 640, 480)
+    }
+
+    /// Square pixels, principal point at the sensor centre, no skew.
+    pub fn new(focal_mm: f64, pitch_mm: f64, width: u32, height: u32) -> Self {
+        Camera {
+            focal_mm,
+            pitch_x_mm: pitch_mm,
+            pitch_y_mm: pitch_mm,
+            width,
+            height,
+            cx: width as f64 / 2.0,
+            cy: height as f64 / 2.0,
+            skew: 0.0,
+            distortion: Distortion::None,
+            shutter: Shutter::global(),
+            noise: None,
+            lens: None,
+        }
+    }
+
+    /// True for the thesis's ideal pinhole with a global shutter (no distortion,
+    /// no readout); noise and lens do not change the geometry.
+    pub fn is_ideal_geometry(&self) -> bool {
+        self.distortion.is_none() && self.shutter.is_global()
+    }
+
+    /// The same camera scaled to a `width x height` sensor, as a calibration
+    /// made at one resolution is used for a video at another: the focal length
+    /// in pixels, the principal point and the skew scale with the size (the
+    /// pixel pitch grows by the inverse factor, so `focal_mm` and the field of
+    /// view are unchanged).
+    pub fn scaled_to(&self, width: u32, height: u32) -> Self {
+        let (sx, sy) = (
+            width as f64 / self.width as f64,
+            height as f64 / self.height as f64,
+        );
+        Camera {
+            width,
+            height,
+            pitch_x_mm: self.pitch_x_mm / sx,
+            pitch_y_mm: self.pitch_y_mm / sy,
+            cx: self.cx * sx,
+            cy: self.cy * sy,
+            skew: self.skew * sx,
+            ..*self
+        }
+    }
+
+    /// Same focal length and pixel pitch, a `width x height` sensor with the
+    /// principal point at its centre (what `--resolution` does).
+    pub fn with_resolution(&self, width: u32, height: u32) -> Self {
+        Camera {
+            width,
+            height,
+            cx: width as f64 / 2.0,
+            cy: height as f64 / 2.0,
+            ..*self
+        }
+    }
+
+    /// Rejects zero/negative/NaN focal length or pitch, an empty sensor, a non-finite principal point.
+    pub fn validate(&self) -> Result<()> {
+        positive("focal length (mm)", self.focal_mm)?;
+        positive("pixel pitch x (mm)", self.pitch_x_mm)?;
+        positive("pixel pitch y (mm)", self.pitch_y_mm)?;
+        finite("principal point cx", self.cx)?;
+        finite("principal point cy", self.cy)?;
+        finite("skew", self.skew)?;
+        if self.width == 0 || self.height == 0 {
+            return Err(Error::invalid(
+                "resolution",
+                format!("must be at least 1x1, got {}x{}", self.width, self.height),
+            ));
+        }
+        self.shutter.validate()?;
+        if let Some(n) = &self.noise {
+            n.validate()?;
+        }
+        if let Some(l) = &self.lens {
+            l.validate(self.focal_mm)?;
+        }
+        self.distortion.validate()?;
+        if !self.distortion.is_none() {
+            self.check_distortion_invertible()?;
+        }
+        Ok(())
+    }
+
+    /// Checks that the distortion is one-to-one over the sensor: every point
+    /// of a 33 x 33 grid over the sensor (edges included) undistorts, the
+    /// Jacobian keeps a positive determinant there, and along every ray from
+    /// the principal point to a grid point the distorted radius grows.
+    fn check_distortion_invertible(&self) -> Result<()> {
+        const N: u32 = 32;
+        let fold = |x: f64, y: f64, why: &str| {
+            Err(Error::invalid(
+                "distortion",
+                format!(
+                    "the model folds over inside the sensor near pixel ({x:.1}, {y:.1}): {why}; \
+                     check the coefficients (and that they belong to this model and resolution)"
+                ),
+            ))
+        };
+        for j in 0..=N {
+            for i in 0..=N {
+                let (px, py) = (
+                    self.width as f64 * i as f64 / N as f64,
+                    self.height as f64 * j as f64 / N as f64,
+                );
+                let (ud, vd) = self.pixel_to_mm(px, py);
+                let Some((u, v)) = self.undistort_mm(ud, vd) else {
+                    return fold(px, py, "undistortion does not converge");
+                };
+                // The distorted point must move outward along the ray to it.
+                for k in 1..=16 {
+                    let s = k as f64 / 16.0;
+                    let jac = self.distortion_jacobian(u * s, v * s);
+                    let det = jac[0][0] * jac[1][1] - jac[0][1] * jac[1][0];
+                    if !(det > 0.0) {
+                        return fold(px, py, "the Jacobian's determinant is not positive");
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Distorted sensor point (mm) of the pinhole sensor point `(u, v)` mm.
+    #[inline]
+    pub fn distort_mm(&self, u: f64, v: f64) -> (f64, f64) {
+        let f = self.focal_mm;
+        let (xd, yd) = self.distortion.distort(u / f, v / f);
+        (xd * f, yd * f)
+    }
+
+    /// Pinhole sensor point (mm) seen at the distorted sensor point `(ud, vd)`
+    /// mm (Newton's method, to [`super::distortion::UNDISTORT_TOL`] in
+    /// normalised units); `None` where it does not converge.
+    #[inline]
+    pub fn undistort_mm(&self, ud: f64, vd: f64) -> Option<(f64, f64)> {
+        let f = self.focal_mm;
+        self.distortion
+            .undistort(ud / f, vd / f)
+            .map(|(x, y)| (x * f, y * f))
+    }
+
+    /// Jacobian of [`Camera::distort_mm`] at the pinhole point `(u, v)` mm
+    /// (dimensionless: the same as in normalised coordinates).
+    #[inline]
+    pub fn distortion_jacobian(&self, u: f64, v: f64) -> Jac {
+        let f = self.focal_mm;
+        self.distortion.jacobian(u / f, v / f)
+    }
+
+    /// Focal length in horizontal pixels.
+    pub fn fx_px(&self) -> f64 {
+        self.focal_mm / self.pitch_x_mm
+    }
+
+    /// Focal length in vertical pixels.
+    pub fn fy_px(&self) -> f64 {
+        self.focal_mm / self.pitch_y_mm
+    }
+
+    /// The sensor as a rectangle in mm around the principal point.
+    pub fn sensor_rect(&self) -> SensorRect {
+        SensorRect {
+            u0: -self.cx * self.pitch_x_mm,
+            u1: (self.width as f64 - self.cx) * self.pitch_x_mm,
+            v0: -self.cy * self.pitch_y_mm,
+            v1: (self.height as f64 - self.cy) * self.pitch_y_mm,
+        }
+    }
+
+    /// Sensor coordinates (mm) of a point given in (fractional) pixel
+    /// coordinates, where pixel `(i, j)` covers `[i, i+1) x [j, j+1)`.
+    /// The centre of pixel `(i, j)` is `pixel_to_mm(i + 0.5, j + 0.5)`.
+    pub fn pixel_to_mm(&self, x: f64, y: f64) -> (f64, f64) {
+        let v = (y - self.cy) * self.pitch_y_mm;
+        let u = (x - self.cx - self.skew * v / self.focal_mm) * self.pitch_x_mm;
+        (u, v)
+    }
+
+    /// Pixel coordinates (fractional, `(0,0)` = top-left corner) of sensor point `(u, v)` mm.
+    pub fn mm_to_pixel(&self, u: f64, v: f64) -> (f64, f64) {
+        (
+            u / self.pitch_x_mm + self.skew * v / self.focal_mm + self.cx,
+            v / self.pitch_y_mm + self.cy,
+        )
+    }
+
+    /// Converts a sensor-plane velocity (mm/s) into pixel velocity (px/s), skew included.
+    pub fn mm_to_px_velocity(&self, du: f64, dv: f64) -> (f64, f64) {
+        (
+            du / self.pitch_x_mm + self.skew * dv / self.focal_mm,
+            dv / self.pitch_y_mm,
+        )
+    }
+}

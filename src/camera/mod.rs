@@ -1,0 +1,18 @@
+//! The camera (SPEC sections 1 and 9): pinhole intrinsics ([`intrinsics`]),
+//! lens distortion ([`distortion`]), rolling shutter ([`shutter`]), sensor
+//! noise ([`noise`]), thin-lens defocus ([`lens`]) and the files that describe
+//! them, Gyroflow lens profiles included ([`file`]). This layer imports
+//! nothing above `error`.
+
+pub mod distortion;
+pub mod file;
+pub mod intrinsics;
+pub mod lens;
+pub mod noise;
+pub mod shutter;
+
+pub use distortion::Distortion;
+pub use intrinsics::{Camera, SensorRect};
+pub use lens::Lens;
+pub use noise::Noise;
+pub use shutter::{Readout, Shutter};
