@@ -186,28 +186,29 @@ pub fn from_gyroflow(p: &Value) -> Result<Camera> {
         }
         None => "opencv_fisheye".into(),
     };
-    let distortion =
-        match model.as_str() {
-            "opencv_fisheye" => Distortion::Fisheye {
-                k1: c(0),
-                k2: c(1),
-                k3: c(2),
-                k4: c(3),
-            },
-            "opencv_standard" => Distortion::Opencv {
-                k1: c(0),
-                k2: c(1),
-                p1: c(2),
-                p2: c(3),
-                k3: c(4),
-            },
-            other => return Err(Error::invalid(
+    let distortion = match model.as_str() {
+        "opencv_fisheye" => Distortion::Fisheye {
+            k1: c(0),
+            k2: c(1),
+            k3: c(2),
+            k4: c(3),
+        },
+        "opencv_standard" => Distortion::Opencv {
+            k1: c(0),
+            k2: c(1),
+            p1: c(2),
+            p2: c(3),
+            k3: c(4),
+        },
+        other => {
+            return Err(Error::invalid(
                 "distortion_model",
                 format!(
                     "'{other}' is not supported (mmbm reads opencv_fisheye and opencv_standard)"
                 ),
-            )),
-        };
+            ))
+        }
+    };
     let focal_mm = match p.get("focal_length").and_then(Value::as_f64) {
         Some(f) if f > 0.0 && f.is_finite() => f,
         _ => fx * NOMINAL_PITCH_MM,
