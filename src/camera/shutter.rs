@@ -40,6 +40,13 @@ impl std::str::FromStr for Readout {
     }
 }
 
+impl Readout {
+    /// True when the lines are rows (top-to-bottom or bottom-to-top).
+    pub fn is_rows(self) -> bool {
+        matches!(self, Readout::TopToBottom | Readout::BottomToTop)
+    }
+}
+
 /// The shutter: global (`readout_s = 0`, the default) or rolling.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 pub struct Shutter {
@@ -77,12 +84,15 @@ impl Shutter {
     /// Delay (s) of the exposure start of the line holding pixel point
     /// `(x, y)` (pixels, `(0, 0)` = top-left corner) on a `width x height`
     /// sensor, after the frame's start (the first line's exposure start).
+    /// A point within 1e-9 px below a line boundary counts to the next line, so
+    /// that a point computed exactly on a boundary (a midpoint rule's node,
+    /// through the mm-to-pixel map's rounding) lands on the same line every time.
     #[inline]
     pub fn delay_s(&self, x: f64, y: f64, width: u32, height: u32) -> f64 {
         if self.readout_s == 0.0 {
             return 0.0;
         }
-        let line = |p: f64, n: u32| (p.floor().clamp(0.0, n as f64 - 1.0), n as f64);
+        let line = |p: f64, n: u32| ((p + 1e-9).floor().clamp(0.0, n as f64 - 1.0), n as f64);
         let (j, n) = match self.direction {
             Readout::TopToBottom => line(y, height),
             Readout::BottomToTop => {

@@ -61,7 +61,11 @@ pub fn parse_resolution(s: &str) -> std::result::Result<(u32, u32), String> {
 /// Camera options (thesis camera by default).
 #[derive(Args, Debug, Clone)]
 pub struct CameraArgs {
-    /// Camera file (TOML or JSON: focal_mm, pitch_mm or pitch_x_mm/pitch_y_mm, width, height, [cx, cy, skew]).
+    /// Camera file: TOML or JSON with focal_mm, pitch_mm (or pitch_x_mm/pitch_y_mm),
+    /// width, height, [cx, cy, skew], and the real-camera keys readout_s,
+    /// readout_direction, [distortion] (model = "opencv": k1,k2,p1,p2,k3; "fisheye":
+    /// k1..k4), [noise] (phi_e_per_s, read_noise_e, full_well_e, gain_dn_per_e, bits,
+    /// seed), [lens] (f_number, focus_m); or a Gyroflow lens profile (.json).
     #[arg(long, value_name = "FILE")]
     pub camera: Option<PathBuf>,
     /// Focal length, mm (overrides the camera file; thesis: 4.2548).
@@ -73,6 +77,21 @@ pub struct CameraArgs {
     /// Sensor resolution WxH, principal point at the centre (thesis: 640x480).
     #[arg(long, value_name = "WxH", value_parser = parse_resolution)]
     pub sensor: Option<(u32, u32)>,
+    /// Scale the camera to a WxH image (focal length in px, principal point and skew
+    /// scale; the field of view stays): a lens profile calibrated at 4K used for 1080p.
+    #[arg(long, value_name = "WxH", value_parser = parse_resolution, conflicts_with = "sensor")]
+    pub scale_to: Option<(u32, u32)>,
+    /// Rolling-shutter readout, s: delay between the first and last line's
+    /// exposure start (0 = global shutter; overrides the camera file's readout_s).
+    #[arg(long, value_name = "S")]
+    pub rolling_readout: Option<f64>,
+    /// Readout direction: top-to-bottom, bottom-to-top, left-to-right, right-to-left.
+    #[arg(long, value_name = "DIR")]
+    pub readout_direction: Option<String>,
+    /// Sensor noise at this light level (electrons per second of a white pixel),
+    /// with the camera file's other noise keys or their defaults.
+    #[arg(long, value_name = "E_PER_S")]
+    pub light: Option<f64>,
 }
 
 impl CameraArgs {
@@ -91,6 +110,21 @@ impl CameraArgs {
         }
         if let Some((w, h)) = self.sensor {
             c = c.with_resolution(w, h);
+        }
+        if let Some((w, h)) = self.scale_to {
+            c = c.scaled_to(w, h);
+        }
+        if let Some(r) = self.rolling_readout {
+            c.shutter.readout_s = r;
+        }
+        if let Some(d) = &self.readout_direction {
+            c.shutter.direction = d.parse()?;
+        }
+        if let Some(phi) = self.light {
+            c.noise = Some(mmbm::camera::Noise {
+                phi_e_per_s: phi,
+                ..c.noise.unwrap_or(mmbm::camera::Noise::at_light(phi))
+            });
         }
         c.validate()?;
         Ok(c)

@@ -66,7 +66,9 @@ pub struct GridRule {
 }
 
 impl GridRule {
-    fn from_points(points: &[(f64, f64)], weights: &[f64]) -> Self {
+    /// A rule of the given sensor points `(u, v)` mm and weights (for a mean,
+    /// the weights sum to 1; a part of a rule keeps its share).
+    pub fn from_points(points: &[(f64, f64)], weights: &[f64]) -> Self {
         let n = points.len().div_ceil(8) * 8;
         let mut m: [Vec<f64>; 5] = Default::default();
         for v in m.iter_mut() {
@@ -116,33 +118,14 @@ impl GridRule {
 
     /// The midpoint (Riemann) rule: centres of `nu x nv` equal cells over `r`.
     pub fn riemann(r: &SensorRect, nu: u32, nv: u32) -> Self {
-        let du = (r.u1 - r.u0) / nu as f64;
-        let dv = (r.v1 - r.v0) / nv as f64;
-        let mut pts = Vec::with_capacity((nu * nv) as usize);
-        for j in 0..nv {
-            for i in 0..nu {
-                pts.push((r.u0 + (i as f64 + 0.5) * du, r.v0 + (j as f64 + 0.5) * dv));
-            }
-        }
-        let w = vec![1.0 / pts.len() as f64; pts.len()];
+        let (pts, w) = riemann_points(r, nu, nv);
         Self::from_points(&pts, &w)
     }
 
     /// Tensor Gauss-Legendre rule with `nu x nv` nodes over `r`.
     pub fn gauss(r: &SensorRect, nu: u32, nv: u32) -> Self {
-        let (xu, wu) = gauss_legendre(nu as usize);
-        let (xv, wv) = gauss_legendre(nv as usize);
-        let (cu, hu) = ((r.u0 + r.u1) / 2.0, (r.u1 - r.u0) / 2.0);
-        let (cv, hv) = ((r.v0 + r.v1) / 2.0, (r.v1 - r.v0) / 2.0);
-        let mut points = Vec::new();
-        let mut weights = Vec::new();
-        for (yv, ww) in xv.iter().zip(&wv) {
-            for (yu, wu) in xu.iter().zip(&wu) {
-                points.push((cu + hu * yu, cv + hv * yv));
-                weights.push(wu * ww / 4.0);
-            }
-        }
-        Self::from_points(&points, &weights)
+        let (pts, w) = gauss_points(r, nu, nv);
+        Self::from_points(&pts, &w)
     }
 
     /// Number of points (without padding).
@@ -169,6 +152,39 @@ impl GridRule {
             }
         }
     }
+}
+
+/// Points (mm, row by row) and weights (summing to 1) of the midpoint rule
+/// on `nu x nv` equal cells over `r`.
+pub fn riemann_points(r: &SensorRect, nu: u32, nv: u32) -> (Vec<(f64, f64)>, Vec<f64>) {
+    let du = (r.u1 - r.u0) / nu as f64;
+    let dv = (r.v1 - r.v0) / nv as f64;
+    let mut pts = Vec::with_capacity((nu * nv) as usize);
+    for j in 0..nv {
+        for i in 0..nu {
+            pts.push((r.u0 + (i as f64 + 0.5) * du, r.v0 + (j as f64 + 0.5) * dv));
+        }
+    }
+    let w = vec![1.0 / pts.len() as f64; pts.len()];
+    (pts, w)
+}
+
+/// Points (mm, row by row) and weights (summing to 1) of the tensor
+/// Gauss-Legendre rule with `nu x nv` nodes over `r`.
+pub fn gauss_points(r: &SensorRect, nu: u32, nv: u32) -> (Vec<(f64, f64)>, Vec<f64>) {
+    let (xu, wu) = gauss_legendre(nu as usize);
+    let (xv, wv) = gauss_legendre(nv as usize);
+    let (cu, hu) = ((r.u0 + r.u1) / 2.0, (r.u1 - r.u0) / 2.0);
+    let (cv, hv) = ((r.v0 + r.v1) / 2.0, (r.v1 - r.v0) / 2.0);
+    let mut points = Vec::new();
+    let mut weights = Vec::new();
+    for (yv, ww) in xv.iter().zip(&wv) {
+        for (yu, wu) in xu.iter().zip(&wu) {
+            points.push((cu + hu * yu, cv + hv * yv));
+            weights.push(wu * ww / 4.0);
+        }
+    }
+    (points, weights)
 }
 
 /// Tensor Gauss-Legendre estimate of MMBM with `nu x nv` nodes, mm/s.

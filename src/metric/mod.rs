@@ -13,7 +13,7 @@ mod exact;
 mod grid;
 
 pub use exact::{exact, exact_with, roll_mean_closed_form, ExactResult};
-pub use grid::{gauss, gauss_legendre, riemann, GridRule};
+pub use grid::{gauss, gauss_legendre, gauss_points, riemann, riemann_points, GridRule};
 
 use crate::camera::Camera;
 use crate::error::{Error, Result};
@@ -299,6 +299,17 @@ fn mmbm_poly_distorted(cam: &Camera, poly: &FlowPoly, method: Method) -> Result<
         }
     };
     finish(cam, mm_s, err, evals)
+}
+
+/// Flow speed (mm/s) at the sensor point `(u, v)` mm of `cam` (through its
+/// distortion, if any; NaN where a point does not undistort).
+#[inline]
+pub fn point_speed(cam: &Camera, poly: &FlowPoly, u: f64, v: f64) -> f64 {
+    if cam.distortion.is_none() {
+        poly.speed(u, v)
+    } else {
+        distorted_speed(cam, poly, u, v)
+    }
 }
 
 /// `|J flow|` (mm/s) at the distorted sensor point `(ud, vd)` mm; NaN where it

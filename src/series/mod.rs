@@ -7,6 +7,7 @@
 //! `experiment` use), and [`run`] streams a file in constant memory to CSV
 //! with header `t,mmbm_mm_s,mmbm_px_s` and shortest round-trip floats.
 
+pub mod frames;
 pub mod gpu;
 
 use crate::error::{Error, Result};

@@ -1,0 +1,125 @@
+//! `mmbm frames`: the exposure MMBM of every frame of a real video, rolling shutter included.
+
+use super::args::{CameraArgs, SceneArgs};
+use super::series::GyroArgs;
+use clap::Args;
+use mmbm::error::Result;
+use mmbm::io::frames::read_frames;
+use mmbm::io::gyro::read_log;
+use mmbm::series::frames::{frame_mmbm, select_sharpest};
+use mmbm::series::SeriesOptions;
+use mmbm::{Method, Scene};
+use std::io::Write;
+use std::path::PathBuf;
+
+/// Exposure MMBM of every video frame (each line over its own rolling-shutter window).
+#[derive(Args, Debug)]
+#[command(
+    after_help = "Output columns: frame (0-based row of FRAMES), t_start (s), exposure_mmbm_mm_s
+(the sensor mean of each point's speed over its own line's window), blur_px (exposure MMBM x
+exposure / pitch), start_mmbm_mm_s (instantaneous MMBM at t_start), exposure_s, readout_s.
+A frame whose window leaves the log gets empty values (one warning for all).
+
+Examples:
+  mmbm frames --gyro ../shared/data/running_phone/gyro.csv --frames ../shared/data/running_phone/frames.csv \\
+      --camera examples/cameras/running_phone.toml --out frames_mmbm.csv
+  mmbm frames --gyro log.gcsv --frames frames.csv --camera lens_profile.json --scale-to 1920x1080 \\
+      --select 20 --gap 0.5 --out sharpest.csv"
+)]
+pub struct FramesArgs {
+    /// Gyro log (CSV, Gyroflow .gcsv or ROS 2 .mcap), on the same clock as FRAMES.
+    #[arg(long, value_name = "FILE")]
+    pub gyro: PathBuf,
+    /// Frame table: CSV with t_start (first line's exposure start, s), exposure_s
+    /// and optionally readout_s (else the camera's readout); '#' lines are comments.
+    #[arg(long, value_name = "FRAMES.csv")]
+    pub frames: PathBuf,
+    /// riemann[:NUxNV], gauss[:N] or exact[:TOL] (gpu is not available here).
+    #[arg(long, default_value = "riemann:8x6")]
+    pub method: String,
+    /// Output CSV (default: stdout).
+    #[arg(long, value_name = "FILE")]
+    pub out: Option<PathBuf>,
+    /// Keep only the N sharpest frames (least blur_px) at least --gap apart.
+    #[arg(long, value_name = "N")]
+    pub select: Option<usize>,
+    /// Smallest time between selected frames' starts, s.
+    #[arg(long, value_name = "S", default_value_t = 0.0, requires = "select")]
+    pub gap: f64,
+    /// Include the log's vx,vy,vz (needs a depth column, --depth or --plane).
+    #[arg(long)]
+    pub use_velocity: bool,
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    #[command(flatten)]
+    pub gyro_opts: GyroArgs,
+    #[command(flatten)]
+    pub camera: CameraArgs,
+}
+
+pub fn run(a: FramesArgs) -> Result<()> {
+    let method: Method = a.method.parse()?;
+    let camera = a.camera.camera()?;
+    let opts = SeriesOptions {
+        scene: Scene {
+            camera,
+            plane: a.scene.plane()?,
+        },
+        method,
+        use_velocity: a.use_velocity,
+    };
+    mmbm::error::finite("--gap", a.gap)?;
+    let frames = read_frames(&a.frames)?;
+    let samples = read_log(&a.gyro, a.gyro_opts.options()?)?;
+    let (rows, outside) = frame_mmbm(&samples, &opts, &frames)?;
+    if !outside.is_empty() {
+        let list: Vec<String> = outside.iter().take(8).map(|k| k.to_string()).collect();
+        eprintln!(
+            "warning: {} frame(s) reach outside the gyro log ({}{}): their values are empty",
+            outside.len(),
+            list.join(", "),
+            if outside.len() > 8 { ", ..." } else { "" }
+        );
+    }
+    let keep: Vec<usize> = match a.select {
+        Some(n) => select_sharpest(&rows, &camera, n, a.gap),
+        None => (0..rows.len()).collect(),
+    };
+    let write = |w: &mut dyn Write| -> Result<()> {
+        let werr = |e: std::io::Error| mmbm::Error::io("<frames output>", e);
+        writeln!(
+            w,
+            "frame,t_start,exposure_mmbm_mm_s,blur_px,start_mmbm_mm_s,exposure_s,readout_s"
+        )
+        .map_err(werr)?;
+        let opt =
+            |x: Option<f64>| x.map_or(String::new(), |v| ryu::Buffer::new().format(v).to_string());
+        for &k in &keep {
+            let r = &rows[k];
+            writeln!(
+                w,
+                "{},{},{},{},{},{},{}",
+                r.frame,
+                ryu::Buffer::new().format(r.t_start),
+                opt(r.exposure_mm_s),
+                opt(r.blur_px(&camera)),
+                opt(r.start_mm_s),
+                ryu::Buffer::new().format(r.exposure_s),
+                ryu::Buffer::new().format(r.readout_s),
+            )
+            .map_err(werr)?;
+        }
+        Ok(())
+    };
+    match &a.out {
+        Some(p) => mmbm::io::atomic::write_atomic(p, |w| write(w))?,
+        None => write(&mut std::io::stdout().lock())?,
+    }
+    eprintln!(
+        "{} frames ({} written), method {method}, camera readout {} s",
+        rows.len(),
+        keep.len(),
+        camera.shutter.readout_s
+    );
+    Ok(())
+}

@@ -1,0 +1,89 @@
+//! Video frame tables (`../shared/data/*/frames.csv`): a CSV with `#` comment
+//! lines and a header with `t_start` (exposure start of the first line, s, on
+//! the gyro log's clock), `exposure_s` and optionally `readout_s` (rolling
+//! shutter, s). Other columns are ignored. Errors name the file, line and column.
+
+use crate::error::{Error, Result};
+use std::path::Path;
+
+/// One video frame.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct VideoFrame {
+    /// Exposure start of the first line, s.
+    pub t_start: f64,
+    /// Exposure time of each line, s.
+    pub exposure_s: f64,
+    /// Rolling-shutter readout (first to last line), s; `None` when the table has no such column.
+    pub readout_s: Option<f64>,
+}
+
+/// Reads a frame table.
+pub fn read_frames(path: &Path) -> Result<Vec<VideoFrame>> {
+    let file = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
+    let mut rd = csv::ReaderBuilder::new()
+        .comment(Some(b'#'))
+        .trim(csv::Trim::All)
+        .from_reader(std::io::BufReader::new(file));
+    let parse_err = |line: u64, column: &str, message: String| Error::Parse {
+        path: path.into(),
+        line,
+        column: column.into(),
+        message,
+    };
+    let headers = rd
+        .headers()
+        .map_err(|e| parse_err(1, "header", e.to_string()))?
+        .clone();
+    let find = |n: &str| headers.iter().position(|h| h == n);
+    let (Some(it), Some(ie)) = (find("t_start"), find("exposure_s")) else {
+        return Err(parse_err(
+            1,
+            "header",
+            format!(
+                "expected columns t_start and exposure_s (and optionally readout_s), found: {}",
+                headers.iter().collect::<Vec<_>>().join(",")
+            ),
+        ));
+    };
+    let ir = find("readout_s");
+    let mut out = Vec::new();
+    let mut record = csv::StringRecord::new();
+    loop {
+        match rd.read_record(&mut record) {
+            Ok(false) => break,
+            Ok(true) => {}
+            Err(e) => {
+                let line = e.position().map_or(0, |p| p.line());
+                return Err(parse_err(line, "record", e.to_string()));
+            }
+        }
+        let line = record.position().map_or(0, |p| p.line());
+        let field = |i: usize, name: &str| -> Result<f64> {
+            let s = record.get(i).unwrap_or("");
+            let x: f64 = s
+                .parse()
+                .map_err(|_| parse_err(line, name, format!("'{s}' is not a number")))?;
+            if !x.is_finite() {
+                return Err(parse_err(line, name, format!("'{s}' is not finite")));
+            }
+            Ok(x)
+        };
+        let frame = VideoFrame {
+            t_start: field(it, "t_start")?,
+            exposure_s: field(ie, "exposure_s")?,
+            readout_s: ir.map(|i| field(i, "readout_s")).transpose()?,
+        };
+        if frame.exposure_s <= 0.0 {
+            return Err(parse_err(
+                line,
+                "exposure_s",
+                format!("must be > 0 s, got {}", frame.exposure_s),
+            ));
+        }
+        if frame.readout_s.is_some_and(|r| r < 0.0) {
+            return Err(parse_err(line, "readout_s", "must be >= 0 s".into()));
+        }
+        out.push(frame);
+    }
+    Ok(out)
+}

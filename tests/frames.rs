@@ -1,0 +1,312 @@
+//! Rolling-shutter exposure MMBM of video frames (SPEC 3 and 9) against
+//! independent computations: each line's window integrated directly, a
+//! closed form for a yaw ramp, and the global-shutter time average.
+
+mod common;
+
+use glam::DVec3;
+use mmbm::camera::{Readout, Shutter};
+use mmbm::io::frames::{read_frames, VideoFrame};
+use mmbm::io::gyro::{read_log, GyroOptions, GyroSample};
+use mmbm::model::flow::flow_at;
+use mmbm::series::frames::{frame_mmbm, select_sharpest};
+use mmbm::series::{mmbm_series, SeriesOptions};
+use mmbm::trigger::Integral;
+use mmbm::{Camera, Method, Scene};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn opts(camera: Camera, method: Method) -> SeriesOptions {
+    SeriesOptions {
+        scene: Scene {
+            camera,
+            plane: None,
+        },
+        method,
+        use_velocity: false,
+    }
+}
+
+/// The independent computation: for every cell centre of an `nu x nv`
+/// midpoint grid over the sensor rectangle (mm, as the metric defines it),
+/// its row's window from the frame table, the speed at each
+/// gyro sample straight from the flow formula, and the trapezoid of the
+/// linear interpolant over the window, written out segment by segment.
+fn direct(samples: &[GyroSample], cam: &Camera, f: &VideoFrame, nu: u32, nv: u32) -> f64 {
+    let readout = f.readout_s.unwrap();
+    let mut total = 0.0;
+    for j in 0..nv {
+        for i in 0..nu {
+            let r = cam.sensor_rect();
+            let u = r.u0 + (i as f64 + 0.5) * (r.u1 - r.u0) / nu as f64;
+            let v = r.v0 + (j as f64 + 0.5) * (r.v1 - r.v0) / nv as f64;
+            // The row holding the point: pixel row = v / pitch_y + cy (skew moves columns only).
+            let row = (v / cam.pitch_y_mm + cam.cy + 1e-9).floor();
+            let a = f.t_start + readout * row / cam.height as f64;
+            let b = a + f.exposure_s;
+            let speed = |s: &GyroSample| {
+                let (du, dv) = flow_at(
+                    cam.focal_mm,
+                    u,
+                    v,
+                    &mmbm::Twist::new(s.omega, DVec3::ZERO),
+                    None,
+                );
+                du.hypot(dv)
+            };
+            let mut integral = 0.0;
+            for w in samples.windows(2) {
+                let (t0, t1) = (w[0].t, w[1].t);
+                let (lo, hi) = (a.max(t0), b.min(t1));
+                if hi <= lo {
+                    continue;
+                }
+                let (s0, s1) = (speed(&w[0]), speed(&w[1]));
+                let at = |x: f64| s0 + (s1 - s0) * (x - t0) / (t1 - t0);
+                integral += (hi - lo) * (at(lo) + at(hi)) / 2.0;
+            }
+            total += integral / f.exposure_s;
+        }
+    }
+    total / (nu * nv) as f64
+}
+
+fn shared_frames(name: &str) -> Option<(Vec<GyroSample>, Vec<VideoFrame>)> {
+    let gyro = common::shared_log(name)?;
+    let frames = read_frames(&gyro.with_file_name("frames.csv")).unwrap();
+    Some((read_log(&gyro, GyroOptions::default()).unwrap(), frames))
+}
+
+fn example_camera(name: &str) -> Camera {
+    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(format!("examples/cameras/{name}.toml"));
+    Camera::load(&p).unwrap()
+}
+
+#[test]
+fn real_logs_match_direct_line_integration() {
+    for name in ["running_phone", "dashboard_car"] {
+        let Some((samples, frames)) = shared_frames(name) else {
+            continue;
+        };
+        let cam = example_camera(name);
+        let (rows, outside) = frame_mmbm(
+            &samples,
+            &opts(cam, Method::Riemann { nu: 8, nv: 6 }),
+            &frames,
+        )
+        .unwrap();
+        assert_eq!(rows.len(), frames.len());
+        assert!(outside.len() <= 2, "{name}: {outside:?}");
+        let mut worst: f64 = 0.0;
+        let mut checked = 0;
+        for (r, f) in rows.iter().zip(&frames).step_by(7) {
+            let Some(m) = r.exposure_mm_s else {
+                continue;
+            };
+            let d = direct(&samples, &cam, f, 8, 6);
+            worst = worst.max((m - d).abs() / d);
+            checked += 1;
+        }
+        eprintln!("{name}: {checked} frames, worst relative difference {worst:.2e}");
+        assert!(checked > 50 && worst < 1e-6, "{name}: {worst}");
+    }
+}
+
+#[test]
+fn global_shutter_is_the_time_average_of_the_series() {
+    let Some((samples, frames)) = shared_frames("running_phone") else {
+        return;
+    };
+    let cam = example_camera("running_phone");
+    let gs: Vec<VideoFrame> = frames
+        .iter()
+        .map(|f| VideoFrame {
+            readout_s: Some(0.0),
+            exposure_s: 0.02,
+            ..*f
+        })
+        .collect();
+    let method = Method::Riemann { nu: 8, nv: 6 };
+    let (rows, _) = frame_mmbm(&samples, &opts(cam, method), &gs).unwrap();
+    let t: Vec<f64> = samples.iter().map(|s| s.t).collect();
+    let m = mmbm_series(
+        &samples,
+        &Scene {
+            camera: cam,
+            plane: None,
+        },
+        method,
+    )
+    .unwrap();
+    let integral = Integral::new(&t, &m);
+    for r in rows.iter().filter(|r| r.exposure_mm_s.is_some()) {
+        let e = integral.mean(r.t_start, r.t_start + 0.02);
+        assert!(
+            (r.exposure_mm_s.unwrap() - e).abs() < 1e-12 * e,
+            "{r:?} vs {e}"
+        );
+        let s = integral.value(r.t_start);
+        assert!((r.start_mm_s.unwrap() - s).abs() < 1e-12 * s);
+    }
+}
+
+/// A yaw ramp w_y = c t: every point's speed is |c t| g(u, v), so a line's
+/// window mean is c (t0 + delay + t_e / 2) g: the later lines see more blur,
+/// in the readout direction (signs and directions included).
+#[test]
+fn yaw_ramp_closed_form_and_directions() {
+    let c = 2.0;
+    let samples: Vec<GyroSample> = (0..=2000)
+        .map(|k| {
+            let t = k as f64 * 1e-3;
+            GyroSample {
+                t,
+                omega: DVec3::new(0.0, c * t, 0.0),
+                velocity: None,
+                depth: None,
+            }
+        })
+        .collect();
+    let (te, tr, t0) = (0.01, 0.03, 0.5);
+    let frame = [VideoFrame {
+        t_start: t0,
+        exposure_s: te,
+        readout_s: Some(tr),
+    }];
+    let mut values = vec![];
+    for dir in [
+        Readout::TopToBottom,
+        Readout::BottomToTop,
+        Readout::LeftToRight,
+    ] {
+        let cam = Camera {
+            shutter: Shutter {
+                readout_s: tr,
+                direction: dir,
+            },
+            ..Camera::thesis()
+        };
+        let (nu, nv) = (8, 6);
+        let (rows, _) =
+            frame_mmbm(&samples, &opts(cam, Method::Riemann { nu, nv }), &frame).unwrap();
+        // Closed form over the same nodes.
+        let mut expect = 0.0;
+        for j in 0..nv {
+            for i in 0..nu {
+                let (px, py) = ((i as f64 + 0.5) * 80.0, (j as f64 + 0.5) * 80.0);
+                let (u, v) = cam.pixel_to_mm(px, py);
+                let g = {
+                    let (du, dv) = flow_at(
+                        cam.focal_mm,
+                        u,
+                        v,
+                        &mmbm::Twist::rotation(0.0, 1.0, 0.0),
+                        None,
+                    );
+                    du.hypot(dv)
+                };
+                let delay = cam.shutter.delay_s(px, py, 640, 480);
+                expect += c * (t0 + delay + te / 2.0) * g / 48.0;
+            }
+        }
+        let got = rows[0].exposure_mm_s.unwrap();
+        assert!(
+            (got - expect).abs() < 1e-12 * expect,
+            "{dir:?}: {got} vs {expect}"
+        );
+        values.push(got);
+    }
+    let global = {
+        let (rows, _) = frame_mmbm(
+            &samples,
+            &opts(Camera::thesis(), Method::Riemann { nu: 8, nv: 6 }),
+            &[VideoFrame {
+                readout_s: Some(0.0),
+                ..frame[0]
+            }],
+        )
+        .unwrap();
+        rows[0].exposure_mm_s.unwrap()
+    };
+    // Later lines, more blur: on a rising ramp any readout adds to it.
+    assert!(values.iter().all(|&v| v > global), "{values:?} vs {global}");
+}
+
+fn run(args: &[&str]) -> (bool, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_mmbm"))
+        .args(args)
+        .output()
+        .unwrap();
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stdout).into(),
+        String::from_utf8_lossy(&out.stderr).into(),
+    )
+}
+
+fn path(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+#[test]
+fn cli_frames_select_and_errors() {
+    let Some(gyro) = common::shared_log("running_phone") else {
+        return;
+    };
+    let frames = gyro.with_file_name("frames.csv");
+    let cam = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("examples/cameras/running_phone.toml");
+    let base = [
+        "frames",
+        "--gyro",
+        path(&gyro),
+        "--frames",
+        path(&frames),
+        "--camera",
+        path(&cam),
+    ];
+    let (ok, all, err) = run(&base);
+    assert!(ok, "{err}");
+    assert!(err.contains("warning: 2 frame(s) reach outside"), "{err}");
+    let lines: Vec<&str> = all.lines().collect();
+    assert_eq!(
+        lines[0],
+        "frame,t_start,exposure_mmbm_mm_s,blur_px,start_mmbm_mm_s,exposure_s,readout_s"
+    );
+    assert_eq!(lines.len(), 589);
+    assert!(
+        lines[1].starts_with("0,") && lines[1].contains(",,,,"),
+        "outside: empty values"
+    );
+    let blur = |l: &str| l.split(',').nth(3).unwrap().parse::<f64>().ok();
+    let (ok, sel, err) = run(&[&base[..], &["--select", "5", "--gap", "0.5"]].concat());
+    assert!(ok, "{err}");
+    let picked: Vec<&str> = sel.lines().skip(1).collect();
+    assert_eq!(picked.len(), 5);
+    let min_all = lines
+        .iter()
+        .skip(1)
+        .filter_map(|l| blur(l))
+        .fold(f64::INFINITY, f64::min);
+    assert!(
+        picked.iter().any(|l| blur(l) == Some(min_all)),
+        "the sharpest frame is picked"
+    );
+    let ts: Vec<f64> = picked
+        .iter()
+        .map(|l| l.split(',').nth(1).unwrap().parse().unwrap())
+        .collect();
+    for (a, b) in ts.iter().zip(ts.iter().skip(1)) {
+        assert!(b - a >= 0.5, "{ts:?}");
+    }
+    let (ok, _, err) = run(&[&base[..], &["--method", "gpu"]].concat());
+    assert!(
+        !ok && err.contains("gpu is not available for frames"),
+        "{err}"
+    );
+    let (ok, _, err) = run(&[&base[..], &["--method", "exact:1e-6"]].concat());
+    assert!(!ok && err.contains("riemann:64x1080"), "{err}");
+    let bad = std::env::temp_dir().join(format!("mmbm-frames-{}.csv", std::process::id()));
+    std::fs::write(&bad, "# c\nt_start,exposure_s\n0.1,0.01\n0.2,abc\n").unwrap();
+    let (ok, _, err) = run(&["frames", "--gyro", path(&gyro), "--frames", path(&bad)]);
+    assert!(!ok && err.contains(":4:exposure_s"), "{err}");
+}
