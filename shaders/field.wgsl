@@ -94,7 +94,7 @@ fn atan_poly(x: f32) -> f32 {
         + z2 * (-0.0161657367 + z2 * 0.0028662257)))))));
     let a = z * p;
     if (inv) {
-        return 1.5707963268 - a;
+        return 1.5707964 - a; // pi/2 in f32, as the twin's FRAC_PI_2
     }
     return a;
 }

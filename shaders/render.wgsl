@@ -30,7 +30,7 @@ struct Params {
     dims: vec4<u32>,       // width, height, kind, N
     lattice: vec4<u32>,    // g1, g2, 0, seed
     range: vec4<u32>,      // row0, k0, k1, (k0 g1) mod N
-    range2: vec4<u32>,     // (k0 g2) mod N, rows, 0, 0
+    range2: vec4<u32>,     // (k0 g2) mod N, rows, line mode, 0
     bbox: vec4<u32>,       // x0, y0, x1, y1 (end exclusive)
 }
 
@@ -131,6 +131,19 @@ fn shade(h: Homography, px: f32, py: f32) -> vec3<f32> {
     return trilinear(u, v, lod);
 }
 
+// Rolling shutter (SPEC 9): the first table entry of pixel (i, j)'s line.
+// Line mode range2.z: 0 one set of N instants for every pixel, 1 one set per
+// row, 2 one per column (each line's own exposure window).
+fn line_base(i: u32, j: u32) -> u32 {
+    if (P.range2.z == 1u) {
+        return j * P.dims.w;
+    }
+    if (P.range2.z == 2u) {
+        return i * P.dims.w;
+    }
+    return 0u;
+}
+
 @compute @workgroup_size(8, 8, 1)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let w = P.dims.x;
@@ -158,10 +171,11 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     var acc = vec3<f32>(0.0);
     let fi = f32(i);
     let fj = f32(j);
+    let base = line_base(i, j);
     for (var k = P.range.y; k < P.range.z; k = k + 1u) {
         let sx = fract(f32(xi) * inv_n + shx);
         let sy = fract(f32(yi) * inv_n + shy);
-        acc = acc + shade(homs[k], fi + sx, fj + sy);
+        acc = acc + shade(homs[base + k], fi + sx, fj + sy);
         xi = xi + g1;
         if (xi >= n) {
             xi = xi - n;
@@ -320,8 +334,9 @@ fn analytic(@builtin(global_invocation_id) gid: vec3<u32>) {
     let px = f32(i) + 0.5;
     let py = f32(j) + 0.5;
     var acc = vec3<f32>(0.0);
+    let base = line_base(i, j);
     for (var k = P.range.y; k < P.range.z; k = k + 1u) {
-        acc = acc + footprint_mean(homs[k], px, py);
+        acc = acc + footprint_mean(homs[base + k], px, py);
     }
     out_rgb[o] = out_rgb[o] + vec4<f32>(acc, 0.0);
 }

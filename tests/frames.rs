@@ -9,7 +9,7 @@ use mmbm::camera::{Readout, Shutter};
 use mmbm::io::frames::{read_frames, VideoFrame};
 use mmbm::io::gyro::{read_log, GyroOptions, GyroSample};
 use mmbm::model::flow::flow_at;
-use mmbm::series::frames::{frame_mmbm, select_sharpest};
+use mmbm::series::frames::frame_mmbm;
 use mmbm::series::{mmbm_series, SeriesOptions};
 use mmbm::trigger::Integral;
 use mmbm::{Camera, Method, Scene};

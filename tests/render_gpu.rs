@@ -32,6 +32,26 @@ fn scenes(tex: &std::path::Path) -> Vec<(&'static str, RenderJob)> {
             "image 6-DoF",
             RenderJob::new(cam, Trajectory::from_twist(tw6, 0.03).unwrap(), image),
         ),
+        (
+            // Rolling shutter (SPEC 9): one table of instants per column; the
+            // trajectory spans readout + exposure.
+            "checker 6-DoF rolling left-to-right",
+            RenderJob::new(
+                Camera {
+                    shutter: mmbm::camera::Shutter {
+                        readout_s: 0.02,
+                        direction: mmbm::camera::Readout::LeftToRight,
+                    },
+                    ..cam
+                },
+                Trajectory::from_twist(tw6, 0.06).unwrap(),
+                {
+                    let mut c = Target::checker(0.03, 1.2);
+                    c.tilt_deg = [12.0, -18.0];
+                    c
+                },
+            ),
+        ),
     ]
 }
 

@@ -196,7 +196,7 @@ impl Camera {
                     let s = k as f64 / 16.0;
                     let jac = self.distortion_jacobian(u * s, v * s);
                     let det = jac[0][0] * jac[1][1] - jac[0][1] * jac[1][0];
-                    if !(det > 0.0) {
+                    if det.is_nan() || det <= 0.0 {
                         return fold(px, py, "the Jacobian's determinant is not positive");
                     }
                 }

@@ -189,7 +189,7 @@ mod tests {
         assert!(a.iter().all(|&p| p == 1.0));
         let mut dark = vec![0.0f32; 1000];
         noise.apply(&mut dark, 0.05, 0).unwrap();
-        assert!(dark.iter().all(|&p| p >= 0.0 && p < 0.01));
+        assert!(dark.iter().all(|&p| (0.0..0.01).contains(&p)));
     }
 
     #[test]

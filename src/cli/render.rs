@@ -170,15 +170,18 @@ pub fn run(args: RenderArgs) -> Result<()> {
     if let Some((w, h)) = a.resolution {
         camera = camera.with_resolution(w, h);
     }
+    // A rolling shutter exposes each line over its own window: the motion
+    // spans the readout plus the exposure.
+    let span = a.exposure + camera.shutter.readout_s;
     let trajectory = match (&a.omega, &a.gyro) {
         (Some(w), None) => {
-            Trajectory::from_twist(Twist::new(*w, a.velocity.unwrap_or_default()), a.exposure)?
+            Trajectory::from_twist(Twist::new(*w, a.velocity.unwrap_or_default()), span)?
         }
         (None, Some(path)) => {
             let at =
                 a.at.ok_or_else(|| Error::invalid("--at", "required with --gyro"))?;
             let samples = mmbm::io::gyro::read_log(path, a.gyro_opts.options()?)?;
-            Trajectory::from_log(&samples, at, a.exposure, a.use_velocity)
+            Trajectory::from_log(&samples, at, span, a.use_velocity)
                 .map_err(|e| Error::invalid("--gyro", format!("{}: {e}", path.display())))?
         }
         _ => {

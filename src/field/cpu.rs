@@ -50,7 +50,7 @@ pub fn atan_poly(x: f32) -> f32 {
                             + z2 * (0.0429096138 + z2 * (-0.0161657367 + z2 * 0.0028662257)))))));
     let a = z * p;
     if inv {
-        1.5707963268 - a
+        std::f32::consts::FRAC_PI_2 - a
     } else {
         a
     }

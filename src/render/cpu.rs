@@ -63,6 +63,17 @@ fn shade(p: &RenderParams, tex: Option<&MipTexture>, h: &GpuHomography, px: f32,
     }
 }
 
+/// Twin of the shader's `line_base`: the first table entry of pixel `(i, j)`'s
+/// line (rolling shutter: one set of instants per row or column).
+#[inline]
+pub fn line_base(p: &RenderParams, i: u32, j: u32) -> u32 {
+    match p.range2[2] {
+        1 => j * p.dims[3],
+        2 => i * p.dims[3],
+        _ => 0,
+    }
+}
+
 /// Sum (not mean) of the samples `k0..k1` of pixel `(i, j)`.
 pub fn pixel_sum(
     p: &RenderParams,
@@ -83,10 +94,11 @@ pub fn pixel_sum(
     let (mut xi, mut yi) = (p.range[3], p.range2[0]);
     let mut acc = Vec3::ZERO;
     let (fi, fj) = (i as f32, j as f32);
+    let base = line_base(p, i, j);
     for k in p.range[1]..p.range[2] {
         let sx = fract(xi as f32 * inv_n + shx);
         let sy = fract(yi as f32 * inv_n + shy);
-        acc += shade(p, tex, &homs[k as usize], fi + sx, fj + sy);
+        acc += shade(p, tex, &homs[(base + k) as usize], fi + sx, fj + sy);
         xi += g1;
         if xi >= n {
             xi -= n;
@@ -283,8 +295,9 @@ pub fn pixel_sum_analytic(p: &RenderParams, homs: &[GpuHomography], i: u32, j: u
     }
     let (px, py) = (i as f32 + 0.5, j as f32 + 0.5);
     let mut acc = Vec3::ZERO;
+    let base = line_base(p, i, j);
     for k in p.range[1]..p.range[2] {
-        acc += footprint_mean(p, &homs[k as usize], px, py);
+        acc += footprint_mean(p, &homs[(base + k) as usize], px, py);
     }
     acc
 }

@@ -63,7 +63,7 @@ pub struct RenderParams {
     pub lattice: [u32; 4],
     /// First row of this dispatch, first and end sample index k0, k1, (k0*g1) mod N.
     pub range: [u32; 4],
-    /// (k0*g2) mod N, rows in this dispatch, 0, 0.
+    /// (k0*g2) mod N, rows in this dispatch, line mode ([`line_mode`]), 0.
     pub range2: [u32; 4],
     /// x0, y0, x1, y1 (px, end exclusive): pixels outside see only the background.
     pub bbox: [u32; 4],
@@ -128,16 +128,57 @@ pub fn instant(trajectory: &Trajectory, m: u32, n: u32) -> f64 {
     trajectory.duration() * (m as f64 + 0.5) / n as f64
 }
 
-/// The homography table: `n` instants, for upload.
+/// Line mode of the homography table (`RenderParams::range2[2]`): 0 one set
+/// of instants for every pixel (global shutter), 1 one set per row, 2 one per
+/// column (rolling shutter, SPEC 9).
+pub fn line_mode(cam: &Camera) -> u32 {
+    match (cam.shutter.is_global(), cam.shutter.direction.is_rows()) {
+        (true, _) => 0,
+        (false, true) => 1,
+        (false, false) => 2,
+    }
+}
+
+/// Lines of the homography table: 1, the rows or the columns.
+pub fn table_lines(cam: &Camera) -> u32 {
+    match line_mode(cam) {
+        0 => 1,
+        1 => cam.height,
+        _ => cam.width,
+    }
+}
+
+/// Exposure of each line, s: the trajectory spans the first line's exposure
+/// start to the last line's exposure end, `readout + exposure`.
+pub fn line_exposure(cam: &Camera, trajectory: &Trajectory) -> f64 {
+    trajectory.duration() - cam.shutter.readout_s
+}
+
+/// Time (s after the trajectory's start) of instant `m` of `n` of table line
+/// `line`: the line's delay plus the step midpoint of its own exposure.
+/// Without a readout this is [`instant`].
+pub fn line_instant(cam: &Camera, trajectory: &Trajectory, line: u32, m: u32, n: u32) -> f64 {
+    if cam.shutter.is_global() {
+        return instant(trajectory, m, n);
+    }
+    let c = line as f64 + 0.5;
+    let delay = cam.shutter.delay_s(c, c, cam.width, cam.height);
+    delay + line_exposure(cam, trajectory) * (m as f64 + 0.5) / n as f64
+}
+
+/// The homography table: `n` instants for each of [`table_lines`] lines
+/// (line-major: entry `line * n + m`), for upload.
 pub fn homographies(
     cam: &Camera,
     target: &Target,
     trajectory: &Trajectory,
     n: u32,
 ) -> Vec<GpuHomography> {
-    (0..n)
-        .map(|m| {
-            let h = homography(cam, target, &trajectory.pose_at(instant(trajectory, m, n)));
+    let lines = table_lines(cam);
+    (0..lines * n)
+        .map(|e| {
+            let t = line_instant(cam, trajectory, e / n, e % n, n);
+            let h = homography(cam, target, &trajectory.pose_at(t));
             let r = |v: DVec3, w: f64| [v.x as f32, v.y as f32, v.z as f32, w as f32];
             GpuHomography {
                 h0: r(h.row(0), 0.0),
@@ -330,7 +371,7 @@ pub fn params(cam: &Camera, target: &Target, n: u32, bbox: [u32; 4], seed: u32) 
         dims: [cam.width, cam.height, kind, n],
         lattice: [g1, g2, 0, seed],
         range: [0, 0, n, 0],
-        range2: [0, cam.height, 0, 0],
+        range2: [0, cam.height, line_mode(cam), 0],
         bbox,
     }
 }
@@ -340,7 +381,12 @@ pub fn with_range(p: &RenderParams, row0: u32, rows: u32, k0: u32, k1: u32) -> R
     let n = p.dims[3] as u64;
     let mut q = *p;
     q.range = [row0, k0, k1, ((k0 as u64 * p.lattice[0] as u64) % n) as u32];
-    q.range2 = [((k0 as u64 * p.lattice[1] as u64) % n) as u32, rows, 0, 0];
+    q.range2 = [
+        ((k0 as u64 * p.lattice[1] as u64) % n) as u32,
+        rows,
+        p.range2[2],
+        0,
+    ];
     q
 }
 

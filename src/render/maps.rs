@@ -117,7 +117,19 @@ fn path_disp(
     y: f64,
 ) -> Option<(f64, f64)> {
     let id: Pose = (glam::DQuat::IDENTITY, DVec3::ZERO);
-    let p0 = target.intersect(cam, &id, x, y)?;
+    path_disp_from(cam, target, &id, poses, x, y)
+}
+
+/// [`path_disp`] for the scene point seen at `(x, y)` from pose `start`.
+fn path_disp_from(
+    cam: &Camera,
+    target: &Target,
+    start: &Pose,
+    poses: &[(DMat3, DVec3)],
+    x: f64,
+    y: f64,
+) -> Option<(f64, f64)> {
+    let p0 = target.intersect(cam, start, x, y)?;
     let first = proj(cam, &poses[0], p0)?;
     let mut prev = first;
     let mut len = 0.0;
@@ -161,7 +173,14 @@ pub fn max_path_px(cam: &Camera, target: &Target, traj: &Trajectory) -> f64 {
 
 /// Computes the maps with `steps` time steps (chords of the track; choose
 /// steps so that a chord is well under a pixel, e.g. `max_path_px / 0.25`).
+///
+/// With a rolling shutter each pixel's path is over its own line's window
+/// (the trajectory spans readout + exposure; SPEC 9) and the speed is the
+/// path over the line's exposure.
 pub fn blur_maps(cam: &Camera, target: &Target, traj: &Trajectory, steps: usize) -> BlurMaps {
+    if !cam.shutter.is_global() {
+        return blur_maps_rolling(cam, target, traj, steps);
+    }
     let poses = inv_poses(traj, steps.max(1));
     let (w, h) = (cam.width as usize, cam.height as usize);
     let dur = traj.duration();
@@ -182,5 +201,62 @@ pub fn blur_maps(cam: &Camera, target: &Target, traj: &Trajectory, steps: usize)
         path_px: vals.iter().map(|v| v.0).collect(),
         disp_px: vals.iter().map(|v| v.1).collect(),
         speed_px_s: vals.iter().map(|v| (v.0 as f64 / dur) as f32).collect(),
+    }
+}
+
+/// [`blur_maps`] with a rolling shutter: one pose table per line (row or
+/// column), over that line's exposure window.
+fn blur_maps_rolling(cam: &Camera, target: &Target, traj: &Trajectory, steps: usize) -> BlurMaps {
+    let steps = steps.max(1);
+    let te = traj.duration() - cam.shutter.readout_s;
+    let rows = cam.shutter.direction.is_rows();
+    let (w, h) = (cam.width as usize, cam.height as usize);
+    let (lines, len) = if rows { (h, w) } else { (w, h) };
+    let per_line: Vec<Vec<(f32, f32)>> = (0..lines)
+        .into_par_iter()
+        .map(|l| {
+            let c = l as f64 + 0.5;
+            let t0 = cam.shutter.delay_s(c, c, cam.width, cam.height);
+            let start = traj.pose_at(t0);
+            let poses: Vec<(DMat3, DVec3)> = (0..=steps)
+                .map(|k| {
+                    let (q, c) = traj.pose_at(t0 + te * k as f64 / steps as f64);
+                    (DMat3::from_quat(q.inverse()), c)
+                })
+                .collect();
+            (0..len)
+                .map(|m| {
+                    let (i, j) = if rows { (m, l) } else { (l, m) };
+                    match path_disp_from(
+                        cam,
+                        target,
+                        &start,
+                        &poses,
+                        i as f64 + 0.5,
+                        j as f64 + 0.5,
+                    ) {
+                        Some((a, d)) => (a as f32, d as f32),
+                        None => (f32::NAN, f32::NAN),
+                    }
+                })
+                .collect()
+        })
+        .collect();
+    let mut path = vec![0f32; w * h];
+    let mut disp = vec![0f32; w * h];
+    for (l, vals) in per_line.iter().enumerate() {
+        for (m, v) in vals.iter().enumerate() {
+            let idx = if rows { l * w + m } else { m * w + l };
+            path[idx] = v.0;
+            disp[idx] = v.1;
+        }
+    }
+    BlurMaps {
+        width: cam.width,
+        height: cam.height,
+        duration: te,
+        speed_px_s: path.iter().map(|&p| (p as f64 / te) as f32).collect(),
+        path_px: path,
+        disp_px: disp,
     }
 }

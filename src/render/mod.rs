@@ -44,6 +44,40 @@ pub const MAX_PIXELS: u64 = 1 << 26;
 /// Most pixel-samples of one frame (work).
 pub const MAX_PIXEL_SAMPLES: u64 = 1 << 40;
 
+/// Most entries of a rolling-shutter homography table (lines x instants; 48 bytes each).
+pub const MAX_TABLE: u64 = 1 << 21;
+
+/// Checks what the renderer supports of the camera: a readout shorter than
+/// the trajectory (which spans readout + exposure); distortion and a lens
+/// (defocus) are not rendered (yet): a clear error rather than an ideal image.
+fn check_camera(cam: &Camera, trajectory: &Trajectory) -> Result<()> {
+    if !cam.distortion.is_none() {
+        return Err(Error::invalid(
+            "distortion",
+            "the renderer does not model lens distortion yet (the metric, flow fields and \
+             `mmbm frames` do); render with a pinhole camera",
+        ));
+    }
+    if cam.lens.is_some() {
+        return Err(Error::invalid(
+            "lens",
+            "the renderer does not model defocus yet; remove [lens] from the camera to render",
+        ));
+    }
+    let te = kernel::line_exposure(cam, trajectory);
+    if te.is_nan() || te <= 0.0 {
+        return Err(Error::invalid(
+            "readout_s",
+            format!(
+                "the trajectory ({} s) must span the readout ({} s) plus a positive exposure",
+                trajectory.duration(),
+                cam.shutter.readout_s
+            ),
+        ));
+    }
+    Ok(())
+}
+
 /// Largest sample count per pixel accepted (a longer blur is an error).
 pub const MAX_SAMPLES: u32 = 1 << 20;
 
@@ -204,7 +238,9 @@ impl fmt::Display for Integrator {
 pub struct RenderJob {
     /// Camera intrinsics.
     pub camera: Camera,
-    /// Camera motion during the exposure.
+    /// Camera motion from the first line's exposure start to the last line's
+    /// exposure end: the exposure, plus the camera's rolling-shutter readout
+    /// when it has one (each line is exposed over its own window, SPEC 9).
     pub trajectory: Trajectory,
     /// The target.
     pub target: Target,
@@ -283,8 +319,14 @@ impl RenderOutput {
 
 static ANNOUNCED: AtomicBool = AtomicBool::new(false);
 
-/// Renders one frame.
+/// Renders one frame. With sensor noise in the camera, the image is the
+/// noisy digital image (EMVA 1288 model, [`crate::camera::Noise`]) scaled to 0..1.
 pub fn render_frame(job: &RenderJob) -> Result<RenderOutput> {
+    render_frame_stream(job, 0)
+}
+
+/// [`render_frame`] with the noise drawn from RNG stream `stream`.
+fn render_frame_stream(job: &RenderJob, stream: u64) -> Result<RenderOutput> {
     let cam = &job.camera;
     job.target.validate_for(cam)?;
     // The camera must stay in front of the target for the whole exposure.
@@ -302,6 +344,7 @@ pub fn render_frame(job: &RenderJob) -> Result<RenderOutput> {
             ),
         ));
     }
+    check_camera(cam, &job.trajectory)?;
     let lmax = maps::max_path_px(cam, &job.target, &job.trajectory);
     let is_image = matches!(job.target.kind, TargetKind::Image { .. });
     let analytic = match job.integrator {
@@ -331,8 +374,23 @@ pub fn render_frame(job: &RenderJob) -> Result<RenderOutput> {
             ),
         ));
     }
+    let lines = kernel::table_lines(cam) as u64;
+    if lines * n as u64 > MAX_TABLE {
+        return Err(Error::invalid(
+            "readout_s",
+            format!(
+                "a rolling shutter needs {n} instants for each of {lines} lines ({} table entries, \
+                 limit {MAX_TABLE}); shorten the exposure or the motion, or lower the resolution",
+                lines * n as u64
+            ),
+        ));
+    }
     let homs = kernel::homographies(cam, &job.target, &job.trajectory, n);
-    let bbox = kernel::target_bbox(cam, &job.target, &job.trajectory, n);
+    // The bounding box over every line's instants: the whole span, as finely.
+    let span_n = (n as f64 * job.trajectory.duration()
+        / kernel::line_exposure(cam, &job.trajectory))
+    .ceil() as u32;
+    let bbox = kernel::target_bbox(cam, &job.target, &job.trajectory, span_n.max(n));
     let params = kernel::params(cam, &job.target, n, bbox, job.seed);
     let tex = kernel::texture_of(&job.target);
     let (rgb, backend_used) = match job.backend.resolve("render", "renderer", &ANNOUNCED)? {
@@ -348,6 +406,14 @@ pub fn render_frame(job: &RenderJob) -> Result<RenderOutput> {
             )
         }
     };
+    let mut rgb = rgb;
+    if let Some(noise) = &cam.noise {
+        noise.apply(
+            &mut rgb,
+            kernel::line_exposure(cam, &job.trajectory),
+            stream,
+        )?;
+    }
     let maps = job.with_maps.then(|| {
         let steps = ((lmax / 0.25).ceil() as usize).clamp(64, 4096);
         maps::blur_maps(cam, &job.target, &job.trajectory, steps)
@@ -363,7 +429,8 @@ pub fn render_frame(job: &RenderJob) -> Result<RenderOutput> {
     })
 }
 
-/// The sharp frame at exposure start (no motion), same quality and backend.
+/// The sharp frame at exposure start (no motion), same quality and backend;
+/// with sensor noise, another realisation of it (RNG stream 1).
 pub fn render_sharp(job: &RenderJob) -> Result<RenderOutput> {
     let still = RenderJob {
         trajectory: Trajectory::from_twist(
@@ -373,5 +440,5 @@ pub fn render_sharp(job: &RenderJob) -> Result<RenderOutput> {
         with_maps: false,
         ..job.clone()
     };
-    render_frame(&still)
+    render_frame_stream(&still, 1)
 }

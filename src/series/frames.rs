@@ -81,7 +81,9 @@ fn line_groups(cam: &Camera, method: Method) -> Result<Vec<(f64, GridRule)>> {
         readout_s: 1.0,
         direction: cam.shutter.direction,
     };
-    let mut groups: BTreeMap<u64, (f64, Vec<(f64, f64)>, Vec<f64>)> = BTreeMap::new();
+    // Per line (keyed by the delay's bits): delay, points, weights.
+    type Line = (f64, Vec<(f64, f64)>, Vec<f64>);
+    let mut groups: BTreeMap<u64, Line> = BTreeMap::new();
     for (&(u, v), &wk) in pts.iter().zip(&w) {
         let (px, py) = cam.mm_to_pixel(u, v);
         let d = unit.delay_s(px, py, cam.width, cam.height);
@@ -247,9 +249,9 @@ mod tests {
     fn window_mean_is_exact_for_piecewise_linear() {
         let t = [0.0, 1.0, 3.0];
         let y = [0.0, 2.0, 0.0];
-        // Integral over [0.5, 2]: 0.5*(1+2)*0.5 + 0.5*(2+1.5)*1 = 0.75 + 1.75 = 2.5.
-        assert!((window_mean(&t, &y, 0.5, 2.0) - 2.5 / 1.5).abs() < 1e-15);
-        assert_eq!(window_mean(&t, &y, 2.0, 2.0), 1.5);
+        // Integral over [0.5, 2]: 0.5*(1+2)*0.5 + 0.5*(2+1)*1 = 0.75 + 1.5 = 2.25.
+        assert!((window_mean(&t, &y, 0.5, 2.0) - 2.25 / 1.5).abs() < 1e-15);
+        assert_eq!(window_mean(&t, &y, 2.0, 2.0), 1.0);
         assert_eq!(window_mean(&t, &y, 0.0, 3.0), 1.0);
     }
 }
