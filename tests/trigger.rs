@@ -428,3 +428,24 @@ fn bad_inputs_are_errors() {
     let e = run(&s, &m, p.as_mut(), &CameraTiming::default()).unwrap_err();
     assert!(e.to_string().contains("sample 3"), "{e}");
 }
+
+/// A rolling shutter (SPEC 9) keeps the camera busy from the first line's
+/// exposure start to the last line's exposure end plus the readout: frames
+/// start at least `t_e + t_rs + t_r` apart.
+#[test]
+fn rolling_readout_extends_the_busy_time() {
+    let (s, m) = sim(Gait::Moderate, 5.0, 3);
+    let gs = timing0();
+    let rs = gs.with_rolling_readout(0.04);
+    assert_eq!(rs.readout, 0.04);
+    let gap = |f: &[Frame]| {
+        f.windows(2)
+            .map(|w| w[1].exposure_start - w[0].exposure_start)
+            .fold(f64::INFINITY, f64::min)
+    };
+    let a = go("fixed:20", &s, &m, &gs);
+    let b = go("fixed:20", &s, &m, &rs);
+    assert!(gap(&a) < 0.06, "global shutter: every 50 ms slot ({})", gap(&a));
+    assert!(gap(&b) >= 0.09 - 1e-9, "rolling: busy 50 + 40 ms ({})", gap(&b));
+    assert!(b.len() < a.len());
+}

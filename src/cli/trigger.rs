@@ -99,7 +99,11 @@ pub fn run(a: TriggerArgs) -> Result<()> {
     if matches!(method, Method::Gpu { .. }) {
         return Err(Error::invalid("--method", "trigger uses a CPU method"));
     }
-    let timing = a.timing.timing(a.exposure);
+    // A rolling shutter keeps the camera busy for its line readout as well.
+    let timing = a
+        .timing
+        .timing(a.exposure)
+        .with_rolling_readout(a.camera.camera()?.shutter.readout_s);
     timing.validate()?;
     let mut policies = Vec::new();
     for p in &a.policy {

@@ -31,6 +31,16 @@ impl Default for CameraTiming {
 }
 
 impl CameraTiming {
+    /// The timing of a rolling-shutter camera (SPEC 9): its last line's
+    /// exposure ends `rolling_readout_s` after the first line's, so the camera
+    /// is busy that much longer before the readout `t_r` that follows.
+    pub fn with_rolling_readout(self, rolling_readout_s: f64) -> Self {
+        CameraTiming {
+            readout: self.readout + rolling_readout_s,
+            ..self
+        }
+    }
+
     /// Checks that the times are finite, the exposure positive and the others non-negative.
     pub fn validate(&self) -> Result<()> {
         crate::error::positive("exposure", self.exposure)?;
