@@ -28,7 +28,7 @@ struct Params {
     colour_b: vec4<f32>,
     lod: vec4<f32>,        // LOD_SCALE, 1/N, 0, 0
     dims: vec4<u32>,       // width, height, kind, N
-    lattice: vec4<u32>,    // g1, g2, 0, seed
+    lattice: vec4<u32>,    // g1, g2, distortion map offset (0: none), seed
     range: vec4<u32>,      // row0, k0, k1, (k0 g1) mod N
     range2: vec4<u32>,     // (k0 g2) mod N, rows, line mode, 0
     bbox: vec4<u32>,       // x0, y0, x1, y1 (end exclusive)
@@ -131,6 +131,17 @@ fn shade(h: Homography, px: f32, py: f32) -> vec3<f32> {
     return trilinear(u, v, lod);
 }
 
+// Lens distortion (SPEC 9): entry lattice.z + (j w + i) of the table is pixel
+// (i, j)'s map: h0 = (x', y', L00, L01), h1 = (L10, L11, _, _), with (x', y')
+// the pinhole pixel coordinates of the ray through the pixel centre and L the
+// Jacobian of undistortion there (host f64). A sample at (sx, sy) in the
+// pixel goes to (x', y') + L (sx - 1/2, sy - 1/2): first order in the pixel.
+fn pixel_point(m: Homography, sx: f32, sy: f32) -> vec2<f32> {
+    let dx = sx - 0.5;
+    let dy = sy - 0.5;
+    return vec2<f32>(m.h0.x + m.h0.z * dx + m.h0.w * dy, m.h0.y + m.h1.x * dx + m.h1.y * dy);
+}
+
 // Rolling shutter (SPEC 9): the first table entry of pixel (i, j)'s line.
 // Line mode range2.z: 0 one set of N instants for every pixel, 1 one set per
 // row, 2 one per column (each line's own exposure window).
@@ -172,10 +183,19 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let fi = f32(i);
     let fj = f32(j);
     let base = line_base(i, j);
+    // Lens distortion: the pixel's map (see pixel_point).
+    var m = Homography(vec4<f32>(0.0), vec4<f32>(0.0), vec4<f32>(0.0));
+    if (P.lattice.z != 0u) {
+        m = homs[P.lattice.z + j * w + i];
+    }
     for (var k = P.range.y; k < P.range.z; k = k + 1u) {
         let sx = fract(f32(xi) * inv_n + shx);
         let sy = fract(f32(yi) * inv_n + shy);
-        acc = acc + shade(homs[base + k], fi + sx, fj + sy);
+        var q = vec2<f32>(fi + sx, fj + sy);
+        if (P.lattice.z != 0u) {
+            q = pixel_point(m, sx, sy);
+        }
+        acc = acc + shade(homs[base + k], q.x, q.y);
         xi = xi + g1;
         if (xi >= n) {
             xi = xi - n;
@@ -300,6 +320,34 @@ fn footprint_mean(h: Homography, px: f32, py: f32) -> vec3<f32> {
     let day = abs((h.h0.y - a * h.h2.y) * r);
     let dbx = abs((h.h1.x - b * h.h2.x) * r);
     let dby = abs((h.h1.y - b * h.h2.y) * r);
+    return footprint_eval(a, b, dax, day, dbx, dby);
+}
+
+// Lens distortion: (px, py) are the pinhole pixel coordinates of the pixel
+// centre's ray and (l0, l1) the rows of the Jacobian of undistortion there,
+// so the footprint's axes are the homography's derivatives times it.
+fn footprint_mean_l(h: Homography, px: f32, py: f32, l0: vec2<f32>, l1: vec2<f32>) -> vec3<f32> {
+    let bg = P.background.xyz;
+    let w = h.h2.x * px + h.h2.y * py + h.h2.z;
+    if (!(w > 0.0)) {
+        return bg;
+    }
+    let r = 1.0 / w;
+    let a = (h.h0.x * px + h.h0.y * py + h.h0.z) * r;
+    let b = (h.h1.x * px + h.h1.y * py + h.h1.z) * r;
+    let sax = (h.h0.x - a * h.h2.x) * r;
+    let say = (h.h0.y - a * h.h2.y) * r;
+    let sbx = (h.h1.x - b * h.h2.x) * r;
+    let sby = (h.h1.y - b * h.h2.y) * r;
+    let dax = abs(sax * l0.x + say * l1.x);
+    let day = abs(sax * l0.y + say * l1.y);
+    let dbx = abs(sbx * l0.x + sby * l1.x);
+    let dby = abs(sbx * l0.y + sby * l1.y);
+    return footprint_eval(a, b, dax, day, dbx, dby);
+}
+
+fn footprint_eval(a: f32, b: f32, dax: f32, day: f32, dbx: f32, dby: f32) -> vec3<f32> {
+    let bg = P.background.xyz;
     let pa = 0.5 * max(dax, day);
     let qa = 0.5 * min(dax, day);
     let pb = 0.5 * max(dbx, dby);
@@ -335,8 +383,15 @@ fn analytic(@builtin(global_invocation_id) gid: vec3<u32>) {
     let py = f32(j) + 0.5;
     var acc = vec3<f32>(0.0);
     let base = line_base(i, j);
-    for (var k = P.range.y; k < P.range.z; k = k + 1u) {
-        acc = acc + footprint_mean(homs[base + k], px, py);
+    if (P.lattice.z != 0u) {
+        let m = homs[P.lattice.z + j * w + i];
+        for (var k = P.range.y; k < P.range.z; k = k + 1u) {
+            acc = acc + footprint_mean_l(homs[base + k], m.h0.x, m.h0.y, m.h0.zw, m.h1.xy);
+        }
+    } else {
+        for (var k = P.range.y; k < P.range.z; k = k + 1u) {
+            acc = acc + footprint_mean(homs[base + k], px, py);
+        }
     }
     out_rgb[o] = out_rgb[o] + vec4<f32>(acc, 0.0);
 }

@@ -33,6 +33,24 @@ fn scenes(tex: &std::path::Path) -> Vec<(&'static str, RenderJob)> {
             RenderJob::new(cam, Trajectory::from_twist(tw6, 0.03).unwrap(), image),
         ),
         (
+            // Lens distortion (SPEC 9): the per-pixel undistortion map.
+            "blobs 6-DoF barrel distortion",
+            RenderJob::new(
+                Camera {
+                    distortion: mmbm::camera::Distortion::Opencv {
+                        k1: -0.3,
+                        k2: 0.08,
+                        p1: 0.001,
+                        p2: -0.002,
+                        k3: 0.0,
+                    },
+                    ..cam
+                },
+                Trajectory::from_twist(tw6, 0.03).unwrap(),
+                Target::blobs(0.5, 1.5),
+            ),
+        ),
+        (
             // Rolling shutter (SPEC 9): one table of instants per column; the
             // trajectory spans readout + exposure.
             "checker 6-DoF rolling left-to-right",

@@ -445,7 +445,15 @@ fn rolling_readout_extends_the_busy_time() {
     };
     let a = go("fixed:20", &s, &m, &gs);
     let b = go("fixed:20", &s, &m, &rs);
-    assert!(gap(&a) < 0.06, "global shutter: every 50 ms slot ({})", gap(&a));
-    assert!(gap(&b) >= 0.09 - 1e-9, "rolling: busy 50 + 40 ms ({})", gap(&b));
+    assert!(
+        gap(&a) < 0.06,
+        "global shutter: every 50 ms slot ({})",
+        gap(&a)
+    );
+    assert!(
+        gap(&b) >= 0.09 - 1e-9,
+        "rolling: busy 50 + 40 ms ({})",
+        gap(&b)
+    );
     assert!(b.len() < a.len());
 }

@@ -205,6 +205,32 @@ impl Camera {
         Ok(())
     }
 
+    /// Pixel coordinates of the ray `(x, y, 1)` (normalised pinhole
+    /// coordinates) through the lens: distorted, then `K`. Without distortion
+    /// this is exactly `mm_to_pixel(f x, f y)`.
+    #[inline]
+    pub fn ray_to_pixel(&self, x: f64, y: f64) -> (f64, f64) {
+        let f = self.focal_mm;
+        if self.distortion.is_none() {
+            return self.mm_to_pixel(f * x, f * y);
+        }
+        let (xd, yd) = self.distortion.distort(x, y);
+        self.mm_to_pixel(f * xd, f * yd)
+    }
+
+    /// The ray `(x, y)` (normalised pinhole coordinates, `z = 1`) seen at
+    /// pixel coordinates `(px, py)`, undistorted; `None` where undistortion
+    /// does not converge. Without distortion: `pixel_to_mm / f`.
+    #[inline]
+    pub fn pixel_to_ray(&self, px: f64, py: f64) -> Option<(f64, f64)> {
+        let (ud, vd) = self.pixel_to_mm(px, py);
+        let f = self.focal_mm;
+        if self.distortion.is_none() {
+            return Some((ud / f, vd / f));
+        }
+        self.distortion.undistort(ud / f, vd / f)
+    }
+
     /// Distorted sensor point (mm) of the pinhole sensor point `(u, v)` mm.
     #[inline]
     pub fn distort_mm(&self, u: f64, v: f64) -> (f64, f64) {

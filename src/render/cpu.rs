@@ -95,10 +95,15 @@ pub fn pixel_sum(
     let mut acc = Vec3::ZERO;
     let (fi, fj) = (i as f32, j as f32);
     let base = line_base(p, i, j);
+    let map = (p.lattice[2] != 0).then(|| &homs[(p.lattice[2] + j * p.dims[0] + i) as usize]);
     for k in p.range[1]..p.range[2] {
         let sx = fract(xi as f32 * inv_n + shx);
         let sy = fract(yi as f32 * inv_n + shy);
-        acc += shade(p, tex, &homs[(base + k) as usize], fi + sx, fj + sy);
+        let (qx, qy) = match map {
+            Some(m) => pixel_point(m, sx, sy),
+            None => (fi + sx, fj + sy),
+        };
+        acc += shade(p, tex, &homs[(base + k) as usize], qx, qy);
         xi += g1;
         if xi >= n {
             xi -= n;
@@ -273,6 +278,45 @@ fn footprint_mean(prm: &RenderParams, h: &GpuHomography, px: f32, py: f32) -> Ve
     let day = ((h.h0[1] - a * h.h2[1]) * r).abs();
     let dbx = ((h.h1[0] - b * h.h2[0]) * r).abs();
     let dby = ((h.h1[1] - b * h.h2[1]) * r).abs();
+    footprint_eval(prm, a, b, [dax, day, dbx, dby])
+}
+
+/// Twin of the shader's `footprint_mean_l`: the footprint through the
+/// pixel's undistortion Jacobian `l` (rows `l[0]`, `l[1]`) at the pinhole
+/// pixel point `(px, py)`.
+fn footprint_mean_l(
+    prm: &RenderParams,
+    h: &GpuHomography,
+    px: f32,
+    py: f32,
+    l: [[f32; 2]; 2],
+) -> Vec3 {
+    let bg = v3(prm.background);
+    let w = h.h2[0] * px + h.h2[1] * py + h.h2[2];
+    if w.is_nan() || w <= 0.0 {
+        return bg;
+    }
+    let r = 1.0 / w;
+    let a = (h.h0[0] * px + h.h0[1] * py + h.h0[2]) * r;
+    let b = (h.h1[0] * px + h.h1[1] * py + h.h1[2]) * r;
+    let sax = (h.h0[0] - a * h.h2[0]) * r;
+    let say = (h.h0[1] - a * h.h2[1]) * r;
+    let sbx = (h.h1[0] - b * h.h2[0]) * r;
+    let sby = (h.h1[1] - b * h.h2[1]) * r;
+    let d = [
+        (sax * l[0][0] + say * l[1][0]).abs(),
+        (sax * l[0][1] + say * l[1][1]).abs(),
+        (sbx * l[0][0] + sby * l[1][0]).abs(),
+        (sbx * l[0][1] + sby * l[1][1]).abs(),
+    ];
+    footprint_eval(prm, a, b, d)
+}
+
+/// Twin of the shader's `footprint_eval`: the target averaged over the
+/// footprint with axis extents `d = [|da/dx|, |da/dy|, |db/dx|, |db/dy|]`.
+fn footprint_eval(prm: &RenderParams, a: f32, b: f32, d: [f32; 4]) -> Vec3 {
+    let bg = v3(prm.background);
+    let [dax, day, dbx, dby] = d;
     let (pa, qa) = (0.5 * dax.max(day), 0.5 * dax.min(day));
     let (pb, qb) = (0.5 * dbx.max(dby), 0.5 * dbx.min(dby));
     if prm.dims[2] == KIND_CHECKER {
@@ -286,6 +330,17 @@ fn footprint_mean(prm: &RenderParams, h: &GpuHomography, px: f32, py: f32) -> Ve
     bg + (white - bg) * (ba * bb) + (red - white) * (ca * cb)
 }
 
+/// Twin of the shader's `pixel_point`: sample `(sx, sy)` of a pixel through
+/// its distortion map entry `m`.
+#[inline]
+fn pixel_point(m: &GpuHomography, sx: f32, sy: f32) -> (f32, f32) {
+    let (dx, dy) = (sx - 0.5, sy - 0.5);
+    (
+        m.h0[0] + m.h0[2] * dx + m.h0[3] * dy,
+        m.h0[1] + m.h1[0] * dx + m.h1[1] * dy,
+    )
+}
+
 /// Sum over the instants `k0..k1` of pixel `(i, j)` (analytic area).
 pub fn pixel_sum_analytic(p: &RenderParams, homs: &[GpuHomography], i: u32, j: u32) -> Vec3 {
     let count = p.range[2] - p.range[1];
@@ -296,6 +351,14 @@ pub fn pixel_sum_analytic(p: &RenderParams, homs: &[GpuHomography], i: u32, j: u
     let (px, py) = (i as f32 + 0.5, j as f32 + 0.5);
     let mut acc = Vec3::ZERO;
     let base = line_base(p, i, j);
+    if p.lattice[2] != 0 {
+        let m = &homs[(p.lattice[2] + j * p.dims[0] + i) as usize];
+        let l = [[m.h0[2], m.h0[3]], [m.h1[0], m.h1[1]]];
+        for k in p.range[1]..p.range[2] {
+            acc += footprint_mean_l(p, &homs[(base + k) as usize], m.h0[0], m.h0[1], l);
+        }
+        return acc;
+    }
     for k in p.range[1]..p.range[2] {
         acc += footprint_mean(p, &homs[(base + k) as usize], px, py);
     }

@@ -189,6 +189,62 @@ pub fn homographies(
         .collect()
 }
 
+/// Lens distortion: one table entry per pixel, to append after the
+/// homographies (the kernel finds them at `RenderParams::lattice[2]`):
+/// `h0 = (x', y', L00, L01)`, `h1 = (L10, L11, 0, 0)` with `(x', y')` the
+/// pinhole pixel coordinates of the ray through the pixel centre and `L`
+/// the Jacobian of the undistortion map (pixel to pinhole pixel) there, in
+/// f64 from [`Camera::pixel_to_ray`] and the distortion's Jacobian. `None`
+/// for a pinhole camera; an error names a pixel that does not undistort.
+pub fn pixel_maps(cam: &Camera) -> crate::error::Result<Option<Vec<GpuHomography>>> {
+    if cam.distortion.is_none() {
+        return Ok(None);
+    }
+    let f = cam.focal_mm;
+    // A = d(mm)/d(pixel) and its inverse (the camera's affine pixel map).
+    let (px, py) = (cam.pitch_x_mm, cam.pitch_y_mm);
+    let a = [[px, -cam.skew * py * px / f], [0.0, py]];
+    let ainv = [[1.0 / px, cam.skew / f], [0.0, 1.0 / py]];
+    let mul = |x: [[f64; 2]; 2], y: [[f64; 2]; 2]| {
+        [
+            [
+                x[0][0] * y[0][0] + x[0][1] * y[1][0],
+                x[0][0] * y[0][1] + x[0][1] * y[1][1],
+            ],
+            [
+                x[1][0] * y[0][0] + x[1][1] * y[1][0],
+                x[1][0] * y[0][1] + x[1][1] * y[1][1],
+            ],
+        ]
+    };
+    let mut out = Vec::with_capacity(cam.width as usize * cam.height as usize);
+    for j in 0..cam.height {
+        for i in 0..cam.width {
+            let (x, y) = (i as f64 + 0.5, j as f64 + 0.5);
+            let (rx, ry) = cam.pixel_to_ray(x, y).ok_or_else(|| {
+                crate::error::Error::invalid(
+                    "distortion",
+                    format!("pixel ({x}, {y}) does not undistort"),
+                )
+            })?;
+            let (cx, cy) = cam.mm_to_pixel(f * rx, f * ry);
+            let jd = cam.distortion.jacobian(rx, ry);
+            let det = jd[0][0] * jd[1][1] - jd[0][1] * jd[1][0];
+            let jinv = [
+                [jd[1][1] / det, -jd[0][1] / det],
+                [-jd[1][0] / det, jd[0][0] / det],
+            ];
+            let l = mul(ainv, mul(jinv, a));
+            out.push(GpuHomography {
+                h0: [cx as f32, cy as f32, l[0][0] as f32, l[0][1] as f32],
+                h1: [l[1][0] as f32, l[1][1] as f32, 0.0, 0.0],
+                h2: [0.0; 4],
+            });
+        }
+    }
+    Ok(Some(out))
+}
+
 /// The pixel box outside which the target is never seen during the exposure
 /// (the whole image for the unbounded checker, or when a target corner passes
 /// behind the camera): the projections of the target's corners at every

@@ -88,7 +88,13 @@ fn inv_poses(traj: &Trajectory, steps: usize) -> Vec<(DMat3, DVec3)> {
 
 fn proj(cam: &Camera, p: &(DMat3, DVec3), x: DVec3) -> Option<(f64, f64)> {
     let pc = p.0 * (x - p.1);
-    (pc.z > 1e-12).then(|| cam.mm_to_pixel(cam.focal_mm * pc.x / pc.z, cam.focal_mm * pc.y / pc.z))
+    (pc.z > 1e-12).then(|| {
+        if cam.distortion.is_none() {
+            cam.mm_to_pixel(cam.focal_mm * pc.x / pc.z, cam.focal_mm * pc.y / pc.z)
+        } else {
+            cam.ray_to_pixel(pc.x / pc.z, pc.y / pc.z)
+        }
+    })
 }
 
 /// Image track (pixel coordinates) of the scene point seen at `(x, y)` at

@@ -51,13 +51,6 @@ pub const MAX_TABLE: u64 = 1 << 21;
 /// the trajectory (which spans readout + exposure); distortion and a lens
 /// (defocus) are not rendered (yet): a clear error rather than an ideal image.
 fn check_camera(cam: &Camera, trajectory: &Trajectory) -> Result<()> {
-    if !cam.distortion.is_none() {
-        return Err(Error::invalid(
-            "distortion",
-            "the renderer does not model lens distortion yet (the metric, flow fields and \
-             `mmbm frames` do); render with a pinhole camera",
-        ));
-    }
     if cam.lens.is_some() {
         return Err(Error::invalid(
             "lens",
@@ -385,13 +378,22 @@ fn render_frame_stream(job: &RenderJob, stream: u64) -> Result<RenderOutput> {
             ),
         ));
     }
-    let homs = kernel::homographies(cam, &job.target, &job.trajectory, n);
+    let mut homs = kernel::homographies(cam, &job.target, &job.trajectory, n);
     // The bounding box over every line's instants: the whole span, as finely.
+    // With distortion, straight target edges image as curves: the whole image.
     let span_n = (n as f64 * job.trajectory.duration()
         / kernel::line_exposure(cam, &job.trajectory))
     .ceil() as u32;
-    let bbox = kernel::target_bbox(cam, &job.target, &job.trajectory, span_n.max(n));
-    let params = kernel::params(cam, &job.target, n, bbox, job.seed);
+    let bbox = if cam.distortion.is_none() {
+        kernel::target_bbox(cam, &job.target, &job.trajectory, span_n.max(n))
+    } else {
+        [0, 0, cam.width, cam.height]
+    };
+    let mut params = kernel::params(cam, &job.target, n, bbox, job.seed);
+    if let Some(maps) = kernel::pixel_maps(cam)? {
+        params.lattice[2] = homs.len() as u32;
+        homs.extend(maps);
+    }
     let tex = kernel::texture_of(&job.target);
     let (rgb, backend_used) = match job.backend.resolve("render", "renderer", &ANNOUNCED)? {
         Resolved::Gpu(ctx) => (

@@ -238,8 +238,8 @@ impl Target {
     /// `(0,0)` = top-left corner) at pose `pose` with the plane: the world
     /// point, or `None` when the ray misses (plane behind or parallel).
     pub fn intersect(&self, cam: &Camera, pose: &Pose, x: f64, y: f64) -> Option<DVec3> {
-        let (u, v) = cam.pixel_to_mm(x, y);
-        let d = pose.0 * DVec3::new(u / cam.focal_mm, v / cam.focal_mm, 1.0);
+        let (rx, ry) = cam.pixel_to_ray(x, y)?;
+        let d = pose.0 * DVec3::new(rx, ry, 1.0);
         let f = self.frame();
         let den = f.normal.dot(d);
         let s = (f.normal.dot(f.origin) - f.normal.dot(pose.1)) / den;
@@ -248,10 +248,17 @@ impl Target {
 }
 
 /// Pixel coordinates (fractional, `(0,0)` = top-left corner) of world point
-/// `p` seen from `pose`, or `None` when it is behind the camera.
+/// `p` seen from `pose` (through the lens distortion, if any), or `None` when
+/// it is behind the camera.
 pub fn project(cam: &Camera, pose: &Pose, p: DVec3) -> Option<(f64, f64)> {
     let pc = pose.0.inverse() * (p - pose.1);
-    (pc.z > 1e-12).then(|| cam.mm_to_pixel(cam.focal_mm * pc.x / pc.z, cam.focal_mm * pc.y / pc.z))
+    (pc.z > 1e-12).then(|| {
+        if cam.distortion.is_none() {
+            cam.mm_to_pixel(cam.focal_mm * pc.x / pc.z, cam.focal_mm * pc.y / pc.z)
+        } else {
+            cam.ray_to_pixel(pc.x / pc.z, pc.y / pc.z)
+        }
+    })
 }
 
 #[cfg(test)]
