@@ -32,6 +32,8 @@ struct Params {
     range: vec4<u32>,      // row0, k0, k1, (k0 g1) mod N
     range2: vec4<u32>,     // (k0 g2) mod N, rows, line mode, 0
     bbox: vec4<u32>,       // x0, y0, x1, y1 (end exclusive)
+    lens: vec4<f32>,       // aperture radius (m; 0: pinhole), fx / s, fy / s, skew / s
+    lens_gen: vec4<u32>,   // g3, g4, (k0 g3) mod N, (k0 g4) mod N
 }
 
 struct Homography {
@@ -142,6 +144,49 @@ fn pixel_point(m: Homography, sx: f32, sy: f32) -> vec2<f32> {
     return vec2<f32>(m.h0.x + m.h0.z * dx + m.h0.w * dy, m.h0.y + m.h1.x * dx + m.h1.y * dy);
 }
 
+// Defocus (SPEC 9, thin lens): a uniform point of the unit disc from a point
+// of the unit square (Shirley-Chiu concentric map; sine and cosine as
+// polynomials on [-pi/4, pi/4], like the twin's).
+fn sin_p(x: f32) -> f32 {
+    let x2 = x * x;
+    return x * (1.0 - x2 / 6.0 * (1.0 - x2 / 20.0 * (1.0 - x2 / 42.0)));
+}
+
+fn cos_p(x: f32) -> f32 {
+    let x2 = x * x;
+    return 1.0 - x2 / 2.0 * (1.0 - x2 / 12.0 * (1.0 - x2 / 30.0 * (1.0 - x2 / 56.0)));
+}
+
+fn concentric(u: f32, v: f32) -> vec2<f32> {
+    let a = 2.0 * u - 1.0;
+    let b = 2.0 * v - 1.0;
+    if (a == 0.0 && b == 0.0) {
+        return vec2<f32>(0.0);
+    }
+    let q = 0.7853982; // pi/4 in f32
+    if (abs(a) > abs(b)) {
+        let t = q * (b / a);
+        return vec2<f32>(a * cos_p(t), a * sin_p(t));
+    }
+    let t = q * (a / b);
+    return vec2<f32>(b * sin_p(t), b * cos_p(t));
+}
+
+// Defocus: the homography of the camera moved to lens point l (m) is
+// H + l.x Gx + l.y Gy (entries e, e + 1, e + 2), seen through the pixel point
+// shifted by -K l / s.
+fn lens_sample(e: u32, l: vec2<f32>, q: vec2<f32>) -> vec3<f32> {
+    let h = homs[e];
+    let gx = homs[e + 1u];
+    let gy = homs[e + 2u];
+    let hl = Homography(
+        h.h0 + l.x * gx.h0 + l.y * gy.h0,
+        h.h1 + l.x * gx.h1 + l.y * gy.h1,
+        vec4<f32>(h.h2.xyz + l.x * gx.h2.xyz + l.y * gy.h2.xyz, h.h2.w));
+    let p = q - vec2<f32>(l.x * P.lens.y + l.y * P.lens.w, l.y * P.lens.z);
+    return shade(hl, p.x, p.y);
+}
+
 // Rolling shutter (SPEC 9): the first table entry of pixel (i, j)'s line.
 // Line mode range2.z: 0 one set of N instants for every pixel, 1 one set per
 // row, 2 one per column (each line's own exposure window).
@@ -188,6 +233,12 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (P.lattice.z != 0u) {
         m = homs[P.lattice.z + j * w + i];
     }
+    // Defocus: two more lattice dimensions with their own per-pixel shifts.
+    let h3 = pcg(h2);
+    let h4 = pcg(h3);
+    let shl = vec2<f32>(unit(h3), unit(h4));
+    var xl = P.lens_gen.z;
+    var yl = P.lens_gen.w;
     for (var k = P.range.y; k < P.range.z; k = k + 1u) {
         let sx = fract(f32(xi) * inv_n + shx);
         let sy = fract(f32(yi) * inv_n + shy);
@@ -195,7 +246,20 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         if (P.lattice.z != 0u) {
             q = pixel_point(m, sx, sy);
         }
-        acc = acc + shade(homs[base + k], q.x, q.y);
+        if (P.lens.x > 0.0) {
+            let d = concentric(fract(f32(xl) * inv_n + shl.x), fract(f32(yl) * inv_n + shl.y));
+            acc = acc + lens_sample((base + k) * 3u, d * P.lens.x, q);
+            xl = xl + P.lens_gen.x;
+            if (xl >= n) {
+                xl = xl - n;
+            }
+            yl = yl + P.lens_gen.y;
+            if (yl >= n) {
+                yl = yl - n;
+            }
+        } else {
+            acc = acc + shade(homs[base + k], q.x, q.y);
+        }
         xi = xi + g1;
         if (xi >= n) {
             xi = xi - n;

@@ -1,11 +1,12 @@
 //! The renderer with the real camera of SPEC section 9: rolling-shutter blur
-//! maps against a closed form, the noise model on rendered frames (photon
-//! transfer over a flat region, seeding), and clear errors for what the
-//! renderer does not model.
+//! maps against a closed form, lens distortion against an exact-undistortion
+//! reference and the flow formula, defocus against SPEC 9's disc, the noise
+//! model on rendered frames (photon transfer over a flat region, seeding).
 
 use glam::DVec3;
 use mmbm::camera::{Distortion, Lens, Noise, Readout, Shutter};
 use mmbm::io::gyro::GyroSample;
+use mmbm::render::Integrator;
 use mmbm::render::{render_frame, render_sharp, Backend, RenderJob, Target, Trajectory};
 use mmbm::{Camera, Twist};
 
@@ -216,31 +217,19 @@ fn distorted_track_speed_equals_the_flow_formula() {
 }
 
 #[test]
-fn unrendered_camera_parts_are_clear_errors() {
+fn readout_beyond_the_trajectory_is_a_clear_error() {
     let traj = Trajectory::from_twist(Twist::rotation(0.1, 0.0, 0.0), 0.02).unwrap();
     let base = Camera::thesis().with_resolution(32, 24);
-    let cases = [
-        (
-            Camera {
-                lens: Some(Lens {
-                    f_number: 2.0,
-                    focus_m: 1.0,
-                }),
-                ..base
+    let cases = [(
+        Camera {
+            shutter: Shutter {
+                readout_s: 0.05,
+                direction: Readout::TopToBottom,
             },
-            "lens",
-        ),
-        (
-            Camera {
-                shutter: Shutter {
-                    readout_s: 0.05,
-                    direction: Readout::TopToBottom,
-                },
-                ..base
-            },
-            "readout_s",
-        ),
-    ];
+            ..base
+        },
+        "readout_s",
+    )];
     for (cam, key) in cases {
         let e = render_frame(&cpu(RenderJob::new(
             cam,
@@ -251,4 +240,93 @@ fn unrendered_camera_parts_are_clear_errors() {
         .to_string();
         assert!(e.contains(key), "{key}: {e}");
     }
+}
+
+/// Defocus (SPEC 9): a small bright patch at depth `z`, focused at `s`,
+/// spreads over a disc of diameter `c = A f / (s - f) |z - s| / z`. The
+/// disc's radial second moment is `D^2 / 8`; the in-focus render's moment
+/// (the patch's own size, filtering and pixel area) is subtracted, since
+/// spreads add under convolution.
+#[test]
+fn defocus_disc_has_the_spec_diameter() {
+    let dir = tempfile::tempdir().unwrap();
+    let tex = dir.path().join("dot.png");
+    // 33 x 33 black with one white texel: 1 mm texels on a 33 mm square.
+    image::RgbImage::from_fn(33, 33, |x, y| {
+        if x == 16 && y == 16 {
+            image::Rgb([255, 255, 255])
+        } else {
+            image::Rgb([0, 0, 0])
+        }
+    })
+    .save(&tex)
+    .unwrap();
+    let z = 0.6;
+    let render = |focus_m: f64| {
+        let cam = Camera {
+            lens: Some(Lens {
+                f_number: 1.4,
+                focus_m,
+            }),
+            ..Camera::new(8.0, 0.005, 96, 96)
+        };
+        let mut target = Target::parse(&format!("image:{}:0.033", tex.display()), z).unwrap();
+        target.background = [0.0; 3];
+        let job = cpu(RenderJob::new(
+            cam,
+            Trajectory::from_twist(Twist::default(), 0.01).unwrap(),
+            target,
+        ));
+        let mut j = job;
+        j.with_maps = false;
+        j.quality = mmbm::render::Quality::Custom {
+            min_samples: 8192,
+            max_spacing_px: 0.25,
+        };
+        (cam, render_frame(&j).unwrap().rgb)
+    };
+    let moment = |rgb: &[f32]| {
+        let (mut s, mut sx, mut sy) = (0.0f64, 0.0, 0.0);
+        for (k, p) in rgb.chunks(3).enumerate() {
+            let (x, y) = ((k % 96) as f64 + 0.5, (k / 96) as f64 + 0.5);
+            s += p[0] as f64;
+            sx += p[0] as f64 * x;
+            sy += p[0] as f64 * y;
+        }
+        let (cx, cy) = (sx / s, sy / s);
+        let mut m = 0.0;
+        for (k, p) in rgb.chunks(3).enumerate() {
+            let (x, y) = ((k % 96) as f64 + 0.5, (k / 96) as f64 + 0.5);
+            m += p[0] as f64 * ((x - cx).powi(2) + (y - cy).powi(2));
+        }
+        m / s
+    };
+    let (_, sharp) = render(z);
+    let m0 = moment(&sharp);
+    for s in [1.0, 2.5, 0.4] {
+        let (cam, img) = render(s);
+        let d = (8.0 * (moment(&img) - m0)).sqrt();
+        let lens = cam.lens.unwrap();
+        let spec = lens.coc_mm(cam.focal_mm, z) / cam.pitch_x_mm;
+        eprintln!("focus {s} m, point at {z} m: disc {d:.3} px, SPEC 9 {spec:.3} px");
+        assert!((d - spec).abs() < 0.5, "focus {s}: {d} vs {spec}");
+    }
+    // The analytic integrator cannot sample the aperture.
+    let cam = Camera {
+        lens: Some(Lens {
+            f_number: 2.0,
+            focus_m: 1.0,
+        }),
+        ..Camera::thesis().with_resolution(32, 24)
+    };
+    let mut job = cpu(RenderJob::new(
+        cam,
+        Trajectory::from_twist(Twist::default(), 0.01).unwrap(),
+        Target::checker(0.02, 1.0),
+    ));
+    job.integrator = Integrator::Analytic;
+    assert!(render_frame(&job)
+        .unwrap_err()
+        .to_string()
+        .contains("lattice"));
 }

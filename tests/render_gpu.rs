@@ -30,7 +30,11 @@ fn scenes(tex: &std::path::Path) -> Vec<(&'static str, RenderJob)> {
         ),
         (
             "image 6-DoF",
-            RenderJob::new(cam, Trajectory::from_twist(tw6, 0.03).unwrap(), image),
+            RenderJob::new(
+                cam,
+                Trajectory::from_twist(tw6, 0.03).unwrap(),
+                image.clone(),
+            ),
         ),
         (
             // Lens distortion (SPEC 9): the per-pixel undistortion map.
@@ -48,6 +52,22 @@ fn scenes(tex: &std::path::Path) -> Vec<(&'static str, RenderJob)> {
                 },
                 Trajectory::from_twist(tw6, 0.03).unwrap(),
                 Target::blobs(0.5, 1.5),
+            ),
+        ),
+        (
+            // Defocus (SPEC 9): two aperture dimensions of the lattice, the
+            // homography's lens derivatives.
+            "image 6-DoF defocus",
+            RenderJob::new(
+                Camera {
+                    lens: Some(mmbm::camera::Lens {
+                        f_number: 1.4,
+                        focus_m: 0.6,
+                    }),
+                    ..cam
+                },
+                Trajectory::from_twist(tw6, 0.03).unwrap(),
+                image.clone(),
             ),
         ),
         (

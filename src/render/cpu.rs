@@ -1,7 +1,9 @@
 //! CPU twin of `shaders/render.wgsl`: the same samples, homography table,
 //! background box and texture maths in f32, one pixel per task (rayon).
 
-use super::kernel::{shifts, GpuHomography, RenderParams, KIND_BLOBS, KIND_CHECKER};
+use super::kernel::{
+    concentric, lens_shifts, shifts, GpuHomography, RenderParams, KIND_BLOBS, KIND_CHECKER,
+};
 use super::texture::MipTexture;
 use glam::Vec3;
 use rayon::prelude::*;
@@ -63,6 +65,47 @@ fn shade(p: &RenderParams, tex: Option<&MipTexture>, h: &GpuHomography, px: f32,
     }
 }
 
+/// Twin of the shader's `lens_sample`: the sample through lens point `l`
+/// (m) of the instant whose three table entries start at `e`.
+#[inline]
+fn lens_sample(
+    p: &RenderParams,
+    tex: Option<&MipTexture>,
+    homs: &[GpuHomography],
+    e: usize,
+    l: (f32, f32),
+    qx: f32,
+    qy: f32,
+) -> Vec3 {
+    let (h, gx, gy) = (&homs[e], &homs[e + 1], &homs[e + 2]);
+    let mix = |a: [f32; 4], b: [f32; 4], c: [f32; 4], w: f32| {
+        [
+            a[0] + l.0 * b[0] + l.1 * c[0],
+            a[1] + l.0 * b[1] + l.1 * c[1],
+            a[2] + l.0 * b[2] + l.1 * c[2],
+            w,
+        ]
+    };
+    let hl = GpuHomography {
+        h0: mix(
+            h.h0,
+            gx.h0,
+            gy.h0,
+            h.h0[3] + l.0 * gx.h0[3] + l.1 * gy.h0[3],
+        ),
+        h1: mix(
+            h.h1,
+            gx.h1,
+            gy.h1,
+            h.h1[3] + l.0 * gx.h1[3] + l.1 * gy.h1[3],
+        ),
+        h2: mix(h.h2, gx.h2, gy.h2, h.h2[3]),
+    };
+    let px = qx - (l.0 * p.lens[1] + l.1 * p.lens[3]);
+    let py = qy - l.1 * p.lens[2];
+    shade(p, tex, &hl, px, py)
+}
+
 /// Twin of the shader's `line_base`: the first table entry of pixel `(i, j)`'s
 /// line (rolling shutter: one set of instants per row or column).
 #[inline]
@@ -96,6 +139,8 @@ pub fn pixel_sum(
     let (fi, fj) = (i as f32, j as f32);
     let base = line_base(p, i, j);
     let map = (p.lattice[2] != 0).then(|| &homs[(p.lattice[2] + j * p.dims[0] + i) as usize]);
+    let (shlx, shly) = lens_shifts(i, j, seed);
+    let (mut xl, mut yl) = (p.lens_gen[2], p.lens_gen[3]);
     for k in p.range[1]..p.range[2] {
         let sx = fract(xi as f32 * inv_n + shx);
         let sy = fract(yi as f32 * inv_n + shy);
@@ -103,7 +148,24 @@ pub fn pixel_sum(
             Some(m) => pixel_point(m, sx, sy),
             None => (fi + sx, fj + sy),
         };
-        acc += shade(p, tex, &homs[(base + k) as usize], qx, qy);
+        if p.lens[0] > 0.0 {
+            let d = concentric(
+                fract(xl as f32 * inv_n + shlx),
+                fract(yl as f32 * inv_n + shly),
+            );
+            let l = (d.0 * p.lens[0], d.1 * p.lens[0]);
+            acc += lens_sample(p, tex, homs, ((base + k) * 3) as usize, l, qx, qy);
+            xl += p.lens_gen[0];
+            if xl >= n {
+                xl -= n;
+            }
+            yl += p.lens_gen[1];
+            if yl >= n {
+                yl -= n;
+            }
+        } else {
+            acc += shade(p, tex, &homs[(base + k) as usize], qx, qy);
+        }
         xi += g1;
         if xi >= n {
             xi -= n;

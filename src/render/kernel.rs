@@ -59,7 +59,7 @@ pub struct RenderParams {
     pub lod: [f32; 4],
     /// width, height (full image, px), target kind, N (samples per pixel).
     pub dims: [u32; 4],
-    /// g1, g2 (lattice generator), 0, seed.
+    /// g1, g2 (lattice generator), distortion map offset ([`pixel_maps`]; 0: none), seed.
     pub lattice: [u32; 4],
     /// First row of this dispatch, first and end sample index k0, k1, (k0*g1) mod N.
     pub range: [u32; 4],
@@ -67,9 +67,15 @@ pub struct RenderParams {
     pub range2: [u32; 4],
     /// x0, y0, x1, y1 (px, end exclusive): pixels outside see only the background.
     pub bbox: [u32; 4],
+    /// Defocus ([`lens_params`]): aperture radius (m; 0: pinhole), and the
+    /// pixel shift per metre of lens offset `fx / s`, `fy / s`, `skew / s`.
+    pub lens: [f32; 4],
+    /// Defocus lattice dimensions: g3, g4, (k0*g3) mod N, (k0*g4) mod N.
+    pub lens_gen: [u32; 4],
 }
 
-const _: () = assert!(std::mem::size_of::<RenderParams>() == 10 * 16);
+const _: () = assert!(std::mem::size_of::<RenderParams>() == 12 * 16);
+const _: () = assert!(std::mem::offset_of!(RenderParams, lens) == 10 * 16);
 const _: () = assert!(std::mem::offset_of!(RenderParams, dims) == 5 * 16);
 const _: () = assert!(std::mem::offset_of!(RenderParams, range2) == 8 * 16);
 const _: () = assert!(std::mem::offset_of!(RenderParams, bbox) == 9 * 16);
@@ -166,8 +172,17 @@ pub fn line_instant(cam: &Camera, trajectory: &Trajectory, line: u32, m: u32, n:
     delay + line_exposure(cam, trajectory) * (m as f64 + 0.5) / n as f64
 }
 
+/// Table entries per instant: 1, or 3 with defocus (`H`, `dH/dlx`, `dH/dly`).
+pub fn table_stride(cam: &Camera) -> u32 {
+    if cam.lens.is_some() {
+        3
+    } else {
+        1
+    }
+}
+
 /// The homography table: `n` instants for each of [`table_lines`] lines
-/// (line-major: entry `line * n + m`), for upload.
+/// (line-major: instant `line * n + m`), [`table_stride`] entries each, for upload.
 pub fn homographies(
     cam: &Camera,
     target: &Target,
@@ -175,18 +190,76 @@ pub fn homographies(
     n: u32,
 ) -> Vec<GpuHomography> {
     let lines = table_lines(cam);
+    let r = |v: DVec3, w: f64| [v.x as f32, v.y as f32, v.z as f32, w as f32];
+    let entry = |h: DMat3, det: f64| GpuHomography {
+        h0: r(h.row(0), 0.0),
+        h1: r(h.row(1), 0.0),
+        h2: r(h.row(2), det),
+    };
     (0..lines * n)
-        .map(|e| {
+        .flat_map(|e| {
             let t = line_instant(cam, trajectory, e / n, e % n, n);
-            let h = homography(cam, target, &trajectory.pose_at(t));
-            let r = |v: DVec3, w: f64| [v.x as f32, v.y as f32, v.z as f32, w as f32];
-            GpuHomography {
-                h0: r(h.row(0), 0.0),
-                h1: r(h.row(1), 0.0),
-                h2: r(h.row(2), h.determinant().abs()),
+            let pose = trajectory.pose_at(t);
+            let h = homography(cam, target, &pose);
+            let mut out = vec![entry(h, h.determinant().abs())];
+            if cam.lens.is_some() {
+                let (gx, gy) = lens_derivatives(cam, target, &pose);
+                out.push(entry(gx, 0.0));
+                out.push(entry(gy, 0.0));
             }
+            out
         })
         .collect()
+}
+
+/// Defocus (SPEC 9, thin lens): a ray through lens point `L = (lx, ly, 0)`
+/// m (camera frame) toward the in-focus point of pinhole pixel `p` is the
+/// ray of a camera moved by `R L` through pixel `p - K L / s`. The homography
+/// is affine in the camera centre, so the moved camera's is
+/// `H + lx Gx + ly Gy`: these are `Gx`, `Gy` (same scaling and sign as `H`).
+pub fn lens_derivatives(
+    cam: &Camera,
+    target: &Target,
+    pose: &super::trajectory::Pose,
+) -> (DMat3, DMat3) {
+    let f = target.frame();
+    let (q, c) = pose;
+    let dist = f.normal.dot(f.origin) - f.normal.dot(*c);
+    let rot = DMat3::from_quat(*q);
+    let g = |delta: DVec3| {
+        let rows = [
+            f.normal * f.e1.dot(delta) - f.e1 * f.normal.dot(delta),
+            f.normal * f.e2.dot(delta) - f.e2 * f.normal.dot(delta),
+            DVec3::ZERO,
+        ];
+        let m = DMat3::from_cols(rows[0], rows[1], rows[2]).transpose();
+        let h = m * rot * pixel_to_ray(cam);
+        if dist < 0.0 {
+            -h
+        } else {
+            h
+        }
+    };
+    (g(rot * DVec3::X), g(rot * DVec3::Y))
+}
+
+/// The defocus parameters ([`RenderParams::lens`]): the aperture radius is
+/// that of `A' = A s / (s - f)` (`A = f / N`), so that a point at depth `z`
+/// spreads over SPEC 9's disc `c = A f / (s - f) |z - s| / z` (the lens is
+/// modelled as a shift of the pinhole by the lens point, toward the in-focus
+/// point at depth `s`).
+pub fn lens_params(cam: &Camera) -> [f32; 4] {
+    let Some(l) = cam.lens else {
+        return [0.0; 4];
+    };
+    let (f, s) = (cam.focal_mm, l.focus_m * 1000.0);
+    let radius_m = 0.5 * l.aperture_mm(f) * s / (s - f) / 1000.0;
+    [
+        radius_m as f32,
+        (cam.fx_px() / l.focus_m) as f32,
+        (cam.fy_px() / l.focus_m) as f32,
+        (cam.skew / l.focus_m) as f32,
+    ]
 }
 
 /// Lens distortion: one table entry per pixel, to append after the
@@ -385,6 +458,47 @@ pub fn shifts(i: u32, j: u32, seed: u32) -> (f32, f32) {
     (f(h1), f(h2))
 }
 
+/// The per-pixel shifts of the two aperture dimensions (defocus): the next
+/// two values of the same hash chain as [`shifts`].
+pub fn lens_shifts(i: u32, j: u32, seed: u32) -> (f32, f32) {
+    let h1 = pcg(i.wrapping_add(pcg(j.wrapping_add(pcg(seed)))));
+    let h3 = pcg(pcg(h1));
+    let h4 = pcg(h3);
+    let f = |h: u32| (h >> 8) as f32 * (1.0 / 16_777_216.0);
+    (f(h3), f(h4))
+}
+
+/// A uniform point on the unit disc from a point of the unit square
+/// (Shirley and Chiu's concentric map), with sine and cosine as polynomials
+/// on `[-pi/4, pi/4]` (|error| < 4e-7) so that the shader computes the same.
+#[inline]
+pub fn concentric(u: f32, v: f32) -> (f32, f32) {
+    let (a, b) = (2.0 * u - 1.0, 2.0 * v - 1.0);
+    if a == 0.0 && b == 0.0 {
+        return (0.0, 0.0);
+    }
+    let q = std::f32::consts::FRAC_PI_4;
+    if a.abs() > b.abs() {
+        let t = q * (b / a);
+        (a * cos_p(t), a * sin_p(t))
+    } else {
+        let t = q * (a / b);
+        (b * sin_p(t), b * cos_p(t))
+    }
+}
+
+#[inline]
+fn sin_p(x: f32) -> f32 {
+    let x2 = x * x;
+    x * (1.0 - x2 / 6.0 * (1.0 - x2 / 20.0 * (1.0 - x2 / 42.0)))
+}
+
+#[inline]
+fn cos_p(x: f32) -> f32 {
+    let x2 = x * x;
+    1.0 - x2 / 2.0 * (1.0 - x2 / 12.0 * (1.0 - x2 / 30.0 * (1.0 - x2 / 56.0)))
+}
+
 /// The parameter block for a whole image (`range` set to all rows and samples).
 pub fn params(cam: &Camera, target: &Target, n: u32, bbox: [u32; 4], seed: u32) -> RenderParams {
     let (kind, tex) = match &target.kind {
@@ -417,6 +531,16 @@ pub fn params(cam: &Camera, target: &Target, n: u32, bbox: [u32; 4], seed: u32) 
         }
     };
     let (g1, g2) = generators(n);
+    // The aperture's two lattice dimensions (defocus only): integers coprime
+    // to N near N times the R4 sequence's last two constants.
+    let (g3, g4) = if cam.lens.is_some() {
+        (
+            coprime_near(n, n as f64 * 0.524_888_4),
+            coprime_near(n, n as f64 * 0.379_706_3),
+        )
+    } else {
+        (0, 0)
+    };
     let bg = target.background;
     RenderParams {
         background: [bg[0], bg[1], bg[2], 0.0],
@@ -429,6 +553,8 @@ pub fn params(cam: &Camera, target: &Target, n: u32, bbox: [u32; 4], seed: u32) 
         range: [0, 0, n, 0],
         range2: [0, cam.height, line_mode(cam), 0],
         bbox,
+        lens: lens_params(cam),
+        lens_gen: [g3, g4, 0, 0],
     }
 }
 
@@ -443,6 +569,8 @@ pub fn with_range(p: &RenderParams, row0: u32, rows: u32, k0: u32, k1: u32) -> R
         p.range2[2],
         0,
     ];
+    q.lens_gen[2] = ((k0 as u64 * p.lens_gen[0] as u64) % n) as u32;
+    q.lens_gen[3] = ((k0 as u64 * p.lens_gen[1] as u64) % n) as u32;
     q
 }
 

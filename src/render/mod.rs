@@ -48,15 +48,8 @@ pub const MAX_PIXEL_SAMPLES: u64 = 1 << 40;
 pub const MAX_TABLE: u64 = 1 << 21;
 
 /// Checks what the renderer supports of the camera: a readout shorter than
-/// the trajectory (which spans readout + exposure); distortion and a lens
-/// (defocus) are not rendered (yet): a clear error rather than an ideal image.
+/// the trajectory (which spans readout + exposure).
 fn check_camera(cam: &Camera, trajectory: &Trajectory) -> Result<()> {
-    if cam.lens.is_some() {
-        return Err(Error::invalid(
-            "lens",
-            "the renderer does not model defocus yet; remove [lens] from the camera to render",
-        ));
-    }
     let te = kernel::line_exposure(cam, trajectory);
     if te.is_nan() || te <= 0.0 {
         return Err(Error::invalid(
@@ -340,8 +333,15 @@ fn render_frame_stream(job: &RenderJob, stream: u64) -> Result<RenderOutput> {
     check_camera(cam, &job.trajectory)?;
     let lmax = maps::max_path_px(cam, &job.target, &job.trajectory);
     let is_image = matches!(job.target.kind, TargetKind::Image { .. });
+    let defocus = cam.lens.is_some();
     let analytic = match job.integrator {
-        Integrator::Auto => !is_image,
+        Integrator::Analytic if defocus => {
+            return Err(Error::invalid(
+                "integrator",
+                "defocus ([lens] in the camera) samples the aperture: use lattice (or auto)",
+            ))
+        }
+        Integrator::Auto => !is_image && !defocus,
         Integrator::Analytic if is_image => {
             return Err(Error::invalid(
                 "integrator",
@@ -367,24 +367,26 @@ fn render_frame_stream(job: &RenderJob, stream: u64) -> Result<RenderOutput> {
             ),
         ));
     }
-    let lines = kernel::table_lines(cam) as u64;
+    let lines = kernel::table_lines(cam) as u64 * kernel::table_stride(cam) as u64;
     if lines * n as u64 > MAX_TABLE {
         return Err(Error::invalid(
-            "readout_s",
+            "render table",
             format!(
-                "a rolling shutter needs {n} instants for each of {lines} lines ({} table entries, \
-                 limit {MAX_TABLE}); shorten the exposure or the motion, or lower the resolution",
+                "{n} instants x {lines} entries per instant and line (rolling shutter lines, \
+                 defocus derivatives) = {} homographies, limit {MAX_TABLE}; shorten the \
+                 exposure or the motion, or lower the resolution",
                 lines * n as u64
             ),
         ));
     }
     let mut homs = kernel::homographies(cam, &job.target, &job.trajectory, n);
     // The bounding box over every line's instants: the whole span, as finely.
-    // With distortion, straight target edges image as curves: the whole image.
+    // With distortion, straight target edges image as curves, and defocus
+    // spreads them: the whole image.
     let span_n = (n as f64 * job.trajectory.duration()
         / kernel::line_exposure(cam, &job.trajectory))
     .ceil() as u32;
-    let bbox = if cam.distortion.is_none() {
+    let bbox = if cam.distortion.is_none() && !defocus {
         kernel::target_bbox(cam, &job.target, &job.trajectory, span_n.max(n))
     } else {
         [0, 0, cam.width, cam.height]
