@@ -16,6 +16,9 @@ fn fixture(name: &str) -> PathBuf {
 
 const GYRO: &str = "# a comment\nt,wx,wy,wz,vx,vy,vz,depth\n0,0.1,-0.2,0.3,0,0,0.1,2\n\
 0.01,0.1,-0.2,0.31,0,0,0.1,2\n0.02,0.12,-0.2,0.3,0,0,0.1,2\n0.03,0.1,-0.25,0.3,0,0,0.1,2\n";
+const GCSV: &str = "GYROFLOW IMU LOG\nversion,1.3\norientation,YxZ\nframe_readout_time,15.23\n\
+frame_readout_direction,0\ntscale,0.001\ngscale,0.00122173047\nt,gx,gy,gz,ax,ay,az\n\
+0,39,86,183,-1137,-15689,-2986\n1,56,100,202,-1179,-15654,-3009\n2,63,108,218,-1247,-15702,-2794\n";
 const CAMERA: &str =
     "focal_mm = 4.2548\npitch_mm = 0.00465\nwidth = 640\nheight = 480\ncx = 320\ncy = 240\n";
 const GAIT: &str = "speed_m_s = 0.2\nstep_hz = 1.5\nsway = [0.1, 0.05, 0.1]\nnoise_std = 0.002\n";
@@ -74,6 +77,25 @@ proptest! {
         let d = tempfile::tempdir().unwrap();
         let p = write(d.path(), "log.csv", &bytes);
         names_file(read_log(&p, GyroOptions::default()), "log.csv")?;
+    }
+
+    #[test]
+    fn gyro_gcsv(bytes in inputs(GCSV.as_bytes())) {
+        let d = tempfile::tempdir().unwrap();
+        let p = write(d.path(), "log.gcsv", &bytes);
+        names_file(read_log(&p, GyroOptions::default()), "log.gcsv")?;
+        names_file(mmbm::io::gcsv::read_header(&p), "log.gcsv")?;
+    }
+
+    #[test]
+    fn gyro_gcsv_after_magic(tail in prop::collection::vec(any::<u8>(), 0..400)) {
+        // Random bytes after the magic line, under a name that does not say .gcsv.
+        let d = tempfile::tempdir().unwrap();
+        let bytes = [b"GYROFLOW IMU LOG\n".as_slice(), &tail].concat();
+        let p = write(d.path(), "imu.txt", &bytes);
+        prop_assert!(mmbm::io::gcsv::is_gcsv(&p));
+        names_file(read_log(&p, GyroOptions::default()), "imu.txt")?;
+        names_file(mmbm::io::gcsv::read_header(&p), "imu.txt")?;
     }
 
     #[test]

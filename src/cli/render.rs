@@ -39,7 +39,8 @@ pub struct RenderOpts {
     #[arg(long, value_name = "VX,VY,VZ", value_parser = parse_vec3, allow_hyphen_values = true,
           requires = "omega")]
     pub velocity: Option<DVec3>,
-    /// Gyro CSV: the trajectory is integrated from its samples.
+    /// Gyro log (CSV, ROS 2 .mcap or Gyroflow .gcsv): the trajectory is
+    /// integrated from its samples.
     #[arg(long, value_name = "FILE", requires = "at")]
     pub gyro: Option<PathBuf>,
     /// Exposure start on the log's clock, s (with --gyro).

@@ -11,13 +11,15 @@ use std::path::PathBuf;
 /// Options for reading a gyro log (shared by the commands that read one).
 #[derive(Args, Debug, Clone)]
 pub struct GyroArgs {
-    /// Unit of the `t` column: s, ms, us or ns.
+    /// Unit of the `t` column: s, ms, us or ns (CSV only: .mcap and .gcsv
+    /// logs carry their own).
     #[arg(long, default_value = "s")]
     pub time_unit: String,
-    /// Unit of wx, wy, wz: rad or deg (per second).
+    /// Unit of wx, wy, wz: rad or deg (per second; CSV only).
     #[arg(long, default_value = "rad")]
     pub angle_unit: String,
-    /// IMU-to-camera rotation, 9 numbers row-major (applied to w and v).
+    /// IMU-to-camera rotation, 9 numbers row-major (applied to w and v; for
+    /// a .gcsv log, after its orientation).
     #[arg(long, value_name = "R11,...,R33", allow_hyphen_values = true)]
     pub imu_rotation: Option<String>,
     /// Added to every time stamp, s.
@@ -57,7 +59,8 @@ impl GyroArgs {
   mmbm series --gyro log.csv --time-unit ms --angle-unit deg --method gauss:4
   mmbm series --gyro log.csv --use-velocity --depth 3 --method gpu:64x48")]
 pub struct SeriesArgs {
-    /// Gyro CSV: t,wx,wy,wz[,vx,vy,vz][,depth].
+    /// Gyro log: CSV t,wx,wy,wz[,vx,vy,vz][,depth]; also a ROS 2 .mcap or a
+    /// Gyroflow .gcsv IMU log (t*tscale s, g*gscale rad/s, its orientation).
     #[arg(long, value_name = "FILE")]
     pub gyro: PathBuf,
     /// riemann[:NUxNV], gauss[:N], exact[:TOL] or gpu[:WxH].

@@ -26,7 +26,8 @@ Examples:
   mmbm trigger --gyro ../shared/data/running_phone/gyro.csv --policy threshold:p20 --exposure 0.02 --summary"
 )]
 pub struct TriggerArgs {
-    /// Gyro CSV: t,wx,wy,wz[,vx,vy,vz][,depth].
+    /// Gyro log: CSV t,wx,wy,wz[,vx,vy,vz][,depth]; also a ROS 2 .mcap or a
+    /// Gyroflow .gcsv IMU log (t*tscale s, g*gscale rad/s, its orientation).
     #[arg(long, value_name = "FILE")]
     pub gyro: PathBuf,
     /// Policy (repeat for several; each row's `policy` column is the string given).

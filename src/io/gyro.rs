@@ -1,6 +1,8 @@
 //! Gyro logs (SPEC section 5): a plain CSV with a header row, columns `t`
 //! (seconds by default), `wx, wy, wz` (rad/s by default), optional `vx, vy, vz`
-//! (m/s) and `depth` (m). Lines starting with `#` are comments.
+//! (m/s) and `depth` (m). Lines starting with `#` are comments. A ROS 2 MCAP
+//! file ([`super::mcap`]) or a Gyroflow `.gcsv` log ([`super::gcsv`]) is
+//! turned into the same CSV text first.
 //!
 //! [`GyroReader`] streams the file in constant memory and validates every
 //! field; errors name the file, line and column.
@@ -211,6 +213,16 @@ impl GyroReader {
             let messages = super::mcap::read_imu(path, opts.topic.as_deref())?;
             let text = super::mcap::to_csv(&messages).into_bytes();
             (Box::new(std::io::Cursor::new(text)), path)
+        } else if super::gcsv::is_gcsv(path) {
+            if opts.time_unit != TimeUnit::S || opts.angle_unit != AngleUnit::Rad {
+                return Err(Error::invalid(
+                    path.display().to_string(),
+                    "a Gyroflow .gcsv log carries its own scales (tscale, gscale): leave --time-unit and --angle-unit at their defaults",
+                ));
+            }
+            // Converted to CSV one line at a time (constant memory), with
+            // the same line numbers; a bad row is reported by the stream.
+            (Box::new(super::gcsv::CsvStream::open(path)?), path)
         } else {
             (
                 Box::new(File::open(path).map_err(|e| Error::io(path, e))?),
@@ -224,7 +236,7 @@ impl GyroReader {
             .from_reader(BufReader::with_capacity(1 << 16, file));
         let headers = reader
             .headers()
-            .map_err(|e| csv_error(path, &e, "header"))?
+            .map_err(|e| csv_error(path, e, "header"))?
             .clone();
         let names: Vec<String> = headers.iter().map(|s| s.to_string()).collect();
         for n in ["t", "wx", "wy", "wz", "vx", "vy", "vz", "depth"] {
@@ -334,7 +346,7 @@ impl GyroReader {
         let more = self
             .reader
             .read_record(&mut self.record)
-            .map_err(|e| csv_error(&self.path, &e, "record"))?;
+            .map_err(|e| csv_error(&self.path, e, "record"))?;
         if !more {
             if self.count == 0 {
                 return Err(Error::Parse {
@@ -447,7 +459,9 @@ impl Iterator for GyroReader {
     }
 }
 
-fn csv_error(path: &Path, e: &csv::Error, what: &str) -> Error {
+/// A CSV reader error as an [`Error`]; an error made by the source itself (a
+/// `.gcsv` row, see [`super::gcsv::CsvStream`]) is returned as it is.
+fn csv_error(path: &Path, e: csv::Error, what: &str) -> Error {
     let (line, column) = match e.kind() {
         csv::ErrorKind::UnequalLengths {
             pos,
@@ -459,11 +473,17 @@ fn csv_error(path: &Path, e: &csv::Error, what: &str) -> Error {
         ),
         _ => (e.position().map_or(0, |p| p.line()), what.to_string()),
     };
+    let message = e.to_string();
+    if let csv::ErrorKind::Io(io) = e.into_kind() {
+        if let Ok(inner) = super::gcsv::unwrap_error(io) {
+            return inner;
+        }
+    }
     Error::Parse {
         path: path.into(),
         line,
         column,
-        message: e.to_string(),
+        message,
     }
 }
 
