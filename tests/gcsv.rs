@@ -421,3 +421,24 @@ fn every_gyro_command_takes_gcsv() {
     assert!(!o.status.success());
     assert!(String::from_utf8_lossy(&o.stderr).contains("tscale, gscale"));
 }
+
+/// `mmbm frames` takes the rolling-shutter readout from the `.gcsv` header
+/// (15.23 ms) when neither the camera nor the frame table gives one.
+#[test]
+fn frames_use_the_gcsv_readout() {
+    let dir = tempfile::tempdir().unwrap();
+    let frames = write(dir.path(), "frames.csv", "t_start,exposure_s\n1.001,0.002\n1.050,0.002\n");
+    let out = Command::new(env!("CARGO_BIN_EXE_mmbm"))
+        .args(["frames", "--gyro"])
+        .arg(walk())
+        .arg("--frames")
+        .arg(&frames)
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let rows: Vec<&str> = stdout.lines().collect();
+    assert_eq!(rows.len(), 3, "{stdout}");
+    assert!(rows[1].ends_with(",0.002,0.01523"), "{}", rows[1]);
+    assert!(rows[1].split(',').nth(2).unwrap().parse::<f64>().unwrap() > 0.0);
+}

@@ -241,21 +241,9 @@ pub fn from_gyroflow(p: &Value) -> Result<Camera> {
     })
 }
 
-/// Gyroflow's direction names (`TopToBottom`, ...) and numbers (0..3).
+/// Gyroflow's direction names and numbers ([`Readout::from_gyroflow`]).
 fn gyroflow_direction(s: &str) -> Result<Readout> {
-    let kebab: String = s
-        .chars()
-        .enumerate()
-        .flat_map(|(i, ch)| {
-            let lower = ch.to_ascii_lowercase();
-            if ch.is_ascii_uppercase() && i > 0 {
-                vec!['-', lower]
-            } else {
-                vec![lower]
-            }
-        })
-        .collect();
-    kebab.parse().map_err(|_| {
+    Readout::from_gyroflow(s.trim_matches('"')).ok_or_else(|| {
         Error::invalid(
             "frame_readout_direction",
             format!("'{s}' is not a readout direction"),

@@ -41,6 +41,20 @@ impl std::str::FromStr for Readout {
 }
 
 impl Readout {
+    /// Parses Gyroflow's `frame_readout_direction`: `0`-`3`, the names
+    /// `TopToBottom`, `BottomToTop`, `LeftToRight`, `RightToLeft`, or the
+    /// sensor rotations Gyroflow also accepts (`180` bottom to top, `270` left
+    /// to right, `90` right to left).
+    pub fn from_gyroflow(s: &str) -> Option<Self> {
+        match s.trim() {
+            "0" | "TopToBottom" => Some(Readout::TopToBottom),
+            "1" | "180" | "BottomToTop" => Some(Readout::BottomToTop),
+            "2" | "270" | "LeftToRight" => Some(Readout::LeftToRight),
+            "3" | "90" | "RightToLeft" => Some(Readout::RightToLeft),
+            _ => None,
+        }
+    }
+
     /// True when the lines are rows (top-to-bottom or bottom-to-top).
     pub fn is_rows(self) -> bool {
         matches!(self, Readout::TopToBottom | Readout::BottomToTop)

@@ -59,7 +59,7 @@ pub struct FramesArgs {
 
 pub fn run(a: FramesArgs) -> Result<()> {
     let method: Method = a.method.parse()?;
-    let camera = a.camera.camera()?;
+    let camera = super::args::with_log_readout(a.camera.camera()?, &a.gyro)?;
     let opts = SeriesOptions {
         scene: Scene {
             camera,

@@ -171,6 +171,9 @@ pub fn run(args: RenderArgs) -> Result<()> {
     if let Some((w, h)) = a.resolution {
         camera = camera.with_resolution(w, h);
     }
+    if let Some(g) = &a.gyro {
+        camera = super::args::with_log_readout(camera, g)?;
+    }
     // A rolling shutter exposes each line over its own window: the motion
     // spans the readout plus the exposure.
     let span = a.exposure + camera.shutter.readout_s;

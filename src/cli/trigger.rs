@@ -101,10 +101,11 @@ pub fn run(a: TriggerArgs) -> Result<()> {
         return Err(Error::invalid("--method", "trigger uses a CPU method"));
     }
     // A rolling shutter keeps the camera busy for its line readout as well.
-    let timing = a
-        .timing
-        .timing(a.exposure)
-        .with_rolling_readout(a.camera.camera()?.shutter.readout_s);
+    let timing = a.timing.timing(a.exposure).with_rolling_readout(
+        super::args::with_log_readout(a.camera.camera()?, &a.gyro)?
+            .shutter
+            .readout_s,
+    );
     timing.validate()?;
     let mut policies = Vec::new();
     for p in &a.policy {

@@ -58,33 +58,10 @@ pub const GYROFLOW_TO_CAMERA: DMat3 = DMat3::from_cols(
     DVec3::new(0.0, 0.0, -1.0),
 );
 
-/// Order in which the rows of a rolling-shutter frame are read.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum ReadoutDirection {
-    /// `0`: top row first.
-    TopToBottom,
-    /// `1`: bottom row first.
-    BottomToTop,
-    /// `2`: left column first.
-    LeftToRight,
-    /// `3`: right column first.
-    RightToLeft,
-}
-
-impl ReadoutDirection {
-    /// Parses a `frame_readout_direction` value: `0`-`3`, or the names
-    /// Gyroflow also accepts (`TopToBottom`, `BottomToTop` or `180`,
-    /// `LeftToRight` or `270`, `RightToLeft` or `90`).
-    pub fn parse(s: &str) -> Option<Self> {
-        match s {
-            "0" | "TopToBottom" => Some(Self::TopToBottom),
-            "1" | "180" | "BottomToTop" => Some(Self::BottomToTop),
-            "2" | "270" | "LeftToRight" => Some(Self::LeftToRight),
-            "3" | "90" | "RightToLeft" => Some(Self::RightToLeft),
-            _ => None,
-        }
-    }
-}
+/// Order in which the lines of a rolling-shutter frame are read: the
+/// camera's own type ([`crate::camera::Readout`]), parsed from Gyroflow's
+/// values by [`crate::camera::Readout::from_gyroflow`].
+pub type ReadoutDirection = crate::camera::Readout;
 
 /// The header of a `.gcsv` file.
 #[derive(Debug, Clone, PartialEq)]
@@ -364,7 +341,7 @@ fn read_head<R: BufRead>(src: &mut R, path: &Path) -> Result<(GcsvHeader, Column
     };
     let readout_direction = match find("frame_readout_direction")? {
         Some(("", _)) => None,
-        Some((v, l)) => Some(ReadoutDirection::parse(v).ok_or_else(|| {
+        Some((v, l)) => Some(ReadoutDirection::from_gyroflow(v).ok_or_else(|| {
             parse_err(
                 path,
                 l,
@@ -678,9 +655,9 @@ mod tests {
         assert!(is_magic(b"\xEF\xBB\xBFCAMERA IMU LOG \r"));
         assert!(!is_magic(b"GYROFLOW IMU LOGS"));
         assert!(!is_magic(b"t,wx,wy,wz"));
-        assert!(ReadoutDirection::parse("4").is_none());
+        assert!(ReadoutDirection::from_gyroflow("4").is_none());
         assert_eq!(
-            ReadoutDirection::parse("90"),
+            ReadoutDirection::from_gyroflow("90"),
             Some(ReadoutDirection::RightToLeft)
         );
     }
