@@ -310,3 +310,64 @@ fn cli_frames_select_and_errors() {
     let (ok, _, err) = run(&["frames", "--gyro", path(&gyro), "--frames", path(&bad)]);
     assert!(!ok && err.contains(":4:exposure_s"), "{err}");
 }
+
+/// The README's table of the running log's sharpest and blurriest frames is
+/// what `mmbm frames` computes (frames, order and every printed digit), as is
+/// the sentence before it (frames inside the log, median blur).
+#[test]
+fn readme_frames_table_is_current() {
+    let Some((samples, frames)) = shared_frames("running_phone") else {
+        return;
+    };
+    let cam = example_camera("running_phone");
+    let (rows, _) = frame_mmbm(
+        &samples,
+        &opts(cam, Method::Riemann { nu: 8, nv: 6 }),
+        &frames,
+    )
+    .unwrap();
+    let mut inside: Vec<_> = rows.iter().filter(|r| r.exposure_mm_s.is_some()).collect();
+    inside.sort_by(|a, b| {
+        a.blur_px(&cam)
+            .unwrap()
+            .total_cmp(&b.blur_px(&cam).unwrap())
+    });
+    let n = inside.len();
+    let median = {
+        let b: Vec<f64> = inside.iter().map(|r| r.blur_px(&cam).unwrap()).collect();
+        0.5 * (b[(n - 1) / 2] + b[n / 2])
+    };
+    let mut expect: Vec<String> = inside[..5]
+        .iter()
+        .chain(&inside[n - 5..])
+        .map(|r| {
+            format!(
+                "| {} | {:.3} | {:.4} | {:.3} | {:.4} |",
+                r.frame,
+                r.t_start,
+                r.exposure_mm_s.unwrap(),
+                r.blur_px(&cam).unwrap(),
+                r.start_mm_s.unwrap()
+            )
+        })
+        .collect();
+    expect.insert(0, "|---|---|---|---|---|".into());
+    expect.insert(
+        0,
+        "| frame | t_start (s) | exposure MMBM (mm/s) | blur (px) | MMBM at start (mm/s) |".into(),
+    );
+    let readme =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/README.md")).unwrap();
+    let start = readme
+        .find("<!-- frames-table")
+        .expect("README frames table");
+    let end = readme.find("<!-- /frames-table -->").unwrap();
+    let table: Vec<&str> = readme[start..end]
+        .lines()
+        .skip(1)
+        .filter(|l| !l.is_empty())
+        .collect();
+    assert_eq!(table, expect, "README table vs computed");
+    let sentence = format!("{n} frames inside the log, median blur {median:.2} px");
+    assert!(readme.contains(&sentence), "README should say: {sentence}");
+}

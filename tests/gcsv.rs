@@ -427,7 +427,11 @@ fn every_gyro_command_takes_gcsv() {
 #[test]
 fn frames_use_the_gcsv_readout() {
     let dir = tempfile::tempdir().unwrap();
-    let frames = write(dir.path(), "frames.csv", "t_start,exposure_s\n1.001,0.002\n1.050,0.002\n");
+    let frames = write(
+        dir.path(),
+        "frames.csv",
+        "t_start,exposure_s\n1.001,0.002\n1.050,0.002\n",
+    );
     let out = Command::new(env!("CARGO_BIN_EXE_mmbm"))
         .args(["frames", "--gyro"])
         .arg(walk())
@@ -436,7 +440,11 @@ fn frames_use_the_gcsv_readout() {
         .output()
         .unwrap();
     let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let rows: Vec<&str> = stdout.lines().collect();
     assert_eq!(rows.len(), 3, "{stdout}");
     assert!(rows[1].ends_with(",0.002,0.01523"), "{}", rows[1]);

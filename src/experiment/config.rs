@@ -3,6 +3,7 @@
 //! the blob board walked towards from 6 m, the thesis policies and their
 //! successors.
 
+use crate::camera::{Distortion, Lens, Noise, Readout};
 use crate::error::{Error, Result};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -48,6 +49,36 @@ pub struct ExperimentConfig {
     pub quality: String,
     /// Render at most this many frames per policy and walk (evenly spread); 0 = all.
     pub max_frames_per_policy: usize,
+    /// Exposures (s) of the exposure sweep in the report (the same frames
+    /// re-rendered at each); empty: no sweep.
+    pub sweep_exposures_s: Vec<f64>,
+    /// Frames of the exposure sweep (the fixed-rate schedule's, evenly spread).
+    pub sweep_frames: usize,
+    /// The real camera of SPEC section 9 (all off by default: the thesis's
+    /// ideal global-shutter pinhole).
+    pub camera: CameraSection,
+}
+
+/// The `[camera]` section: the thesis camera (focal length, pitch, at
+/// `resolution`) with any of the camera file's real-camera keys.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct CameraSection {
+    /// Rolling-shutter readout, s (first to last line's exposure start).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub readout_s: Option<f64>,
+    /// Readout direction (default top-to-bottom).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub readout_direction: Option<Readout>,
+    /// Lens distortion.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub distortion: Option<Distortion>,
+    /// Sensor noise (a light level `phi_e_per_s` and the sensor's keys).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub noise: Option<Noise>,
+    /// Thin lens (defocus).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub lens: Option<Lens>,
 }
 
 impl Default for ExperimentConfig {
@@ -83,6 +114,9 @@ impl Default for ExperimentConfig {
             resolution: [640, 480],
             quality: "default".into(),
             max_frames_per_policy: 0,
+            sweep_exposures_s: vec![0.01, 0.02, 0.035, 0.05, 0.07],
+            sweep_frames: 12,
+            camera: CameraSection::default(),
         }
     }
 }
@@ -177,6 +211,12 @@ impl ExperimentConfig {
             .map_err(|e| key("quality", e))?;
         crate::render::Target::parse(&self.target, self.start_distance_m)
             .map_err(|e| key("target", e))?;
+        for &e in &self.sweep_exposures_s {
+            positive("sweep_exposures_s", e)?;
+        }
+        crate::experiment::walk::camera(self)
+            .validate()
+            .map_err(|e| key("camera", e))?;
         Ok(())
     }
 

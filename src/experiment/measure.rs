@@ -243,10 +243,13 @@ pub fn render_and_measure(
         .min(walk.samples.len() - 1);
     let distance = walk.distance[i];
     let use_velocity = walk.samples[i].velocity.is_some();
+    // A rolling shutter exposes each line over its own window: the motion
+    // spans the readout plus the exposure.
+    let rolling = cam.shutter.readout_s;
     let traj = Trajectory::from_log(
         &walk.samples,
         frame.exposure_start,
-        cfg.exposure_s,
+        cfg.exposure_s + rolling,
         use_velocity,
     )?;
     let target = Target::parse(&cfg.target, distance)?;
@@ -264,7 +267,8 @@ pub fn render_and_measure(
     let means = maps.means();
     let rgb8 = to_rgb8(cam.width, cam.height, &out.rgb)?;
     // True blob centres at mid-exposure (the centroid of a smear).
-    let mid = traj.pose_at(0.5 * cfg.exposure_s);
+    // (Rolling shutter: the middle line's mid-exposure.)
+    let mid = traj.pose_at(0.5 * (cfg.exposure_s + rolling));
     let frame_pl = target.frame();
     let (board, expected): (Vec<Point2>, Vec<Point2>) = target
         .blob_centres()

@@ -17,6 +17,7 @@ pub mod figures;
 pub mod measure;
 pub mod report;
 pub mod run;
+pub mod sweep;
 pub mod walk;
 
 pub use config::ExperimentConfig;

@@ -256,6 +256,8 @@ pub struct Outcome {
     pub seconds: f64,
     /// Frames rendered.
     pub rendered: usize,
+    /// The exposure sweep (empty when not configured).
+    pub sweep: Vec<super::sweep::SweepRow>,
 }
 
 /// The render-quality note: the preset and its measured error against the default preset.
@@ -380,6 +382,7 @@ pub fn report_md(
           widths along image rows only (as their authors' code does), so they are blind to vertical smear, \
           which dominates a walking robot's pitching; the blur effect and the ground-truth blur see both directions.\n\n";
     s += &table_6(stats);
+    s += &super::sweep::sweep_md(cfg, &o.sweep);
     s += "\n## Figures\n\n";
     for f in figs {
         s += &format!("![{f}]({f})\n\n");

@@ -97,6 +97,7 @@ pub fn run(cfg: &ExperimentConfig, out: &Path, progress: bool) -> Result<Outcome
         bar.inc(1);
     }
     bar.finish_and_clear();
+    let sweep = super::sweep::exposure_sweep(cfg, &walks, quality)?;
 
     let mut records = Vec::new();
     for (wi, w) in walks.iter().enumerate() {
@@ -130,6 +131,7 @@ pub fn run(cfg: &ExperimentConfig, out: &Path, progress: bool) -> Result<Outcome
             stats,
             seconds: t_start.elapsed().as_secs_f64(),
             rendered: plan.len(),
+            sweep,
         };
         let md = report_md(cfg, &outcome, &figs, check);
         write_atomic(&out.join("report.md"), |w| {

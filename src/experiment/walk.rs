@@ -90,7 +90,8 @@ pub fn make_walk(
     })
 }
 
-/// The camera timing of the configuration.
+/// The camera timing of the configuration (a rolling shutter's line readout
+/// keeps the camera busy too).
 pub fn timing(cfg: &ExperimentConfig) -> CameraTiming {
     CameraTiming {
         delay: cfg.delay_s,
@@ -98,9 +99,24 @@ pub fn timing(cfg: &ExperimentConfig) -> CameraTiming {
         readout: cfg.readout_s,
         min_interval: cfg.min_interval_s,
     }
+    .with_rolling_readout(cfg.camera.readout_s.unwrap_or(0.0))
 }
 
-/// The rendering camera: thesis focal length and pitch at the configured resolution.
+/// The camera: thesis focal length and pitch at the configured resolution,
+/// with the `[camera]` section's rolling shutter, distortion, noise and lens.
 pub fn camera(cfg: &ExperimentConfig) -> Camera {
-    Camera::thesis().with_resolution(cfg.resolution[0], cfg.resolution[1])
+    let mut c = Camera::thesis().with_resolution(cfg.resolution[0], cfg.resolution[1]);
+    let s = &cfg.camera;
+    if let Some(r) = s.readout_s {
+        c.shutter.readout_s = r;
+    }
+    if let Some(d) = s.readout_direction {
+        c.shutter.direction = d;
+    }
+    if let Some(d) = s.distortion {
+        c.distortion = d;
+    }
+    c.noise = s.noise;
+    c.lens = s.lens;
+    c
 }

@@ -2,6 +2,7 @@
 //! metric rules here, the flow-field kernels ([`field`]), the renderer
 //! ([`render`]) and the trigger policies ([`trigger`]).
 
+mod camera;
 mod field;
 mod render;
 mod trigger;
@@ -20,7 +21,8 @@ use std::time::Instant;
   mmbm bench --what metric
   mmbm bench --what gpu
   mmbm bench --what trigger
-  mmbm bench --what render")]
+  mmbm bench --what render
+  mmbm bench --what camera")]
 pub struct BenchArgs {
     /// metric, gpu, trigger, render or all.
     #[arg(long, default_value = "all")]
@@ -45,7 +47,7 @@ pub fn time_per_call(secs: f64, mut f: impl FnMut()) -> f64 {
     }
 }
 
-fn twists(n: usize) -> Vec<Twist> {
+pub(crate) fn twists(n: usize) -> Vec<Twist> {
     let mut s = 1u64;
     (0..n)
         .map(|_| {
@@ -125,15 +127,17 @@ pub fn run(a: BenchArgs) -> Result<()> {
         "gpu" => field::run(),
         "trigger" => trigger::bench(),
         "render" => render::bench(),
+        "camera" => camera::bench(),
         "all" => {
             metric()?;
             field::run()?;
             trigger::bench()?;
-            render::bench()
+            render::bench()?;
+            camera::bench()
         }
         w => Err(mmbm::Error::invalid(
             "--what",
-            format!("'{w}': expected metric, gpu, trigger, render or all"),
+            format!("'{w}': expected metric, gpu, trigger, render, camera or all"),
         )),
     }
 }
