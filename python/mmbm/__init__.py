@@ -17,6 +17,8 @@ message.
 
 from __future__ import annotations
 
+import dataclasses
+import json
 import os
 from dataclasses import dataclass
 from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
@@ -29,6 +31,7 @@ __all__ = [
     "Camera",
     "metric",
     "series",
+    "frames",
     "read_gyro",
     "flow_field",
     "render",
@@ -43,13 +46,17 @@ ArrayLike = Any
 
 @dataclass(frozen=True)
 class Camera:
-    """A pinhole camera (the keys of mmbm's camera files).
+    """A camera (the keys of mmbm's camera files, SPEC sections 1 and 9).
 
     ``focal_mm``: focal length, mm; ``pitch_x_mm``, ``pitch_y_mm``: pixel
     pitch, mm; ``width``, ``height``: sensor size, px; ``cx``, ``cy``:
     principal point, px from the top-left corner (default: the centre);
     ``skew``: px. ``Camera()`` is the thesis camera (4.2548 mm, 4.65 um,
-    640 x 480).
+    640 x 480). The real camera: ``readout_s`` (rolling shutter, s; 0 =
+    global) and ``readout_direction`` ("top-to-bottom", ...), ``distortion``
+    (e.g. ``{"model": "opencv", "k1": -0.28}`` or ``{"model": "fisheye",
+    "k1": 0.03}``), ``noise`` (``{"phi_e_per_s": 50000, ...}``), ``lens``
+    (``{"f_number": 2.0, "focus_m": 1.5}``).
     """
 
     focal_mm: float = 4.2548
@@ -60,6 +67,11 @@ class Camera:
     cx: Optional[float] = None
     cy: Optional[float] = None
     skew: float = 0.0
+    readout_s: float = 0.0
+    readout_direction: str = "top-to-bottom"
+    distortion: Optional[dict] = None
+    noise: Optional[dict] = None
+    lens: Optional[dict] = None
 
     def __post_init__(self) -> None:
         if self.cx is None:
@@ -71,14 +83,31 @@ class Camera:
     @classmethod
     def from_file(cls, path: PathLike) -> "Camera":
         """Reads a camera file (TOML or JSON, as ``mmbm --camera FILE``)."""
-        f, px, py, w, h, cx, cy, skew = _mmbm.camera_from_file(os.fspath(path))
-        return cls(f, px, py, w, h, cx, cy, skew)
+        f, px, py, w, h, cx, cy, skew, extras = _mmbm.camera_from_file(os.fspath(path))
+        x = json.loads(extras)
+        dist = x.get("distortion", {"model": "none"})
+        return cls(
+            f, px, py, w, h, cx, cy, skew,
+            readout_s=x["readout_s"],
+            readout_direction=x["readout_direction"],
+            distortion=None if dist.get("model") == "none" else dist,
+            noise=x.get("noise"),
+            lens=x.get("lens"),
+        )
 
     def with_resolution(self, width: int, height: int) -> "Camera":
         """Same focal length and pitch, another size, principal point at the centre."""
-        return Camera(self.focal_mm, self.pitch_x_mm, self.pitch_y_mm, width, height, None, None, self.skew)
+        return dataclasses.replace(self, width=width, height=height, cx=None, cy=None)
 
-    def _tuple(self) -> Tuple[float, float, float, int, int, float, float, float]:
+    def _extras(self) -> str:
+        x: dict = {"readout_s": float(self.readout_s), "readout_direction": self.readout_direction}
+        for k in ("distortion", "noise", "lens"):
+            v = getattr(self, k)
+            if v is not None:
+                x[k] = v
+        return json.dumps(x)
+
+    def _tuple(self) -> Tuple[float, float, float, int, int, float, float, float, str]:
         return (
             float(self.focal_mm),
             float(self.pitch_x_mm),
@@ -88,10 +117,11 @@ class Camera:
             float(self.cx),  # type: ignore[arg-type]
             float(self.cy),  # type: ignore[arg-type]
             float(self.skew),
+            self._extras(),
         )
 
 
-def _cam(camera: Optional[Camera]) -> Tuple[float, float, float, int, int, float, float, float]:
+def _cam(camera: Optional[Camera]) -> Tuple[float, float, float, int, int, float, float, float, str]:
     return (camera or Camera())._tuple()
 
 
@@ -164,6 +194,43 @@ def series(
     if depth is not None:
         d = np.ascontiguousarray(np.broadcast_to(np.asarray(depth, dtype=np.float64), tt.shape))
     return _mmbm.series(_cam(camera), tt, w, v, d, _plane(None, plane), method)
+
+
+def frames(
+    t: ArrayLike,
+    omega: ArrayLike,
+    t_start: ArrayLike,
+    exposure_s: ArrayLike,
+    readout_s: Optional[ArrayLike] = None,
+    method: str = "riemann:8x6",
+    camera: Optional[Camera] = None,
+) -> Dict[str, np.ndarray]:
+    """Exposure MMBM of every video frame (SPEC 9: each line over its own
+    rolling-shutter window), as ``mmbm frames``: ``t`` (N,) s and ``omega``
+    (N, 3) rad/s of the log; per frame ``t_start`` (the first line's
+    exposure start, s), ``exposure_s`` and ``readout_s`` (default: the
+    camera's ``readout_s``), broadcast to one shape. Returns
+    ``{"exposure_mmbm_mm_s", "blur_px", "start_mmbm_mm_s"}`` (NaN where a
+    frame's window leaves the log). ``telemetry_parser``'s
+    ``frame_readout_time()`` (ms) / 1000 is a ``readout_s``."""
+    tt = np.ascontiguousarray(np.asarray(t, dtype=np.float64).ravel())
+    if not (np.all(np.isfinite(tt)) and np.all(np.diff(tt) > 0)):
+        raise ValueError("t: times must be finite and strictly increasing (s)")
+    w = _rows3(omega, "omega")
+    if w.shape[0] != tt.shape[0]:
+        raise ValueError(f"omega has {w.shape[0]} rows for {tt.shape[0]} times")
+    ts = np.asarray(t_start, dtype=np.float64).ravel()
+    es = np.ascontiguousarray(np.broadcast_to(np.asarray(exposure_s, dtype=np.float64), ts.shape))
+    rs = None
+    if readout_s is not None:
+        rs = np.ascontiguousarray(np.broadcast_to(np.asarray(readout_s, dtype=np.float64), ts.shape))
+    cam = camera or Camera()
+    e, s0 = _mmbm.frames(cam._tuple(), tt, w, np.ascontiguousarray(ts), es, rs, method)
+    return {
+        "exposure_mmbm_mm_s": e,
+        "blur_px": e * es / cam.pitch_x_mm,
+        "start_mmbm_mm_s": s0,
+    }
 
 
 def read_gyro(

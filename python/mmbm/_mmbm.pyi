@@ -5,7 +5,7 @@ from typing import Any, Dict, List, Optional, Sequence, Tuple
 import numpy as np
 import numpy.typing as npt
 
-CamTuple = Tuple[float, float, float, int, int, float, float, float]
+CamTuple = Tuple[float, float, float, int, int, float, float, float, str]
 F64 = npt.NDArray[np.float64]
 F32 = npt.NDArray[np.float32]
 
@@ -22,6 +22,9 @@ def series(
     plane_: Optional[F64],
     method: str,
 ) -> F64: ...
+def frames(
+    cam: CamTuple, t: F64, omega: F64, t_start: F64, exposure_s: F64, readout_s: Optional[F64], method: str
+) -> Tuple[F64, F64]: ...
 def read_gyro(
     path: str,
     time_unit: str,

@@ -5,10 +5,10 @@
 //! become `OSError` (files) or `ValueError` (everything else).
 
 use glam::DVec3;
+use mmbm::camera::Camera;
 use mmbm::gpu::Backend;
 use mmbm::io::gyro::{parse_rotation, GyroOptions, GyroSample};
 use mmbm::metric::{Method, Scene};
-use mmbm::camera::Camera;
 use mmbm::model::motion::{Plane, Twist};
 use mmbm::render::{Integrator, Quality, RenderJob, Target, Trajectory};
 use numpy::ndarray::{Array1, Array2, Array3};
@@ -18,8 +18,20 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::path::PathBuf;
 
-/// The camera as the Python half passes it.
-type CamTuple = (f64, f64, f64, u32, u32, f64, f64, f64);
+/// The camera as the Python half passes it: the pinhole intrinsics and the
+/// real-camera parts of SPEC 9 as a JSON object ([`Extras`]).
+type CamTuple = (f64, f64, f64, u32, u32, f64, f64, f64, String);
+
+/// The camera file's real-camera keys (rolling shutter, distortion, noise, lens).
+#[derive(serde::Serialize, serde::Deserialize, Default)]
+#[serde(deny_unknown_fields, default)]
+struct Extras {
+    readout_s: f64,
+    readout_direction: mmbm::camera::Readout,
+    distortion: mmbm::camera::Distortion,
+    noise: Option<mmbm::camera::Noise>,
+    lens: Option<mmbm::camera::Lens>,
+}
 
 fn err(e: mmbm::Error) -> PyErr {
     match e {
@@ -29,7 +41,12 @@ fn err(e: mmbm::Error) -> PyErr {
 }
 
 fn camera(c: CamTuple) -> PyResult<Camera> {
-    let (focal_mm, pitch_x_mm, pitch_y_mm, width, height, cx, cy, skew) = c;
+    let (focal_mm, pitch_x_mm, pitch_y_mm, width, height, cx, cy, skew, extras) = c;
+    let x: Extras = if extras.is_empty() {
+        Extras::default()
+    } else {
+        serde_json::from_str(&extras).map_err(|e| PyValueError::new_err(format!("camera: {e}")))?
+    };
     let cam = Camera {
         focal_mm,
         pitch_x_mm,
@@ -39,7 +56,13 @@ fn camera(c: CamTuple) -> PyResult<Camera> {
         cx,
         cy,
         skew,
-        ..Camera::thesis()
+        distortion: x.distortion,
+        shutter: mmbm::camera::Shutter {
+            readout_s: x.readout_s,
+            direction: x.readout_direction,
+        },
+        noise: x.noise,
+        lens: x.lens,
     };
     cam.validate().map_err(err)?;
     Ok(cam)
@@ -55,6 +78,14 @@ fn cam_tuple(c: &Camera) -> CamTuple {
         c.cx,
         c.cy,
         c.skew,
+        serde_json::to_string(&Extras {
+            readout_s: c.shutter.readout_s,
+            readout_direction: c.shutter.direction,
+            distortion: c.distortion,
+            noise: c.noise,
+            lens: c.lens,
+        })
+        .unwrap_or_default(),
     )
 }
 
@@ -125,6 +156,71 @@ fn metric<'py>(
         })
         .map_err(err)?;
     Ok(Array1::from(out).into_pyarray(py))
+}
+
+/// Exposure MMBM (mm/s, each line over its own rolling-shutter window) and
+/// the MMBM at the start of every video frame; NaN where a frame's window
+/// leaves the log. Returns `(exposure_mm_s, start_mm_s)`.
+#[pyfunction]
+#[pyo3(signature = (cam, t, omega, t_start, exposure_s, readout_s, method))]
+#[allow(clippy::too_many_arguments, clippy::type_complexity)]
+fn frames<'py>(
+    py: Python<'py>,
+    cam: CamTuple,
+    t: PyReadonlyArray1<'py, f64>,
+    omega: PyReadonlyArray2<'py, f64>,
+    t_start: PyReadonlyArray1<'py, f64>,
+    exposure_s: PyReadonlyArray1<'py, f64>,
+    readout_s: Option<PyReadonlyArray1<'py, f64>>,
+    method: &str,
+) -> PyResult<(
+    Bound<'py, numpy::PyArray1<f64>>,
+    Bound<'py, numpy::PyArray1<f64>>,
+)> {
+    let w = rows3(&omega)?;
+    let samples: Vec<GyroSample> = t
+        .as_slice()?
+        .iter()
+        .zip(&w)
+        .map(|(&t, &omega)| GyroSample {
+            t,
+            omega,
+            velocity: None,
+            depth: None,
+        })
+        .collect();
+    let (ts, es) = (t_start.as_slice()?, exposure_s.as_slice()?);
+    let rs = readout_s.as_ref().map(|r| r.as_slice()).transpose()?;
+    let video: Vec<mmbm::io::frames::VideoFrame> = (0..ts.len())
+        .map(|k| mmbm::io::frames::VideoFrame {
+            t_start: ts[k],
+            exposure_s: es[k],
+            readout_s: rs.map(|r| r[k]),
+        })
+        .collect();
+    let opts = mmbm::series::SeriesOptions {
+        scene: Scene {
+            camera: camera(cam)?,
+            plane: None,
+        },
+        method: method.parse().map_err(err)?,
+        use_velocity: false,
+    };
+    let (rows, _) = py
+        .detach(|| mmbm::series::frames::frame_mmbm(&samples, &opts, &video))
+        .map_err(err)?;
+    let e: Vec<f64> = rows
+        .iter()
+        .map(|r| r.exposure_mm_s.unwrap_or(f64::NAN))
+        .collect();
+    let s0: Vec<f64> = rows
+        .iter()
+        .map(|r| r.start_mm_s.unwrap_or(f64::NAN))
+        .collect();
+    Ok((
+        Array1::from(e).into_pyarray(py),
+        Array1::from(s0).into_pyarray(py),
+    ))
 }
 
 /// MMBM (mm/s) of a log: samples `t`, `omega`, optional `velocity` and `depth`.
@@ -292,15 +388,18 @@ fn render<'py>(
     sharp: bool,
 ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
     let camera = camera(cam)?;
+    // A rolling shutter's lines are exposed one after another: the motion
+    // spans the readout plus the exposure (as in `mmbm render`).
+    let span = exposure + camera.shutter.readout_s;
     let trajectory = match (omega, gyro) {
         (Some(w), None) => {
-            Trajectory::from_twist(Twist::new(DVec3::from(w), DVec3::from(velocity)), exposure)
+            Trajectory::from_twist(Twist::new(DVec3::from(w), DVec3::from(velocity)), span)
                 .map_err(err)?
         }
         (None, Some(g)) => {
             let at = at.ok_or_else(|| PyValueError::new_err("at: required with gyro"))?;
             let samples = dict_samples(&g)?;
-            Trajectory::from_log(&samples, at, exposure, use_velocity).map_err(err)?
+            Trajectory::from_log(&samples, at, span, use_velocity).map_err(err)?
         }
         _ => {
             return Err(PyValueError::new_err(
@@ -485,6 +584,7 @@ fn _mmbm(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(camera_check, m)?)?;
     m.add_function(wrap_pyfunction!(metric, m)?)?;
     m.add_function(wrap_pyfunction!(series, m)?)?;
+    m.add_function(wrap_pyfunction!(frames, m)?)?;
     m.add_function(wrap_pyfunction!(read_gyro, m)?)?;
     m.add_function(wrap_pyfunction!(flow_field, m)?)?;
     m.add_function(wrap_pyfunction!(render, m)?)?;
