@@ -146,7 +146,8 @@ impl GridRule {
                 let mut sum = 0.0;
                 for (k, j) in jac.iter().enumerate() {
                     let (a, b) = poly.eval(self.m[0][k], self.m[1][k]);
-                    sum += self.w[k] * (j[0] * a + j[1] * b).hypot(j[2] * a + j[3] * b);
+                    let (x, y) = (j[0] * a + j[1] * b, j[2] * a + j[3] * b);
+                    sum += self.w[k] * (x * x + y * y).sqrt();
                 }
                 sum
             }

@@ -319,7 +319,7 @@ fn distorted_speed(cam: &Camera, poly: &FlowPoly, ud: f64, vd: f64) -> f64 {
         Some((u, v)) => {
             let (a, b) =
                 crate::camera::distortion::apply(&cam.distortion_jacobian(u, v), poly.eval(u, v));
-            a.hypot(b)
+            (a * a + b * b).sqrt()
         }
         None => f64::NAN,
     }
