@@ -214,10 +214,28 @@ impl ExperimentConfig {
         for &e in &self.sweep_exposures_s {
             positive("sweep_exposures_s", e)?;
         }
-        crate::experiment::walk::camera(self)
-            .validate()
-            .map_err(|e| key("camera", e))?;
+        self.camera().validate().map_err(|e| key("camera", e))?;
         Ok(())
+    }
+
+    /// The camera: thesis focal length and pitch at `resolution`, with the
+    /// `[camera]` section's rolling shutter, distortion, noise and lens.
+    pub fn camera(&self) -> crate::camera::Camera {
+        let mut c =
+            crate::camera::Camera::thesis().with_resolution(self.resolution[0], self.resolution[1]);
+        let s = &self.camera;
+        if let Some(r) = s.readout_s {
+            c.shutter.readout_s = r;
+        }
+        if let Some(d) = s.readout_direction {
+            c.shutter.direction = d;
+        }
+        if let Some(d) = s.distortion {
+            c.distortion = d;
+        }
+        c.noise = s.noise;
+        c.lens = s.lens;
+        c
     }
 
     /// The configuration as TOML (written into the report).

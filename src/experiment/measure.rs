@@ -224,6 +224,8 @@ pub fn image_difference(a: &[f32], b: &[f32]) -> (f64, f64) {
 pub struct Rendered {
     /// The measurements.
     pub measure: FrameMeasure,
+    /// Where it was rendered (`gpu: <adapter>` or `cpu (N threads)`).
+    pub backend: String,
     /// Linear RGB, interleaved.
     pub rgb: Vec<f32>,
 }
@@ -255,7 +257,8 @@ pub fn render_and_measure(
     let target = Target::parse(&cfg.target, distance)?;
     let mut job = RenderJob::new(cam, traj.clone(), target.clone());
     job.quality = quality;
-    job.backend = Backend::Auto;
+    // Many frames: a hardware GPU, else the CPU twin (see `Backend::Bulk`).
+    job.backend = Backend::Bulk;
     job.seed = seed;
     let t0 = Instant::now();
     let out = render::render_frame(&job)?;
@@ -289,6 +292,7 @@ pub fn render_and_measure(
         (f64::NAN, f64::NAN)
     };
     Ok(Rendered {
+        backend: out.backend_used.clone(),
         measure: FrameMeasure {
             distance_m: distance,
             blur_px: means.path_px,

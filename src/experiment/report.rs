@@ -258,6 +258,8 @@ pub struct Outcome {
     pub rendered: usize,
     /// The exposure sweep (empty when not configured).
     pub sweep: Vec<super::sweep::SweepRow>,
+    /// Where the frames were rendered (`gpu: <adapter>` or `cpu (N threads)`).
+    pub backend: String,
 }
 
 /// The render-quality note: the preset and its measured error against the default preset.
@@ -391,7 +393,10 @@ pub fn report_md(
     s += "## Method and simplifications\n\n";
     s += "- Walks are simulated by `mmbm simulate` (seeded); the log is both the measurement the policies see and the true motion the renderer follows (its gyro noise included).\n";
     s += "- Policies decide on the rotation-only MMBM (thesis camera, 8x6 grid) of each gyro sample.\n";
-    s += "- Each kept frame is rendered on the GPU (CPU twin when no adapter) from the log window of its exposure, rotation and translation integrated on SE(3).\n";
+    s += &format!(
+        "- Each kept frame is rendered from the log window of its exposure, rotation and translation integrated on SE(3), on a hardware GPU when there is one, else with the renderer's CPU twin (also on a software adapter such as lavapipe, where the twin is faster and the driver's memory grows per dispatch); this run: {}.\n",
+        if o.backend.is_empty() { "no frame rendered" } else { &o.backend }
+    );
     s += "- At every exposure start the camera looks at the board's centre; the board's distance follows the walked distance from the start distance.\n";
     s += &quality_note(cfg, check);
     s += "\n## Configuration\n\n```toml\n";

@@ -76,11 +76,15 @@ pub fn run(cfg: &ExperimentConfig, out: &Path, progress: bool) -> Result<Outcome
     let check = quality_check(cfg, &walks, &plan, quality)?;
     let mut measures = HashMap::new();
     let mut extremes: HashMap<(usize, usize), Extremes> = HashMap::new();
+    let mut backend = String::new();
     for (k, &(wi, pi, fi)) in plan.iter().enumerate() {
         let w = &walks[wi];
         let frame = &w.runs[pi].1[fi];
         bar.set_message(format!("{} {}", w.name, frame.policy));
         let r = render_and_measure(cfg, w, frame, camera(cfg), quality, k as u32)?;
+        if backend.is_empty() {
+            backend = r.backend.clone();
+        }
         // Keep the sharpest and the most blurred frame of each (walk, policy).
         let b = r.measure.blur_px;
         let e = extremes.entry((wi, pi)).or_insert_with(|| Extremes {
@@ -132,6 +136,7 @@ pub fn run(cfg: &ExperimentConfig, out: &Path, progress: bool) -> Result<Outcome
             seconds: t_start.elapsed().as_secs_f64(),
             rendered: plan.len(),
             sweep,
+            backend,
         };
         let md = report_md(cfg, &outcome, &figs, check);
         write_atomic(&out.join("report.md"), |w| {

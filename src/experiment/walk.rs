@@ -102,21 +102,7 @@ pub fn timing(cfg: &ExperimentConfig) -> CameraTiming {
     .with_rolling_readout(cfg.camera.readout_s.unwrap_or(0.0))
 }
 
-/// The camera: thesis focal length and pitch at the configured resolution,
-/// with the `[camera]` section's rolling shutter, distortion, noise and lens.
+/// The camera of the configuration ([`ExperimentConfig::camera`]).
 pub fn camera(cfg: &ExperimentConfig) -> Camera {
-    let mut c = Camera::thesis().with_resolution(cfg.resolution[0], cfg.resolution[1]);
-    let s = &cfg.camera;
-    if let Some(r) = s.readout_s {
-        c.shutter.readout_s = r;
-    }
-    if let Some(d) = s.readout_direction {
-        c.shutter.direction = d;
-    }
-    if let Some(d) = s.distortion {
-        c.distortion = d;
-    }
-    c.noise = s.noise;
-    c.lens = s.lens;
-    c
+    cfg.camera()
 }
