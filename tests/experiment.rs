@@ -78,6 +78,9 @@ fn tiny_experiment_end_to_end() {
         "threshold:0.4",
         "oracle:0.4",
         "```toml",
+        "discarded by a gate",
+        "## Exposure sweep (thesis Fig. 1.1)",
+        "| exposure (ms) | frames | blob success | mean blur (px) |",
     ] {
         assert!(md.contains(needle), "report lacks {needle}");
     }

@@ -210,7 +210,7 @@ pub fn table_5_1(walks: &[Walk]) -> String {
 /// policy, blob success, JNBM and blur.
 pub fn table_6(stats: &[PolicyStats]) -> String {
     let mut s = String::from(
-        "| walk | policy | frames kept | fps | frames lost vs fixed | rendered | all 16 blobs | success % | mean JNBM | mean CPBD | mean blur effect | mean blur px | p95 blur px | max blur px | mean exposure MMBM mm/s | pose error cm | pose error deg |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+        "| walk | policy | frames kept | discarded by a gate | fps | frames lost vs fixed | rendered | all 16 blobs | success % | mean JNBM | mean CPBD | mean blur effect | mean blur px | p95 blur px | max blur px | mean exposure MMBM mm/s | pose error cm | pose error deg |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     for st in stats {
         let fixed = stats
@@ -221,10 +221,11 @@ pub fn table_6(stats: &[PolicyStats]) -> String {
         let succ = st.success_pct();
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
             st.walk,
             st.policy,
             st.kept,
+            st.triggered - st.kept,
             f(st.fps, 2),
             lost,
             st.rendered,
