@@ -457,3 +457,26 @@ fn rolling_readout_extends_the_busy_time() {
     );
     assert!(b.len() < a.len());
 }
+
+/// `gate0` (the thesis's test) keeps a fixed-rate frame when the MMBM of its
+/// decision sample is <= X; `gate` when the exposure average is. Both fire
+/// exactly the fixed schedule's triggers.
+#[test]
+fn gate_at_start_and_over_the_exposure() {
+    let (s, m) = sim(Gait::Moderate, 10.0, 5);
+    let tm = timing0();
+    let fixed = go("fixed:5", &s, &m, &tm);
+    let g = go("gate:0.6", &s, &m, &tm);
+    let g0 = go("gate0:0.6", &s, &m, &tm);
+    assert_eq!(fixed.len(), g.len());
+    assert_eq!(fixed.len(), g0.len());
+    for ((f, a), b) in fixed.iter().zip(&g).zip(&g0) {
+        assert_eq!((f.index, a.index), (b.index, b.index));
+        assert_eq!(a.kept, f.mmbm_exposure_mm_s <= 0.6);
+        assert_eq!(b.kept, f.mmbm_trigger_mm_s <= 0.6);
+    }
+    assert!(
+        g.iter().zip(&g0).any(|(a, b)| a.kept != b.kept),
+        "the two tests differ somewhere"
+    );
+}

@@ -17,7 +17,9 @@ use std::path::PathBuf;
     after_help = "Policies (X in mm/s, or pNN = NN-th percentile of the whole log's MMBM, an offline calibration that
 looks at the future, so not causal: `mmbm live` refuses it; FPS at most 1000):
   fixed:FPS[@PHASE]  threshold:X  adaptive[:X[:FPS]]  oracle:X[:H]  forecast:X[:H]
-  gate:X[:FPS[@PHASE]]  deadline:FPS[:X]
+  gate:X[:FPS[@PHASE]]  gate0:X[:FPS[@PHASE]]  deadline:FPS[:X]
+  (gate keeps a fixed-rate frame when its exposure-averaged MMBM is <= X; gate0, the thesis's test, when
+  the MMBM at the exposure start, i.e. of the decision sample, is)
 
 Examples:
   mmbm simulate --gait moderate --duration 16 --out walk.csv

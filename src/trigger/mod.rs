@@ -39,6 +39,7 @@
 //! | `oracle:X[:H]` | perfect future knowledge (see [`Oracle`]); `H` default 0.2 s |
 //! | `forecast:X[:H]` | the oracle's rule on a blind periodic forecast (see [`Forecast`]) |
 //! | `gate:X[:FPS[@PHASE]]` | `fixed` (default 5 fps), frames whose exposure MMBM is above `X` marked not kept |
+//! | `gate0:X[:FPS[@PHASE]]` | the same, on the MMBM at the exposure start (the decision sample): the thesis's test |
 //! | `deadline:FPS[:X]` | one frame per fixed-rate slot at the best causal instant (see [`Deadline`]) |
 
 mod live;

@@ -63,7 +63,7 @@ pub(crate) fn parse_rate(s: &str, spec: &str) -> Result<(f64, f64)> {
 }
 
 const GRAMMAR: &str = "fixed:FPS[@PHASE], threshold:X, adaptive[:X[:FPS]], oracle:X[:H], \
-forecast:X[:H], gate:X[:FPS[@PHASE]] or deadline:FPS[:X] (X in mm/s or pNN)";
+forecast:X[:H], gate:X[:FPS[@PHASE]], gate0:X[:FPS[@PHASE]] or deadline:FPS[:X] (X in mm/s or pNN)";
 
 /// Parses a policy string (grammar in the module docs). The policy keeps the
 /// string exactly as given for the `policy` column.
@@ -101,15 +101,22 @@ pub fn parse_policy(spec: &str) -> Result<Box<dyn Policy>> {
             let (fps, phase) = parse_rate(r, spec)?;
             Box::new(Gate::new(spec, level(x)?, fps, phase))
         }
+        ("gate0", [x]) => Box::new(Gate::at_start(spec, level(x)?, 5.0, 0.0)),
+        ("gate0", [x, r]) => {
+            let (fps, phase) = parse_rate(r, spec)?;
+            Box::new(Gate::at_start(spec, level(x)?, fps, phase))
+        }
         ("deadline", [f]) => Box::new(Deadline::new(spec, parse_fps(f, "frame rate", spec)?, None)),
         ("deadline", [f, x]) => Box::new(Deadline::new(
             spec,
             parse_fps(f, "frame rate", spec)?,
             Some(level(x)?),
         )),
-        ("fixed" | "threshold" | "adaptive" | "oracle" | "forecast" | "gate" | "deadline", _) => {
-            return Err(bad("wrong number of ':' arguments"))
-        }
+        (
+            "fixed" | "threshold" | "adaptive" | "oracle" | "forecast" | "gate" | "gate0"
+            | "deadline",
+            _,
+        ) => return Err(bad("wrong number of ':' arguments")),
         _ => return Err(bad("unknown policy")),
     };
     Ok(p)

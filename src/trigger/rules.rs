@@ -216,21 +216,33 @@ impl Policy for Adaptive {
 /// `gate:X[:FPS[@PHASE]]`: the fixed schedule (default 5 fps), and a frame
 /// whose exposure-averaged MMBM is above `X` is marked not kept (thesis
 /// section 5.3.1, its "enhancement": the average over the exposure rather
-/// than the value at its start).
+/// than the value at its start). `gate0:X[:FPS[@PHASE]]` is the thesis's own
+/// test: the MMBM of the decision sample (the last one before the exposure
+/// starts) above `X` marks the frame not kept.
 #[derive(Debug, Clone)]
 pub struct Gate {
     fixed: Fixed,
     level: Level,
     x: f64,
+    at_start: bool,
 }
 
 impl Gate {
-    /// Gate at `level` on a fixed rate `fps` with phase `phase` s.
+    /// Gate at `level` (on the exposure average) on a fixed rate `fps` with phase `phase` s.
     pub fn new(spec: &str, level: Level, fps: f64, phase: f64) -> Self {
         Gate {
             fixed: Fixed::new(spec, fps, phase),
             level,
             x: f64::NAN,
+            at_start: false,
+        }
+    }
+
+    /// The thesis's gate: on the MMBM at the exposure start (the decision sample).
+    pub fn at_start(spec: &str, level: Level, fps: f64, phase: f64) -> Self {
+        Gate {
+            at_start: true,
+            ..Self::new(spec, level, fps, phase)
         }
     }
 }
@@ -247,7 +259,11 @@ impl Policy for Gate {
         self.fixed.decide(obs)
     }
     fn keep(&self, frame: &Frame) -> bool {
-        frame.mmbm_exposure_mm_s <= self.x
+        if self.at_start {
+            frame.mmbm_trigger_mm_s <= self.x
+        } else {
+            frame.mmbm_exposure_mm_s <= self.x
+        }
     }
 }
 
