@@ -79,6 +79,8 @@ fn tiny_experiment_end_to_end() {
         "oracle:0.4",
         "```toml",
         "discarded by a gate",
+        "success % fixed threshold",
+        "Baseline `fixed:5` (moderate",
         "## Exposure sweep (thesis Fig. 1.1)",
         "| exposure (ms) | frames | blob success | mean blur (px) |",
     ] {

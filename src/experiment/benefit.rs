@@ -349,6 +349,7 @@ mod tests {
                 blobs_found: 16,
                 blobs_matched: 16,
                 blobs_ok: ok,
+                blobs_ok_fixed: ok,
                 pose_err_m: 0.0,
                 pose_err_deg: 0.0,
                 samples_per_pixel: 1,

@@ -36,6 +36,9 @@ pub struct FrameMeasure {
     pub blobs_matched: usize,
     /// All 16 found, each near its true centre.
     pub blobs_ok: bool,
+    /// The same with the fixed redness threshold [`FIXED_BLOB_THRESHOLD`]
+    /// (a global threshold, as the thesis's OpenCV thresholding).
+    pub blobs_ok_fixed: bool,
     /// When all 16 blobs were extracted: error of the camera position estimated
     /// from them (planar homography) against the true mid-exposure pose, m.
     pub pose_err_m: f64,
@@ -191,6 +194,21 @@ pub fn blob_metrics(img: &image::RgbImage, expected: &[(f64, f64)]) -> BlobOutco
     }
 }
 
+/// The fixed redness threshold (8-bit sRGB `R - max(G, B)`) of the thesis-style
+/// detector: half a saturated red's redness (about 170), whatever the image.
+pub const FIXED_BLOB_THRESHOLD: f64 = 85.0;
+
+/// Blob success with the fixed threshold [`FIXED_BLOB_THRESHOLD`].
+pub fn blob_ok_fixed(img: &image::RgbImage, expected: &[(f64, f64)]) -> bool {
+    let params = crate::board::blobs::BlobParams {
+        threshold: Some(FIXED_BLOB_THRESHOLD),
+        ..Default::default()
+    };
+    crate::board::blobs::extract(img, &params)
+        .and_then(|b| crate::board::blobs::evaluate(&b, expected, pitch_px(expected)))
+        .is_ok_and(|r| r.ok)
+}
+
 /// Blob pitch (px): the smallest distance between two expected centres.
 fn pitch_px(c: &[(f64, f64)]) -> f64 {
     let mut best = f64::INFINITY;
@@ -304,6 +322,7 @@ pub fn render_and_measure(
             blobs_found: blobs.found,
             blobs_matched: blobs.matched,
             blobs_ok: blobs.ok,
+            blobs_ok_fixed: blob_ok_fixed(&rgb8, &expected),
             pose_err_m,
             pose_err_deg,
             samples_per_pixel: out.samples_per_pixel,
