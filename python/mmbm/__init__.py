@@ -125,6 +125,17 @@ def _cam(camera: Optional[Camera]) -> Tuple[float, float, float, int, int, float
     return (camera or Camera())._tuple()
 
 
+def _log(t: ArrayLike, omega: ArrayLike) -> Tuple[np.ndarray, np.ndarray]:
+    """A log's times (N,) s, checked increasing, and its (N, 3) angular velocities."""
+    tt = np.ascontiguousarray(np.asarray(t, dtype=np.float64).ravel())
+    if not (np.all(np.isfinite(tt)) and np.all(np.diff(tt) > 0)):
+        raise ValueError("t: times must be finite and strictly increasing (s)")
+    w = _rows3(omega, "omega")
+    if w.shape[0] != tt.shape[0]:
+        raise ValueError(f"omega has {w.shape[0]} rows for {tt.shape[0]} times")
+    return tt, w
+
+
 def _rows3(x: ArrayLike, name: str) -> np.ndarray:
     a = np.ascontiguousarray(np.asarray(x, dtype=np.float64))
     if a.ndim == 1:
@@ -181,12 +192,7 @@ def series(
     (N,)), ``omega`` (N, 3) rad/s, optional ``velocity`` (N, 3) m/s with a
     per-sample ``depth`` (N,) m or a ``plane``. The same as ``mmbm series``.
     Arrays from ``telemetry_parser`` work as they are (see the README)."""
-    tt = np.ascontiguousarray(np.asarray(t, dtype=np.float64).ravel())
-    if not (np.all(np.isfinite(tt)) and np.all(np.diff(tt) > 0)):
-        raise ValueError("t: times must be finite and strictly increasing (s)")
-    w = _rows3(omega, "omega")
-    if w.shape[0] != tt.shape[0]:
-        raise ValueError(f"omega has {w.shape[0]} rows for {tt.shape[0]} times")
+    tt, w = _log(t, omega)
     v = None if velocity is None else _rows3(velocity, "velocity")
     if v is not None and v.shape[0] != tt.shape[0]:
         raise ValueError(f"velocity has {v.shape[0]} rows for {tt.shape[0]} times")
@@ -213,12 +219,7 @@ def frames(
     ``{"exposure_mmbm_mm_s", "blur_px", "start_mmbm_mm_s"}`` (NaN where a
     frame's window leaves the log). ``telemetry_parser``'s
     ``frame_readout_time()`` (ms) / 1000 is a ``readout_s``."""
-    tt = np.ascontiguousarray(np.asarray(t, dtype=np.float64).ravel())
-    if not (np.all(np.isfinite(tt)) and np.all(np.diff(tt) > 0)):
-        raise ValueError("t: times must be finite and strictly increasing (s)")
-    w = _rows3(omega, "omega")
-    if w.shape[0] != tt.shape[0]:
-        raise ValueError(f"omega has {w.shape[0]} rows for {tt.shape[0]} times")
+    tt, w = _log(t, omega)
     ts = np.asarray(t_start, dtype=np.float64).ravel()
     es = np.ascontiguousarray(np.broadcast_to(np.asarray(exposure_s, dtype=np.float64), ts.shape))
     rs = None

@@ -158,6 +158,19 @@ fn metric<'py>(
     Ok(Array1::from(out).into_pyarray(py))
 }
 
+/// Gyro samples from a log's arrays (the Python side checked the lengths).
+fn log_samples(t: &[f64], w: &[DVec3], v: Option<&[DVec3]>, d: Option<&[f64]>) -> Vec<GyroSample> {
+    t.iter()
+        .enumerate()
+        .map(|(k, &t)| GyroSample {
+            t,
+            omega: w[k],
+            velocity: v.map(|v| v[k]),
+            depth: d.map(|d| d[k]),
+        })
+        .collect()
+}
+
 /// Exposure MMBM (mm/s, each line over its own rolling-shutter window) and
 /// the MMBM at the start of every video frame; NaN where a frame's window
 /// leaves the log. Returns `(exposure_mm_s, start_mm_s)`.
@@ -177,18 +190,7 @@ fn frames<'py>(
     Bound<'py, numpy::PyArray1<f64>>,
     Bound<'py, numpy::PyArray1<f64>>,
 )> {
-    let w = rows3(&omega)?;
-    let samples: Vec<GyroSample> = t
-        .as_slice()?
-        .iter()
-        .zip(&w)
-        .map(|(&t, &omega)| GyroSample {
-            t,
-            omega,
-            velocity: None,
-            depth: None,
-        })
-        .collect();
+    let samples = log_samples(t.as_slice()?, &rows3(&omega)?, None, None);
     let (ts, es) = (t_start.as_slice()?, exposure_s.as_slice()?);
     let rs = readout_s.as_ref().map(|r| r.as_slice()).transpose()?;
     let video: Vec<mmbm::io::frames::VideoFrame> = (0..ts.len())
@@ -243,17 +245,7 @@ fn series<'py>(
         .as_ref()
         .map(|d| d.as_slice().map(|s| s.to_vec()))
         .transpose()?;
-    let t = t.as_slice()?.to_vec();
-    let samples: Vec<GyroSample> = t
-        .iter()
-        .enumerate()
-        .map(|(k, &t)| GyroSample {
-            t,
-            omega: w[k],
-            velocity: v.as_ref().map(|v| v[k]),
-            depth: d.as_ref().map(|d| d[k]),
-        })
-        .collect();
+    let samples = log_samples(t.as_slice()?, &w, v.as_deref(), d.as_deref());
     let opts = mmbm::series::SeriesOptions {
         scene: Scene {
             camera: camera(cam)?,
@@ -470,15 +462,9 @@ fn dict_samples(g: &Bound<'_, PyDict>) -> PyResult<Vec<GyroSample>> {
     if w.len() != t.len() || v.as_ref().is_some_and(|v| v.len() != t.len()) {
         return Err(PyValueError::new_err("gyro: arrays of different lengths"));
     }
-    Ok(t.iter()
-        .enumerate()
-        .map(|(k, &t)| GyroSample {
-            t,
-            omega: DVec3::from(w[k]),
-            velocity: v.as_ref().map(|v| DVec3::from(v[k])),
-            depth: None,
-        })
-        .collect())
+    let w: Vec<DVec3> = w.into_iter().map(DVec3::from).collect();
+    let v: Option<Vec<DVec3>> = v.map(|v| v.into_iter().map(DVec3::from).collect());
+    Ok(log_samples(&t, &w, v.as_deref(), None))
 }
 
 /// A simulated gait log: `{t, omega, velocity}`.

@@ -227,13 +227,13 @@ pub fn run(a: LiveArgs) -> Result<()> {
             "live decisions use a CPU method (riemann, gauss or exact)",
         ));
     }
+    let camera = a.camera.camera()?;
     // A rolling shutter keeps the camera busy for its line readout as well.
     let timing = a
         .timing
         .timing(a.exposure)
-        .with_rolling_readout(a.camera.camera()?.shutter.readout_s);
+        .with_rolling_readout(camera.shutter.readout_s);
     timing.validate()?;
-    let camera = a.camera.camera()?;
     let opts = SeriesOptions {
         scene: Scene {
             camera,

@@ -102,12 +102,12 @@ pub fn run(a: TriggerArgs) -> Result<()> {
     if matches!(method, Method::Gpu { .. }) {
         return Err(Error::invalid("--method", "trigger uses a CPU method"));
     }
+    let camera = super::args::with_log_readout(a.camera.camera()?, &a.gyro)?;
     // A rolling shutter keeps the camera busy for its line readout as well.
-    let timing = a.timing.timing(a.exposure).with_rolling_readout(
-        super::args::with_log_readout(a.camera.camera()?, &a.gyro)?
-            .shutter
-            .readout_s,
-    );
+    let timing = a
+        .timing
+        .timing(a.exposure)
+        .with_rolling_readout(camera.shutter.readout_s);
     timing.validate()?;
     let mut policies = Vec::new();
     for p in &a.policy {
@@ -115,7 +115,7 @@ pub fn run(a: TriggerArgs) -> Result<()> {
     }
     let opts = SeriesOptions {
         scene: Scene {
-            camera: a.camera.camera()?,
+            camera,
             plane: a.scene.plane()?,
         },
         method,

@@ -4,7 +4,7 @@
 
 use super::config::ExperimentConfig;
 use super::measure::{half, FrameRecord};
-use super::walk::{camera, Walk};
+use super::walk::Walk;
 use crate::error::Result;
 use crate::gpu::Backend;
 use crate::io::atomic::write_atomic_path;
@@ -34,7 +34,7 @@ pub fn write_all(
     records: &[FrameRecord],
     extremes: &HashMap<(usize, usize), Extremes>,
 ) -> Result<Vec<String>> {
-    let cam = camera(cfg);
+    let cam = cfg.camera();
     let mut figs = Vec::new();
     for (wi, w) in walks.iter().enumerate() {
         let t: Vec<f64> = w.samples.iter().map(|s| s.t).collect();

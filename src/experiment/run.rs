@@ -5,7 +5,7 @@ use super::config::ExperimentConfig;
 use super::figures::{self, Extremes};
 use super::measure::{image_difference, render_and_measure, FrameRecord};
 use super::report::{frames_csv, policy_stats, report_md, Outcome};
-use super::walk::{camera, make_walk, Walk};
+use super::walk::{make_walk, Walk};
 use crate::error::{Error, Result};
 use crate::io::atomic::write_atomic;
 use crate::metric::Scene;
@@ -33,7 +33,7 @@ pub fn run(cfg: &ExperimentConfig, out: &Path, progress: bool) -> Result<Outcome
     let t_start = Instant::now();
     let quality = Quality::from_str(&cfg.quality)?;
     let scene = Scene {
-        camera: camera(cfg),
+        camera: cfg.camera(),
         plane: None,
     };
     let names: Vec<String> = if cfg.gyro.is_some() {
@@ -81,7 +81,7 @@ pub fn run(cfg: &ExperimentConfig, out: &Path, progress: bool) -> Result<Outcome
         let w = &walks[wi];
         let frame = &w.runs[pi].1[fi];
         bar.set_message(format!("{} {}", w.name, frame.policy));
-        let r = render_and_measure(cfg, w, frame, camera(cfg), quality, k as u32)?;
+        let r = render_and_measure(cfg, w, frame, cfg.camera(), quality, k as u32)?;
         if backend.is_empty() {
             backend = r.backend.clone();
         }
@@ -173,7 +173,7 @@ fn quality_check(
     let frame = &walks[wi].runs[pi].1[fi];
     // The central 160 x 120 window (same focal length and pitch), where the
     // board is: the default preset is slow at full resolution on lavapipe.
-    let cam = camera(cfg).with_resolution(160, 120);
+    let cam = cfg.camera().with_resolution(160, 120);
     let a = render_and_measure(cfg, &walks[wi], frame, cam, quality, 0)?;
     let b = render_and_measure(cfg, &walks[wi], frame, cam, Quality::Default, 0)?;
     let (mean, p99) = image_difference(&a.rgb, &b.rgb);

@@ -6,7 +6,7 @@
 
 use super::config::ExperimentConfig;
 use super::measure::render_and_measure;
-use super::walk::{camera, Walk};
+use super::walk::Walk;
 use crate::error::Result;
 use crate::render::Quality;
 
@@ -44,7 +44,7 @@ pub fn exposure_sweep(
     };
     let n = cfg.sweep_frames.min(frames.len());
     let picks: Vec<usize> = (0..n).map(|k| k * frames.len() / n.max(1)).collect();
-    let cam = camera(cfg);
+    let cam = cfg.camera();
     let last = walk.samples.last().map_or(f64::NEG_INFINITY, |s| s.t);
     let mut rows = Vec::new();
     for &e in &cfg.sweep_exposures_s {

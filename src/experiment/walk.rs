@@ -2,7 +2,6 @@
 //! series, the board's distance, and every policy's frames.
 
 use super::config::ExperimentConfig;
-use crate::camera::Camera;
 use crate::error::Result;
 use crate::io::gyro::{read_log, GyroOptions, GyroSample};
 use crate::metric::{Method, Scene};
@@ -100,9 +99,4 @@ pub fn timing(cfg: &ExperimentConfig) -> CameraTiming {
         min_interval: cfg.min_interval_s,
     }
     .with_rolling_readout(cfg.camera.readout_s.unwrap_or(0.0))
-}
-
-/// The camera of the configuration ([`ExperimentConfig::camera`]).
-pub fn camera(cfg: &ExperimentConfig) -> Camera {
-    cfg.camera()
 }

@@ -196,20 +196,19 @@ pub fn homographies(
         h1: r(h.row(1), 0.0),
         h2: r(h.row(2), det),
     };
-    (0..lines * n)
-        .flat_map(|e| {
-            let t = line_instant(cam, trajectory, e / n, e % n, n);
-            let pose = trajectory.pose_at(t);
-            let h = homography(cam, target, &pose);
-            let mut out = vec![entry(h, h.determinant().abs())];
-            if cam.lens.is_some() {
-                let (gx, gy) = lens_derivatives(cam, target, &pose);
-                out.push(entry(gx, 0.0));
-                out.push(entry(gy, 0.0));
-            }
-            out
-        })
-        .collect()
+    let mut out = Vec::with_capacity((lines * n * table_stride(cam)) as usize);
+    for e in 0..lines * n {
+        let t = line_instant(cam, trajectory, e / n, e % n, n);
+        let pose = trajectory.pose_at(t);
+        let h = homography(cam, target, &pose);
+        out.push(entry(h, h.determinant().abs()));
+        if cam.lens.is_some() {
+            let (gx, gy) = lens_derivatives(cam, target, &pose);
+            out.push(entry(gx, 0.0));
+            out.push(entry(gy, 0.0));
+        }
+    }
+    out
 }
 
 /// Defocus (SPEC 9, thin lens): a ray through lens point `L = (lx, ly, 0)`
