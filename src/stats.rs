@@ -26,6 +26,51 @@ pub fn mean(x: &[f64]) -> Option<f64> {
     }
 }
 
+/// Average ranks (1-based, ties share their mean rank) of `x`.
+fn ranks(x: &[f64]) -> Vec<f64> {
+    let mut idx: Vec<usize> = (0..x.len()).collect();
+    idx.sort_by(|&a, &b| x[a].total_cmp(&x[b]));
+    let mut r = vec![0.0; x.len()];
+    let mut k = 0;
+    while k < idx.len() {
+        let mut j = k;
+        while j + 1 < idx.len() && x[idx[j + 1]] == x[idx[k]] {
+            j += 1;
+        }
+        let avg = (k + j) as f64 / 2.0 + 1.0;
+        for &i in &idx[k..=j] {
+            r[i] = avg;
+        }
+        k = j + 1;
+    }
+    r
+}
+
+/// Spearman's rank correlation of the pairs where both values are finite
+/// (ties get average ranks; the Pearson correlation of the ranks). `None`
+/// with fewer than 3 pairs or a constant side.
+pub fn spearman(x: &[f64], y: &[f64]) -> Option<f64> {
+    let (a, b): (Vec<f64>, Vec<f64>) = x
+        .iter()
+        .zip(y)
+        .filter(|(a, b)| a.is_finite() && b.is_finite())
+        .map(|(a, b)| (*a, *b))
+        .unzip();
+    if a.len() < 3 {
+        return None;
+    }
+    let (ra, rb) = (ranks(&a), ranks(&b));
+    let n = ra.len() as f64;
+    let (ma, mb) = (ra.iter().sum::<f64>() / n, rb.iter().sum::<f64>() / n);
+    let (mut sab, mut saa, mut sbb) = (0.0, 0.0, 0.0);
+    for (p, q) in ra.iter().zip(&rb) {
+        sab += (p - ma) * (q - mb);
+        saa += (p - ma) * (p - ma);
+        sbb += (q - mb) * (q - mb);
+    }
+    (saa > 0.0 && sbb > 0.0).then(|| sab / (saa * sbb).sqrt())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -52,5 +97,21 @@ mod tests {
     fn mean_of_values() {
         assert_eq!(mean(&[1.0, 2.0, 6.0]), Some(3.0));
         assert_eq!(mean(&[]), None);
+    }
+
+    #[test]
+    fn spearman_by_hand() {
+        // One swap in four: 1 - 6 * 2 / (4 * 15) = 0.8.
+        let r = spearman(&[1.0, 2.0, 3.0, 4.0], &[1.0, 3.0, 2.0, 4.0]).unwrap();
+        assert!((r - 0.8).abs() < 1e-12);
+        // Ties share ranks 2.5: 4.5 / sqrt(4.5 * 5).
+        let r = spearman(&[1.0, 2.0, 2.0, 3.0], &[1.0, 2.0, 3.0, 4.0]).unwrap();
+        assert!((r - 4.5 / 22.5f64.sqrt()).abs() < 1e-12);
+        // Monotone but not linear: 1; reversed: -1; NaN pairs left out.
+        let r = spearman(&[1.0, 8.0, 27.0, f64::NAN], &[1.0, 2.0, 3.0, 9.0]).unwrap();
+        assert!((r - 1.0).abs() < 1e-12);
+        assert!((spearman(&[3.0, 2.0, 1.0], &[1.0, 2.0, 3.0]).unwrap() + 1.0).abs() < 1e-12);
+        assert_eq!(spearman(&[1.0, 1.0, 1.0], &[1.0, 2.0, 3.0]), None);
+        assert_eq!(spearman(&[1.0, 2.0], &[1.0, 2.0]), None);
     }
 }

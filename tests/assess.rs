@@ -124,8 +124,16 @@ fn check_monotone(label: &str, base: &GrayImage) {
     let sharp = jnbm(base).unwrap();
     let heavy = jnbm(&motion_blur(base, 25)).unwrap();
     assert!(heavy < 0.5 * sharp, "{label}: {sharp} vs {heavy}");
+    // the authors' CPBD keeps every Sobel pixel with |gradient| > 2 grey
+    // levels/px, and on 8-bit rounded blur the strictly monotone walk stops at
+    // the first flat step: many short widths survive heavy blur, so CPBD
+    // does not fall to 0 (0.21 on camera at 25 px)
+    let c_sharp = cpbd(base).unwrap();
     let c_heavy = cpbd(&motion_blur(base, 25)).unwrap();
-    assert!(c_heavy < 0.1, "{label}: CPBD of heavy blur {c_heavy}");
+    assert!(
+        c_heavy < 0.35 * c_sharp,
+        "{label}: CPBD of heavy blur {c_heavy} vs sharp {c_sharp}"
+    );
 }
 
 #[test]
@@ -178,6 +186,8 @@ fn undefined_and_bad_inputs() {
     let a = assess(&flat).unwrap();
     assert_eq!(a.jnbm, None);
     assert_eq!(a.cpbd, 0.0);
+    assert_eq!(a.jnbm_2d, None);
+    assert_eq!(a.cpbd_2d, 0.0);
     assert_eq!(a.blur_effect, 1.0);
     assert_eq!(a.laplacian_var, 0.0);
     assert!(jnbm(&flat).is_err());
@@ -221,6 +231,8 @@ fn cli_json_in_argument_order() {
         assert!(o["laplacian_var"].as_f64().unwrap() > 0.0);
         assert!(o["cpbd"].as_f64().unwrap() >= 0.0);
         assert!(o["jnbm"].as_f64().unwrap() > 0.0);
+        assert!(o["cpbd_2d"].as_f64().unwrap() >= 0.0);
+        assert!(o["jnbm_2d"].as_f64().unwrap() > 0.0);
     }
     assert!(arr[0]["jnbm"].as_f64().unwrap() < arr[1]["jnbm"].as_f64().unwrap());
 }
@@ -235,6 +247,7 @@ fn cli_text_and_errors() {
     assert!(out.status.success());
     let s = String::from_utf8_lossy(&out.stdout);
     assert!(s.contains("jnbm") && s.contains("bars.png"), "{s}");
+    assert!(s.contains("jnbm_2d") && s.contains("cpbd_2d"), "{s}");
 
     let out = bin()
         .arg("assess")

@@ -56,7 +56,7 @@ fn simulate_then_trigger() {
     let mut lines = out.lines();
     assert_eq!(
         lines.next().unwrap(),
-        "policy,trigger_t,exposure_start,exposure_end,mmbm_trigger_mm_s,mmbm_exposure_mm_s,kept"
+        "policy,trigger_t,exposure_start,exposure_end,mmbm_trigger_mm_s,mmbm_exposure_mm_s,kept,gain"
     );
     let fixed = lines.clone().filter(|l| l.starts_with("fixed:5,")).count();
     assert!((18..=20).contains(&fixed), "{fixed} fixed frames in 4 s");

@@ -20,6 +20,10 @@ const CAUSAL: &[&str] = &[
     "adaptive:0.3:3",
     "forecast:0.4",
     "forecast:0.5:0.3",
+    "phase:0.4",
+    "phase:0.5:0.3",
+    "fixed:5+exp:2",
+    "phase:0.4+exp:2:0.005",
     "gate:0.8",
     "gate:0.6:4@0.1",
     "deadline:5",
@@ -56,6 +60,7 @@ fn timing(exposure: f64) -> CameraTiming {
         exposure,
         readout: 0.0125,
         min_interval: 0.2,
+        ..CameraTiming::default()
     }
 }
 

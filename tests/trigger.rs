@@ -29,6 +29,7 @@ fn timing0() -> CameraTiming {
         exposure: 0.05,
         readout: 0.0,
         min_interval: 0.2,
+        ..CameraTiming::default()
     }
 }
 
@@ -84,6 +85,7 @@ fn camera_busy_blocks_triggers() {
         exposure: 0.05,
         readout: 0.02,
         min_interval: 0.0,
+        ..CameraTiming::default()
     };
     // 100 fps asks every 10 ms; the camera is busy 72.5 ms per frame.
     let f = go("fixed:100", &s, &m, &tm);
@@ -106,6 +108,7 @@ fn camera_busy_blocks_triggers() {
         "adaptive",
         "oracle:0.8:0.05",
         "forecast:0.8",
+        "phase:0.8",
         "gate:0.5:12",
         "deadline:10",
         "deadline:10:0.5",
@@ -132,9 +135,13 @@ fn causal_policies_never_read_the_future() {
         "adaptive",
         "adaptive:0.3:3",
         "forecast:0.4",
+        "phase:0.4",
+        "phase:0.5:0.3",
         "gate:0.5",
         "deadline:5",
         "deadline:5:0.4",
+        "fixed:5+exp:2",
+        "phase:0.4+exp:1.5:0.005",
     ] {
         let full = go(spec, &s, &m, &tm);
         let part = go(spec, &s[..cut], &m[..cut], &tm);
@@ -184,10 +191,13 @@ fn policy_strings_round_trip_and_bad_ones_fail() {
         "adaptive:0.3",
         "oracle:0.4",
         "forecast:0.4:0.1",
+        "phase:0.4:0.1",
         "gate:0.8",
         "gate:0.8:4@0.1",
         "deadline:5",
         "deadline:5:0.4",
+        "deadline:5+exp:2",
+        "threshold:p20+exp:3:0.01",
     ] {
         let f = go(spec, &s, &m, &CameraTiming::default());
         assert!(!f.is_empty(), "{spec}");
@@ -208,11 +218,64 @@ fn policy_strings_round_trip_and_bad_ones_fail() {
         "deadline",
         "gate:0.4:5:1",
         "warp:9",
+        "fixed:5+exp",
+        "fixed:5+exp:0",
+        "fixed:5+exp:2:-1",
+        "fixed:5+gain:2",
+        "+exp:2",
+        "warp:9+exp:2",
     ] {
         let e = parse_policy(bad)
             .err()
             .unwrap_or_else(|| panic!("'{bad}' accepted"));
         assert!(e.to_string().contains("policy"), "{bad}: {e}");
+    }
+}
+
+#[test]
+fn exposure_control_by_hand() {
+    // MMBM steps 0.5 -> 0.05 -> 5 -> 0 mm/s (each held 1 s). With a 2 px
+    // budget and the 4.65 um pitch: t_e = 2 * 0.00465 / M, clamped to
+    // [1 ms, 70 ms]; the gain is 70 ms / t_e; the timing is fixed:5's.
+    let n = 2400;
+    let t = grid(n, 1.0 / 600.0);
+    let m: Vec<f64> = t
+        .iter()
+        .map(|&x| [0.5, 0.05, 5.0, 0.0][(x as usize).min(3)])
+        .collect();
+    let tm = CameraTiming::default();
+    let fixed = go("fixed:5", &log(&t), &m, &tm);
+    let f = go("fixed:5+exp:2", &log(&t), &m, &tm);
+    assert_eq!(f.len(), fixed.len());
+    for (a, b) in f.iter().zip(&fixed) {
+        assert_eq!(a.trigger_t, b.trigger_t);
+        let x = a.mmbm_trigger_mm_s;
+        let want = if x == 0.5 {
+            2.0 * 0.00465 / 0.5 // 18.6 ms
+        } else if x == 5.0 {
+            0.002 * 0.93 // 1.86 ms
+        } else {
+            0.07 // 0.05 mm/s asks 186 ms: the camera's 70 ms; no motion: the same
+        };
+        assert!((a.exposure_s() - want).abs() < 1e-12, "{a:?}");
+        assert!((a.gain - 0.07 / want).abs() < 1e-9, "{a:?}");
+        assert_eq!(a.exposure_start, b.exposure_start);
+    }
+    // The shortest exposure bounds it: 5 ms at 5 mm/s.
+    let f = go("fixed:5+exp:2:0.005", &log(&t), &m, &tm);
+    let fast: Vec<_> = f.iter().filter(|a| a.mmbm_trigger_mm_s == 5.0).collect();
+    assert!(!fast.is_empty());
+    for a in fast {
+        assert!((a.exposure_s() - 0.005).abs() < 1e-12 && (a.gain - 14.0).abs() < 1e-9);
+    }
+    // The predicted blur over the exposure is the budget where the MMBM is
+    // constant over the exposure (the 0.5 mm/s second): 2 px.
+    for a in go("fixed:5+exp:2", &log(&t), &m, &tm)
+        .iter()
+        .filter(|a| a.exposure_end < 0.99)
+    {
+        let px = a.mmbm_exposure_mm_s * a.exposure_s() / tm.pitch_mm;
+        assert!((px - 2.0).abs() < 1e-9, "{px}");
     }
 }
 
@@ -255,6 +318,7 @@ fn summary_and_table51_by_hand() {
         mmbm_trigger_mm_s: trig,
         mmbm_exposure_mm_s: exp,
         kept,
+        gain: 1.0,
     };
     let f = vec![
         fr(0.0, 0.5, 1.0, true),
@@ -390,6 +454,44 @@ fn forecast_finds_the_period_of_a_periodic_log() {
 }
 
 #[test]
+fn phase_learns_touchdowns_of_a_clocked_gait() {
+    // A gait clock of 0.8 s with touchdowns jittered by +-30 ms: each step is
+    // a sharp transient (1.5 mm/s decaying over 0.1 s) on a 0.2 mm/s floor,
+    // with a second, smaller bump (0.25 mm/s) at 0.5 s after touchdown. The phase policy
+    // must find the touchdowns (each within 1 sample of the level crossing
+    // it reports) and, once locked, put every frame in a quiet part.
+    let n = 600 * 30;
+    let t = grid(n, 1.0 / 600.0);
+    let jitter = [0.0, 0.03, -0.02, 0.01, -0.03, 0.02, 0.0, -0.01];
+    let td: Vec<f64> = (0..40).map(|k| 0.8 * k as f64 + jitter[k % 8]).collect();
+    let m: Vec<f64> = t
+        .iter()
+        .map(|&x| {
+            let k = td.partition_point(|&d| d <= x);
+            let s = if k == 0 { 10.0 } else { x - td[k - 1] };
+            0.2 + 1.5 * (-s / 0.03).exp() + 0.25 * (-((s - 0.5) / 0.05).powi(2)).exp()
+        })
+        .collect();
+    let mut p = Phase::new("phase:0.4", Level::Abs(0.4), 0.2);
+    let f = run(&log(&t), &m, &mut p, &CameraTiming::default()).unwrap();
+    let found: Vec<f64> = p.touchdowns().collect();
+    assert_eq!(found.len(), Phase::CYCLES + 1);
+    for x in &found {
+        // The level crossing lies on the transient's rise, within 2 samples of the touchdown.
+        let near = td.iter().map(|d| (x - d).abs()).fold(f64::MAX, f64::min);
+        assert!(
+            near <= 2.0 / 600.0,
+            "touchdown at {x}: {near} s from the nearest"
+        );
+    }
+    let late: Vec<_> = f.iter().filter(|f| f.trigger_t > 10.0).collect();
+    assert!(late.len() >= 20, "{}", late.len());
+    for fr in late {
+        assert!(fr.mmbm_exposure_mm_s < 0.3, "{fr:?}");
+    }
+}
+
+#[test]
 fn quality_order_on_simulated_gaits() {
     // Lower mean exposure MMBM is better. Summed over three 120 s logs.
     for g in [Gait::Slow, Gait::Moderate] {
@@ -401,14 +503,22 @@ fn quality_order_on_simulated_gaits() {
             }
             acc / 3.0
         };
-        let (o, f, t, x) = (
+        let (o, f, t, x, ph) = (
             mean("oracle:0.4"),
             mean("forecast:0.4"),
             mean("threshold:0.4"),
             mean("fixed:5"),
+            mean("phase:0.4"),
         );
-        println!("{g}: oracle {o:.4} forecast {f:.4} threshold {t:.4} fixed {x:.4}; forecast recovers {:.0} % of the oracle's gain over threshold", 100.0 * (t - f) / (t - o));
+        println!("{g}: oracle {o:.4} forecast {f:.4} phase {ph:.4} threshold {t:.4} fixed {x:.4}; forecast recovers {:.0} %, phase {:.0} % of the oracle's gain over threshold", 100.0 * (t - f) / (t - o), 100.0 * (t - ph) / (t - o));
         assert!(o < f && f < t && t < x, "{g}: {o} {f} {t} {x}");
+        // The learned phase forecast: issue 11's goal is 70 % of the oracle's
+        // gain on the moderate walk (72 % on these seeds, 70 % on seeds 1-5);
+        // the slow walk 49 %. Margins below those, so the test fails on a
+        // predictor that stops learning (the blind forecast: 5 % and 13 %).
+        let share = (t - ph) / (t - o);
+        let floor = if g == Gait::Moderate { 0.65 } else { 0.4 };
+        assert!(share >= floor, "{g}: phase {ph} threshold {t} oracle {o}");
     }
 }
 

@@ -350,18 +350,21 @@ def trigger(
     delay: float = 0.0025,
     readout: float = 0.0125,
     min_interval: float = 0.2,
+    pitch_mm: float = 0.00465,
 ) -> List[Dict[str, Any]]:
     """Runs trigger policies (``fixed:5``, ``threshold:0.4``, ``oracle:0.4``,
     ...; see ``mmbm trigger --help``) on an MMBM series (``t`` s, ``mmbm``
     mm/s): one dict per frame with ``policy``, ``trigger_t``,
     ``exposure_start``, ``exposure_end`` (s), ``mmbm_trigger_mm_s``,
-    ``mmbm_exposure_mm_s`` and ``kept``, as ``mmbm trigger``'s CSV rows."""
+    ``mmbm_exposure_mm_s``, ``kept`` and ``gain``, as ``mmbm trigger``'s CSV rows.
+    ``pitch_mm`` (the pixel pitch) turns MMBM into px for exposure control
+    (``fixed:5+exp:2``: at most ~2 px of predicted blur per frame)."""
     policies = [policy] if isinstance(policy, str) else list(policy)
     tt = np.ascontiguousarray(np.asarray(t, dtype=np.float64).ravel())
     mm = np.ascontiguousarray(np.asarray(mmbm, dtype=np.float64).ravel())
     if tt.shape != mm.shape:
         raise ValueError(f"t has {tt.size} values, mmbm {mm.size}")
-    return _mmbm.trigger(tt, mm, policies, float(exposure), float(delay), float(readout), float(min_interval))
+    return _mmbm.trigger(tt, mm, policies, float(exposure), float(delay), float(readout), float(min_interval), float(pitch_mm))
 
 
 def read_exr(path: PathLike) -> Dict[str, np.ndarray]:

@@ -491,7 +491,7 @@ fn simulate<'py>(
 
 /// Runs policies on an MMBM series: a list of frame dicts.
 #[pyfunction]
-#[pyo3(signature = (t, mmbm_mm_s, policies, exposure, delay, readout, min_interval))]
+#[pyo3(signature = (t, mmbm_mm_s, policies, exposure, delay, readout, min_interval, pitch_mm))]
 #[allow(clippy::too_many_arguments)]
 fn trigger<'py>(
     py: Python<'py>,
@@ -502,6 +502,7 @@ fn trigger<'py>(
     delay: f64,
     readout: f64,
     min_interval: f64,
+    pitch_mm: f64,
 ) -> PyResult<Vec<Bound<'py, PyDict>>> {
     let t = t.as_slice()?.to_vec();
     let m = mmbm_mm_s.as_slice()?.to_vec();
@@ -519,6 +520,7 @@ fn trigger<'py>(
         exposure,
         readout,
         min_interval,
+        pitch_mm,
     };
     let mut frames = Vec::new();
     for p in &policies {
@@ -542,6 +544,7 @@ fn trigger<'py>(
             d.set_item("mmbm_trigger_mm_s", f.mmbm_trigger_mm_s)?;
             d.set_item("mmbm_exposure_mm_s", f.mmbm_exposure_mm_s)?;
             d.set_item("kept", f.kept)?;
+            d.set_item("gain", f.gain)?;
             Ok(d)
         })
         .collect()

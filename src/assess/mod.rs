@@ -7,26 +7,35 @@
 //! and tuned on): `Y = (299 R + 587 G + 114 B + 500) div 1000`. Grey files are
 //! used as they are (16-bit grey is scaled to 8 bits).
 //!
-//! - [`jnbm()`]: Just Noticeable Blur Metric (Ferzli & Karam 2009); higher = sharper.
-//! - [`cpbd()`]: Cumulative Probability of Blur Detection (Narvekar & Karam 2011),
-//!   0 (blurred) .. 1 (sharp).
+//! - [`jnbm()`]: Just Noticeable Blur Metric (Ferzli & Karam 2009) as the
+//!   authors' `JNBM_compute.m` computes it (block-local edge maps); higher = sharper.
+//! - [`cpbd()`]: Cumulative Probability of Blur Detection (Narvekar & Karam 2011)
+//!   as the authors' `CPBD_compute.m` computes it, 0 (blurred) .. 1 (sharp).
+//! - [`jnbm_2d()`], [`cpbd_2d()`]: direction-aware variants that measure edge
+//!   widths along rows *and* columns (the originals only see horizontal widths,
+//!   so they are blind to vertical smear).
+//! - [`whole_image`]: the earlier whole-image approximation of JNBM and CPBD,
+//!   kept for comparison.
 //! - [`blur_effect()`]: Crete et al. 2007 blur effect exactly as scikit-image's
 //!   `skimage.measure.blur_effect` (0 sharp .. 1 blurred).
 //! - [`laplacian_var()`]: variance of the 4-neighbour Laplacian (higher = sharper).
 //!
-//! [`assess`] computes all four; JNBM is `None` when it is undefined (no edge
-//! block, see [`jnbm()`]).
+//! [`assess`] computes all six; JNBM is `None` when it is undefined (no edge
+//! block with a measured width, see [`jnbm()`]).
 
 pub mod blur_effect;
 pub mod cpbd;
 pub mod edges;
 pub mod jnbm;
 pub mod laplacian;
+pub mod matlab_edge;
+pub mod whole_image;
 
 pub use blur_effect::{blur_effect, blur_effect_axes};
-pub use cpbd::cpbd;
-pub use jnbm::{jnbm, jnbm_report, JnbmReport};
+pub use cpbd::{cpbd, cpbd_2d};
+pub use jnbm::{jnbm, jnbm_2d, jnbm_2d_report, jnbm_report, JnbmReport};
 pub use laplacian::laplacian_var;
+pub use whole_image::{cpbd_whole_image, jnbm_whole_image, jnbm_whole_image_report};
 
 use crate::error::{Error, Result};
 use image::{DynamicImage, GrayImage, RgbImage};
@@ -72,27 +81,37 @@ pub fn load_grey(path: &Path) -> Result<GrayImage> {
     Ok(to_grey(&img))
 }
 
-/// The four metrics of one image.
+/// The metrics of one image.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Assessment {
-    /// JNBM (higher = sharper); `None` when the image has no edge block.
+    /// JNBM (authors' code; higher = sharper); `None` when undefined (no
+    /// edge block with a measured width).
     pub jnbm: Option<f64>,
-    /// CPBD, 0 (blurred) .. 1 (sharp).
+    /// CPBD (authors' code), 0 (blurred) .. 1 (sharp).
     pub cpbd: f64,
+    /// Direction-aware JNBM (widths along rows and columns); `None` when undefined.
+    pub jnbm_2d: Option<f64>,
+    /// Direction-aware CPBD (widths along rows and columns), 0 .. 1.
+    pub cpbd_2d: f64,
     /// Crete et al. blur effect, 0 (sharp) .. 1 (blurred).
     pub blur_effect: f64,
     /// Variance of the 4-neighbour Laplacian, (grey levels)^2.
     pub laplacian_var: f64,
 }
 
-/// All four metrics. Errors when the image is smaller than one 64x64 block
-/// (JNBM and CPBD need at least one whole block).
+/// All metrics (edge maps shared between each metric and its `_2d`
+/// variant). Errors when the image is smaller than one 64x64 block (JNBM and
+/// CPBD need at least one whole block).
 pub fn assess(img: &GrayImage) -> Result<Assessment> {
+    use edges::Axes;
     let (nbx, nby) = check_blocks("image", img)?;
-    let ed = edges::EdgeData::new(img);
+    let blocks = jnbm::blocks(img, nbx, nby, Axes::Both);
+    let cp = cpbd::CpbdData::new(img, Axes::Both);
     Ok(Assessment {
-        jnbm: jnbm::report_from(&ed, nbx, nby).jnbm,
-        cpbd: cpbd::cpbd_from(&ed, nbx, nby),
+        jnbm: jnbm::report_from(&blocks, Axes::Rows).jnbm,
+        cpbd: cpbd::cpbd_from(&cp, nbx, nby, Axes::Rows),
+        jnbm_2d: jnbm::report_from(&blocks, Axes::Both).jnbm,
+        cpbd_2d: cpbd::cpbd_from(&cp, nbx, nby, Axes::Both),
         blur_effect: blur_effect(img)?,
         laplacian_var: laplacian_var(img)?,
     })

@@ -232,13 +232,15 @@ pub struct TimingArgs {
 }
 
 impl TimingArgs {
-    /// The camera timing with exposure `exposure` (s); validated by its users.
-    pub fn timing(&self, exposure: f64) -> mmbm::trigger::CameraTiming {
+    /// The camera timing with exposure `exposure` (s) and pixel pitch
+    /// `pitch_mm` (mm); validated by its users.
+    pub fn timing(&self, exposure: f64, pitch_mm: f64) -> mmbm::trigger::CameraTiming {
         mmbm::trigger::CameraTiming {
             delay: self.delay,
             exposure,
             readout: self.readout,
             min_interval: self.min_interval,
+            pitch_mm,
         }
     }
 }

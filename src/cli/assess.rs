@@ -1,4 +1,5 @@
-//! `mmbm assess`: image blur metrics (JNBM, CPBD, blur effect, Laplacian variance).
+//! `mmbm assess`: image blur metrics (JNBM, CPBD and their direction-aware
+//! variants, blur effect, Laplacian variance).
 
 use clap::Args;
 use mmbm::assess::{assess, load_grey, Assessment};
@@ -10,8 +11,10 @@ use std::path::{Path, PathBuf};
 #[command(
     after_help = "Colour images are reduced to Rec. 601 luma of the sRGB values.
 JNBM: higher = sharper (null/n/a when the image has no edge block);
-CPBD: 0 blurred .. 1 sharp; blur_effect: 0 sharp .. 1 blurred;
-laplacian_var: grey levels^2, higher = sharper.
+CPBD: 0 blurred .. 1 sharp (both as the authors' MATLAB code computes them:
+edge widths along rows only, blind to vertical blur);
+jnbm_2d, cpbd_2d: the same with widths along rows and columns;
+blur_effect: 0 sharp .. 1 blurred; laplacian_var: grey levels^2, higher = sharper.
 
 Examples:
   mmbm assess frame.png
@@ -54,6 +57,8 @@ pub fn run(a: AssessArgs) -> Result<()> {
                     "path": p.display().to_string(),
                     "jnbm": r.jnbm,
                     "cpbd": r.cpbd,
+                    "jnbm_2d": r.jnbm_2d,
+                    "cpbd_2d": r.cpbd_2d,
                     "blur_effect": r.blur_effect,
                     "laplacian_var": r.laplacian_var,
                 })
@@ -62,15 +67,17 @@ pub fn run(a: AssessArgs) -> Result<()> {
         println!("{}", serde_json::Value::Array(arr));
     } else {
         println!(
-            "{:>10} {:>8} {:>12} {:>14}  path",
-            "jnbm", "cpbd", "blur_effect", "laplacian_var"
+            "{:>10} {:>8} {:>10} {:>8} {:>12} {:>14}  path",
+            "jnbm", "cpbd", "jnbm_2d", "cpbd_2d", "blur_effect", "laplacian_var"
         );
+        let opt = |v: Option<f64>| v.map_or("n/a".to_string(), |v| format!("{v:.4}"));
         for (p, r) in a.images.iter().zip(&results) {
-            let j = r.jnbm.map_or("n/a".to_string(), |v| format!("{v:.4}"));
             println!(
-                "{:>10} {:>8.4} {:>12.4} {:>14.2}  {}",
-                j,
+                "{:>10} {:>8.4} {:>10} {:>8.4} {:>12.4} {:>14.2}  {}",
+                opt(r.jnbm),
                 r.cpbd,
+                opt(r.jnbm_2d),
+                r.cpbd_2d,
                 r.blur_effect,
                 r.laplacian_var,
                 p.display()

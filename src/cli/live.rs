@@ -24,7 +24,7 @@ line) or JSON lines {\"t\":..,\"wx\":..,\"wy\":..,\"wz\":..}, on stdin (default)
 lines per UDP datagram (--udp), or a recorded log fed at real time (--replay).
 
 Output (stdout, one JSON object per line, flushed at once):
-  {\"t\":..,\"policy\":..,\"trigger\":true,\"frame\":K,\"mmbm_mm_s\":..,\"exposure_start\":..,\"exposure_end\":..}
+  {\"t\":..,\"policy\":..,\"trigger\":true,\"frame\":K,\"mmbm_mm_s\":..,\"exposure_start\":..,\"exposure_end\":..,\"gain\":..}
   {\"t\":..,\"policy\":..,\"exposed\":true,\"frame\":K,\"trigger_t\":..,\"mmbm_exposure_mm_s\":..,\"kept\":..}
     (once a sample at or after the exposure end has arrived)
   {\"t\":..,\"policy\":..,\"trigger\":false,\"mmbm_mm_s\":..}   (every other sample, with --all)
@@ -191,7 +191,7 @@ impl Decider {
                     Event::Trigger(k, f) => serde_json::json!({
                         "t": f.trigger_t, "policy": f.policy, "trigger": true, "frame": k,
                         "mmbm_mm_s": f.mmbm_trigger_mm_s, "exposure_start": f.exposure_start,
-                        "exposure_end": f.exposure_end,
+                        "exposure_end": f.exposure_end, "gain": f.gain,
                     }),
                     Event::Exposed(k, f) => serde_json::json!({
                         "t": s.t, "policy": f.policy, "exposed": true, "frame": k,
@@ -231,7 +231,7 @@ pub fn run(a: LiveArgs) -> Result<()> {
     // A rolling shutter keeps the camera busy for its line readout as well.
     let timing = a
         .timing
-        .timing(a.exposure)
+        .timing(a.exposure, camera.pitch_x_mm)
         .with_rolling_readout(camera.shutter.readout_s);
     timing.validate()?;
     let opts = SeriesOptions {

@@ -61,7 +61,7 @@ pub struct TriggerArgs {
     pub camera: CameraArgs,
 }
 
-fn summary_text(frames: &[Frame], spec: &str, duration: f64) -> String {
+fn summary_text(frames: &[Frame], spec: &str, duration: f64, pitch_mm: f64) -> String {
     let s = trigger::summary_over(frames, duration);
     let t = trigger::prediction_error(frames);
     // Statistics of no frames are undefined: "n/a", never "NaN".
@@ -74,6 +74,7 @@ fn summary_text(frames: &[Frame], spec: &str, duration: f64) -> String {
     };
     format!(
         "{spec}: {} frames, {} kept, {} fps over {} s; exposure MMBM mean {} p95 {} max {} mm/s (trigger mean {})\n  \
+         blur over the exposure mean {} px, exposure mean {} ms\n  \
          Table 5.1 (exposure - trigger): min {} max {} mean {} abs mean {} std {} mm/s; \
          % min {} max {} mean {} abs mean {} std {}\n",
         s.frames,
@@ -84,6 +85,8 @@ fn summary_text(frames: &[Frame], spec: &str, duration: f64) -> String {
         n(s.p95_mm_s, 4),
         n(s.max_mm_s, 4),
         n(s.mean_trigger_mm_s, 4),
+        n(s.mean_blur_mm / pitch_mm, 2),
+        n(s.mean_exposure_s * 1e3, 2),
         n(t.abs.min, 4),
         n(t.abs.max, 4),
         n(t.abs.mean, 4),
@@ -106,7 +109,7 @@ pub fn run(a: TriggerArgs) -> Result<()> {
     // A rolling shutter keeps the camera busy for its line readout as well.
     let timing = a
         .timing
-        .timing(a.exposure)
+        .timing(a.exposure, camera.pitch_x_mm)
         .with_rolling_readout(camera.shutter.readout_s);
     timing.validate()?;
     let mut policies = Vec::new();
@@ -128,7 +131,7 @@ pub fn run(a: TriggerArgs) -> Result<()> {
     let mut text = String::new();
     for (p, spec) in policies.iter_mut().zip(&a.policy) {
         let frames = trigger::run(&samples, &m, p.as_mut(), &timing)?;
-        text.push_str(&summary_text(&frames, spec, duration));
+        text.push_str(&summary_text(&frames, spec, duration, timing.pitch_mm));
         all.push(frames);
     }
     let write = |w: &mut dyn Write| -> Result<()> {

@@ -337,6 +337,7 @@ mod tests {
                 mmbm_trigger_mm_s: 0.0,
                 mmbm_exposure_mm_s: 0.0,
                 kept: true,
+                gain: 1.0,
             },
             measure: Some(FrameMeasure {
                 distance_m: 3.0,
@@ -354,6 +355,7 @@ mod tests {
                 pose_err_deg: 0.0,
                 samples_per_pixel: 1,
                 render_ms: 1.0,
+                ..FrameMeasure::default()
             }),
         }
     }

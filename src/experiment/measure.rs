@@ -22,10 +22,19 @@ pub struct FrameMeasure {
     pub blur_px: f64,
     /// Mean end-to-start displacement, px.
     pub disp_px: f64,
-    /// JNBM (higher = sharper); NaN when undefined.
+    /// Mean horizontal path over the exposure (sum of |dx| along each
+    /// pixel's track), px, from tracks on a grid of pixels ([`axis_blur`]).
+    pub blur_h_px: f64,
+    /// The same vertically (sum of |dy|), px.
+    pub blur_v_px: f64,
+    /// JNBM (authors' code; higher = sharper); NaN when undefined.
     pub jnbm: f64,
-    /// CPBD (higher = sharper).
+    /// CPBD (authors' code; higher = sharper).
     pub cpbd: f64,
+    /// JNBM with edge widths along both axes ([`crate::assess::jnbm_2d`]).
+    pub jnbm_2d: f64,
+    /// CPBD with edge widths along both axes ([`crate::assess::cpbd_2d`]).
+    pub cpbd_2d: f64,
     /// Crete et al. blur effect (0 sharp .. 1 blurred).
     pub blur_effect: f64,
     /// Variance of the Laplacian.
@@ -136,6 +145,10 @@ pub struct ImageMetrics {
     pub jnbm: f64,
     /// CPBD.
     pub cpbd: f64,
+    /// JNBM, widths along both axes.
+    pub jnbm_2d: f64,
+    /// CPBD, widths along both axes.
+    pub cpbd_2d: f64,
     /// Crete et al. blur effect.
     pub blur_effect: f64,
     /// Laplacian variance.
@@ -148,6 +161,8 @@ pub fn image_metrics(img: &image::RgbImage) -> ImageMetrics {
     ImageMetrics {
         jnbm: crate::assess::jnbm(&gray).unwrap_or(f64::NAN),
         cpbd: crate::assess::cpbd(&gray).unwrap_or(f64::NAN),
+        jnbm_2d: crate::assess::jnbm_2d(&gray).unwrap_or(f64::NAN),
+        cpbd_2d: crate::assess::cpbd_2d(&gray).unwrap_or(f64::NAN),
         blur_effect: crate::assess::blur_effect(&gray).unwrap_or(f64::NAN),
         laplacian_var: crate::assess::laplacian_var(&gray).unwrap_or(f64::NAN),
     }
@@ -266,12 +281,21 @@ pub fn render_and_measure(
     // A rolling shutter exposes each line over its own window: the motion
     // spans the readout plus the exposure.
     let rolling = cam.shutter.readout_s;
+    let exposure = frame.exposure_s();
     let traj = Trajectory::from_log(
         &walk.samples,
         frame.exposure_start,
-        cfg.exposure_s + rolling,
+        exposure + rolling,
         use_velocity,
     )?;
+    // Exposure control raised the gain: the system gain K scales with it
+    // (the same DN from fewer electrons).
+    let mut cam = cam;
+    if let Some(n) = cam.noise.as_mut() {
+        if frame.gain != 1.0 {
+            n.gain_dn_per_e = Some(n.gain() * frame.gain);
+        }
+    }
     let target = Target::parse(&cfg.target, distance)?;
     let mut job = RenderJob::new(cam, traj.clone(), target.clone());
     job.quality = quality;
@@ -286,10 +310,11 @@ pub fn render_and_measure(
         .as_ref()
         .ok_or_else(|| Error::invalid("render", "no blur maps"))?;
     let means = maps.means();
+    let (blur_h_px, blur_v_px) = axis_blur(&cam, &target, &traj);
     let rgb8 = to_rgb8(cam.width, cam.height, &out.rgb)?;
     // True blob centres at mid-exposure (the centroid of a smear).
     // (Rolling shutter: the middle line's mid-exposure.)
-    let mid = traj.pose_at(0.5 * (cfg.exposure_s + rolling));
+    let mid = traj.pose_at(0.5 * (exposure + rolling));
     let frame_pl = target.frame();
     let (board, expected): (Vec<Point2>, Vec<Point2>) = target
         .blob_centres()
@@ -315,8 +340,12 @@ pub fn render_and_measure(
             distance_m: distance,
             blur_px: means.path_px,
             disp_px: means.disp_px,
+            blur_h_px,
+            blur_v_px,
             jnbm: img.jnbm,
             cpbd: img.cpbd,
+            jnbm_2d: img.jnbm_2d,
+            cpbd_2d: img.cpbd_2d,
             blur_effect: img.blur_effect,
             laplacian_var: img.laplacian_var,
             blobs_found: blobs.found,
@@ -330,6 +359,34 @@ pub fn render_and_measure(
         },
         rgb: out.rgb,
     })
+}
+
+/// Mean horizontal and vertical path lengths (px) over the exposure: the
+/// tracks of the blur maps ([`render::maps::track`], 64 steps) of the pixel
+/// centres of a 32 x 24 grid, summing `|dx|` and `|dy|` along each (pixels
+/// whose track is lost are left out). Their sum bounds the path length from
+/// above (a diagonal track counts in both).
+pub fn axis_blur(cam: &Camera, target: &Target, traj: &Trajectory) -> (f64, f64) {
+    let (nx, ny) = (32, 24);
+    let (mut h, mut v, mut n) = (0.0, 0.0, 0usize);
+    for j in 0..ny {
+        for i in 0..nx {
+            let x = (i as f64 + 0.5) * cam.width as f64 / nx as f64;
+            let y = (j as f64 + 0.5) * cam.height as f64 / ny as f64;
+            if let Some(tr) = render::maps::track(cam, target, traj, x, y, 64) {
+                for w in tr.windows(2) {
+                    h += (w[1].0 - w[0].0).abs();
+                    v += (w[1].1 - w[0].1).abs();
+                }
+                n += 1;
+            }
+        }
+    }
+    if n == 0 {
+        (f64::NAN, f64::NAN)
+    } else {
+        (h / n as f64, v / n as f64)
+    }
 }
 
 /// Pose from the matched blob centres against the true camera pose `mid`

@@ -18,6 +18,7 @@ pub mod measure;
 pub mod report;
 pub mod run;
 pub mod sweep;
+pub mod truth;
 pub mod walk;
 
 pub use config::ExperimentConfig;

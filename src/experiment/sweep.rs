@@ -9,6 +9,7 @@ use super::measure::render_and_measure;
 use super::walk::Walk;
 use crate::error::Result;
 use crate::render::Quality;
+use crate::trigger::Frame;
 
 /// One exposure of the sweep.
 #[derive(Debug, Clone, PartialEq)]
@@ -48,17 +49,18 @@ pub fn exposure_sweep(
     let last = walk.samples.last().map_or(f64::NEG_INFINITY, |s| s.t);
     let mut rows = Vec::new();
     for &e in &cfg.sweep_exposures_s {
-        let c = ExperimentConfig {
-            exposure_s: e,
-            ..cfg.clone()
-        };
         let (mut count, mut ok, mut blur) = (0usize, 0usize, 0.0);
         for (k, &fi) in picks.iter().enumerate() {
             let f = &frames[fi];
             if f.exposure_start + e + cam.shutter.readout_s > last {
                 continue;
             }
-            let r = render_and_measure(&c, walk, f, cam, quality, k as u32)?;
+            // The same trigger, exposed for `e` at the nominal gain.
+            let f = Frame {
+                exposure_end: f.exposure_start + e,
+                ..f.clone()
+            };
+            let r = render_and_measure(cfg, walk, &f, cam, quality, k as u32)?;
             count += 1;
             ok += r.measure.blobs_ok as usize;
             blur += r.measure.blur_px;

@@ -97,6 +97,7 @@ pub fn timing(cfg: &ExperimentConfig) -> CameraTiming {
         exposure: cfg.exposure_s,
         readout: cfg.readout_s,
         min_interval: cfg.min_interval_s,
+        pitch_mm: cfg.camera().pitch_x_mm,
     }
     .with_rolling_readout(cfg.camera.readout_s.unwrap_or(0.0))
 }

@@ -150,7 +150,6 @@ impl Live {
         self.integral.trim_before(keep_from.min(t));
         let i = self.n - 1;
         let start = t + self.timing.delay;
-        let end = start + self.timing.exposure;
         let camera_free = start >= self.free_at;
         let obs = Observation {
             i,
@@ -163,6 +162,8 @@ impl Live {
             timing: &self.timing,
         };
         if self.policy.decide(&obs) && camera_free {
+            let (te, gain) = self.policy.exposure(&obs);
+            let end = start + te;
             let f = Frame {
                 policy: self.policy.spec().to_string(),
                 index: i,
@@ -172,6 +173,7 @@ impl Live {
                 mmbm_trigger_mm_s: mmbm_mm_s,
                 mmbm_exposure_mm_s: f64::NAN,
                 kept: true,
+                gain,
             };
             let k = self.frames;
             self.frames += 1;

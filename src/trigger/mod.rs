@@ -38,12 +38,16 @@
 //! | `adaptive[:X[:FPS]]` | thesis rule with an adaptive threshold (see [`Adaptive`]); `X` default 0.4, target `FPS` default 2.5 |
 //! | `oracle:X[:H]` | perfect future knowledge (see [`Oracle`]); `H` default 0.2 s |
 //! | `forecast:X[:H]` | the oracle's rule on a blind periodic forecast (see [`Forecast`]) |
+//! | `phase:X[:H]` | the oracle's rule on a forecast folded over the last gait cycles, aligned on detected touchdowns (see [`Phase`]) |
 //! | `gate:X[:FPS[@PHASE]]` | `fixed` (default 5 fps), frames whose exposure MMBM is above `X` marked not kept |
 //! | `gate0:X[:FPS[@PHASE]]` | the same, on the MMBM at the exposure start (the decision sample): the thesis's test |
 //! | `deadline:FPS[:X]` | one frame per fixed-rate slot at the best causal instant (see [`Deadline`]) |
+//! | `P+exp:B[:TMIN]` | any policy `P` with exposure control: each frame's exposure shortened (and gain raised) so the blur the MMBM predicts stays within `B` px (see [`Exposure`]) |
 
+mod exposure;
 mod live;
 mod parse;
+mod phase;
 mod policy;
 mod predict;
 mod rules;
@@ -51,8 +55,10 @@ mod run;
 mod stats;
 mod timing;
 
+pub use exposure::Exposure;
 pub use live::{Event, Live};
 pub use parse::parse_policy;
+pub use phase::Phase;
 pub use policy::{Level, LogView, Observation, Policy};
 pub use predict::{Forecast, Oracle};
 pub use rules::{Adaptive, Deadline, Fixed, Gate, Threshold};

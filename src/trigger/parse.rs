@@ -1,6 +1,8 @@
 //! The policy parser: `name:args` strings (grammar in the module docs of
 //! [`crate::trigger`]) to boxed [`Policy`] values.
 
+use super::exposure::Exposure;
+use super::phase::Phase;
 use super::policy::{Level, Policy};
 use super::predict::{Forecast, Oracle};
 use super::rules::{Adaptive, Deadline, Fixed, Gate, Threshold};
@@ -63,11 +65,29 @@ pub(crate) fn parse_rate(s: &str, spec: &str) -> Result<(f64, f64)> {
 }
 
 const GRAMMAR: &str = "fixed:FPS[@PHASE], threshold:X, adaptive[:X[:FPS]], oracle:X[:H], \
-forecast:X[:H], gate:X[:FPS[@PHASE]], gate0:X[:FPS[@PHASE]] or deadline:FPS[:X] (X in mm/s or pNN)";
+forecast:X[:H], phase:X[:H], gate:X[:FPS[@PHASE]], gate0:X[:FPS[@PHASE]] or deadline:FPS[:X] (X in mm/s or pNN), \
+each optionally followed by +exp:B[:TMIN] (exposure control: blur budget B px, shortest exposure TMIN s)";
 
 /// Parses a policy string (grammar in the module docs). The policy keeps the
 /// string exactly as given for the `policy` column.
 pub fn parse_policy(spec: &str) -> Result<Box<dyn Policy>> {
+    if let Some((base, modifier)) = spec.split_once('+') {
+        let bad =
+            |msg: &str| Error::invalid("policy", format!("'{spec}': {msg}; expected {GRAMMAR}"));
+        let inner = parse_policy(base)?;
+        let parts: Vec<&str> = modifier.trim().split(':').collect();
+        let (budget, tmin) = match parts.as_slice() {
+            ["exp", b] => (*b, None),
+            ["exp", b, t] => (*b, Some(*t)),
+            _ => return Err(bad("after '+' expected exp:B[:TMIN]")),
+        };
+        let budget = parse_pos(budget, "blur budget (px)", spec)?;
+        let tmin = match tmin {
+            Some(t) => parse_pos(t, "shortest exposure (s)", spec)?,
+            None => Exposure::MIN_EXPOSURE,
+        };
+        return Ok(Box::new(Exposure::new(spec, inner, budget, tmin)));
+    }
     let parts: Vec<&str> = spec.trim().split(':').collect();
     let name = parts[0].to_ascii_lowercase();
     let args = &parts[1..];
@@ -96,6 +116,8 @@ pub fn parse_policy(spec: &str) -> Result<Box<dyn Policy>> {
             level(x)?,
             parse_pos(h, "horizon", spec)?,
         )),
+        ("phase", [x]) => Box::new(Phase::new(spec, level(x)?, 0.2)),
+        ("phase", [x, h]) => Box::new(Phase::new(spec, level(x)?, parse_pos(h, "horizon", spec)?)),
         ("gate", [x]) => Box::new(Gate::new(spec, level(x)?, 5.0, 0.0)),
         ("gate", [x, r]) => {
             let (fps, phase) = parse_rate(r, spec)?;
@@ -113,7 +135,7 @@ pub fn parse_policy(spec: &str) -> Result<Box<dyn Policy>> {
             Some(level(x)?),
         )),
         (
-            "fixed" | "threshold" | "adaptive" | "oracle" | "forecast" | "gate" | "gate0"
+            "fixed" | "threshold" | "adaptive" | "oracle" | "forecast" | "phase" | "gate" | "gate0"
             | "deadline",
             _,
         ) => return Err(bad("wrong number of ':' arguments")),

@@ -84,6 +84,12 @@ pub trait Policy {
     fn keep(&self, _frame: &Frame) -> bool {
         true
     }
+    /// The exposure (s) and relative gain of a frame triggered at `obs`: the
+    /// camera's exposure and gain 1, unless the policy controls the exposure
+    /// (at most the camera's, which the runner counts on).
+    fn exposure(&self, obs: &Observation) -> (f64, f64) {
+        (obs.timing.exposure, 1.0)
+    }
 }
 
 /// A threshold: an absolute MMBM (mm/s) or a percentile of the log's own series.

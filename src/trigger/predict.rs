@@ -85,6 +85,67 @@ impl Policy for Oracle {
     }
 }
 
+/// The gait period (s) from the last [`Forecast::WINDOW`] s of `hist` before
+/// `now`: box-averaged into [`Forecast::BIN`]-s bins (left in `bins`, raw),
+/// the mean removed, the normalised autocorrelation over lags
+/// [`Forecast::MIN_LAG`] .. `WINDOW / 2`; the shortest lag at a local maximum
+/// reaching `ratio` of the highest correlation, refined by a parabola. `None`
+/// before `WINDOW` s of log or when the highest correlation is below
+/// [`Forecast::MIN_CORR`] (not periodic).
+pub(super) fn estimate_period(
+    hist: &Integral,
+    bins: &mut Vec<f64>,
+    t0: f64,
+    now: f64,
+    ratio: f64,
+) -> Option<f64> {
+    if now - t0 < Forecast::WINDOW {
+        return None;
+    }
+    let nb = (Forecast::WINDOW / Forecast::BIN).round() as usize;
+    let a = now - Forecast::WINDOW;
+    bins.clear();
+    for b in 0..nb {
+        let lo = a + b as f64 * Forecast::BIN;
+        bins.push(hist.mean(lo, lo + Forecast::BIN));
+    }
+    let mean = bins.iter().sum::<f64>() / nb as f64;
+    let x: Vec<f64> = bins.iter().map(|v| v - mean).collect();
+    let lmin = (Forecast::MIN_LAG / Forecast::BIN).ceil() as usize;
+    let lmax = nb / 2;
+    let corr = |l: usize| {
+        let (mut s, mut s0, mut s1) = (0.0, 0.0, 0.0);
+        for k in 0..nb - l {
+            s += x[k] * x[k + l];
+            s0 += x[k] * x[k];
+            s1 += x[k + l] * x[k + l];
+        }
+        if s0 > 0.0 && s1 > 0.0 {
+            s / (s0 * s1).sqrt()
+        } else {
+            0.0
+        }
+    };
+    let c: Vec<f64> = (lmin - 1..=lmax + 1).map(corr).collect();
+    let best = c[1..c.len() - 1].iter().copied().fold(f64::MIN, f64::max);
+    if best < Forecast::MIN_CORR {
+        return None;
+    }
+    for j in 1..c.len() - 1 {
+        if c[j] >= ratio * best && c[j] >= c[j - 1] && c[j] >= c[j + 1] {
+            let den = c[j - 1] - 2.0 * c[j] + c[j + 1];
+            let off = if den < 0.0 {
+                (0.5 * (c[j - 1] - c[j + 1]) / den).clamp(-0.5, 0.5)
+            } else {
+                0.0
+            };
+            let lag = (lmin - 1 + j) as f64 + off;
+            return Some(lag * Forecast::BIN);
+        }
+    }
+    None
+}
+
 /// `forecast:X[:H]`: the oracle's rule applied to a blind forecast of the
 /// quasi-periodic gait, using only the samples up to the decision.
 ///
@@ -154,57 +215,6 @@ impl Forecast {
         self.period
     }
 
-    fn estimate_period(&mut self, t0: f64, now: f64) -> Option<f64> {
-        if now - t0 < Self::WINDOW {
-            return None;
-        }
-        let nb = (Self::WINDOW / Self::BIN).round() as usize;
-        let a = now - Self::WINDOW;
-        self.bins.clear();
-        for b in 0..nb {
-            let lo = a + b as f64 * Self::BIN;
-            self.bins.push(self.hist.mean(lo, lo + Self::BIN));
-        }
-        let mean = self.bins.iter().sum::<f64>() / nb as f64;
-        for x in &mut self.bins {
-            *x -= mean;
-        }
-        let x = &self.bins;
-        let lmin = (Self::MIN_LAG / Self::BIN).ceil() as usize;
-        let lmax = nb / 2;
-        let corr = |l: usize| {
-            let (mut s, mut s0, mut s1) = (0.0, 0.0, 0.0);
-            for k in 0..nb - l {
-                s += x[k] * x[k + l];
-                s0 += x[k] * x[k];
-                s1 += x[k + l] * x[k + l];
-            }
-            if s0 > 0.0 && s1 > 0.0 {
-                s / (s0 * s1).sqrt()
-            } else {
-                0.0
-            }
-        };
-        let c: Vec<f64> = (lmin - 1..=lmax + 1).map(corr).collect();
-        let best = c[1..c.len() - 1].iter().copied().fold(f64::MIN, f64::max);
-        if best < Self::MIN_CORR {
-            return None;
-        }
-        for j in 1..c.len() - 1 {
-            if c[j] >= 0.8 * best && c[j] >= c[j - 1] && c[j] >= c[j + 1] {
-                let den = c[j - 1] - 2.0 * c[j] + c[j + 1];
-                let off = if den < 0.0 {
-                    (0.5 * (c[j - 1] - c[j + 1]) / den).clamp(-0.5, 0.5)
-                } else {
-                    0.0
-                };
-                let lag = (lmin - 1 + j) as f64 + off;
-                return Some(lag * Self::BIN);
-            }
-        }
-        None
-    }
-
     /// Forecast exposure average for a trigger at `tau`; None without a past window.
     fn predict(&self, tau: f64, p: f64, now: f64, t0: f64, timing: &CameraTiming) -> Option<f64> {
         let (mut s, mut n) = (0.0, 0);
@@ -255,7 +265,7 @@ impl Policy for Forecast {
         }
         let (t0, now) = (obs.t0, obs.now());
         if now - self.estimated_at >= Self::REESTIMATE {
-            self.period = self.estimate_period(t0, now);
+            self.period = estimate_period(&self.hist, &mut self.bins, t0, now, 0.8);
             self.estimated_at = now;
         }
         let timing = obs.timing;

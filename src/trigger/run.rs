@@ -79,6 +79,8 @@ pub fn run(
             timing,
         };
         if policy.decide(&obs) && camera_free {
+            let (te, gain) = policy.exposure(&obs);
+            let end = start + te;
             let mut f = Frame {
                 policy: policy.spec().to_string(),
                 index: i,
@@ -88,6 +90,7 @@ pub fn run(
                 mmbm_trigger_mm_s: mmbm_mm_s[i],
                 mmbm_exposure_mm_s: integral.mean(start, end),
                 kept: true,
+                gain,
             };
             f.kept = policy.keep(&f);
             frames.push(f);

@@ -7,7 +7,7 @@ use std::io::Write;
 
 /// Header of the frames CSV written by [`write_frames`].
 pub const FRAME_HEADER: &str =
-    "policy,trigger_t,exposure_start,exposure_end,mmbm_trigger_mm_s,mmbm_exposure_mm_s,kept";
+    "policy,trigger_t,exposure_start,exposure_end,mmbm_trigger_mm_s,mmbm_exposure_mm_s,kept,gain";
 
 /// Summary of one policy's frames. The MMBM statistics are over the kept
 /// frames' exposure MMBM (NaN when no frame was kept).
@@ -31,6 +31,11 @@ pub struct Summary {
     pub max_mm_s: f64,
     /// Mean MMBM at the trigger sample of the kept frames, mm/s.
     pub mean_trigger_mm_s: f64,
+    /// Mean exposure of the kept frames, s (exposure control shortens some).
+    pub mean_exposure_s: f64,
+    /// Mean blur length on the sensor of the kept frames, exposure MMBM x
+    /// exposure, mm (divide by the pixel pitch for px).
+    pub mean_blur_mm: f64,
 }
 
 /// Summary with the rate over the frames' own span: `duration_s` is
@@ -73,6 +78,13 @@ pub fn summary_over(frames: &[Frame], duration_s: f64) -> Summary {
         p95_mm_s: percentile(&e, 95.0).unwrap_or(f64::NAN),
         max_mm_s: e.iter().copied().fold(f64::NAN, f64::max),
         mean_trigger_mm_s: mean(&trig),
+        mean_exposure_s: mean(&kept.iter().map(|f| f.exposure_s()).collect::<Vec<_>>()),
+        mean_blur_mm: mean(
+            &kept
+                .iter()
+                .map(|f| f.mmbm_exposure_mm_s * f.exposure_s())
+                .collect::<Vec<_>>(),
+        ),
     }
 }
 
@@ -152,7 +164,8 @@ pub fn prediction_error(frames: &[Frame]) -> Table51 {
     }
 }
 
-/// Writes frames as CSV ([`FRAME_HEADER`]; `kept` is 1 or 0; floats in
+/// Writes frames as CSV ([`FRAME_HEADER`]; `kept` is 1 or 0; `gain` the
+/// sensor gain relative to the nominal exposure's; floats in
 /// shortest round-trip form). `header` false appends rows only.
 pub fn write_frames(w: &mut dyn Write, frames: &[Frame], header: bool) -> Result<()> {
     let e = |e: std::io::Error| Error::io("<frames output>", e);
@@ -162,14 +175,15 @@ pub fn write_frames(w: &mut dyn Write, frames: &[Frame], header: bool) -> Result
     for f in frames {
         writeln!(
             w,
-            "{},{},{},{},{},{},{}",
+            "{},{},{},{},{},{},{},{}",
             f.policy,
             f.trigger_t,
             f.exposure_start,
             f.exposure_end,
             f.mmbm_trigger_mm_s,
             f.mmbm_exposure_mm_s,
-            u8::from(f.kept)
+            u8::from(f.kept),
+            f.gain
         )
         .map_err(e)?;
     }

@@ -14,18 +14,22 @@ pub struct CameraTiming {
     pub readout: f64,
     /// Minimum interval between triggers of the MMBM-triggered policies.
     pub min_interval: f64,
+    /// Pixel pitch, mm: turns an MMBM (mm/s) times an exposure into a blur
+    /// length in px for exposure control (`+exp:B`).
+    pub pitch_mm: f64,
 }
 
 impl Default for CameraTiming {
     /// Delay 2.5 ms, exposure 70 ms (thesis ch. 6), readout 12.5 ms (a
     /// 640 x 480 Flea2 at its 80 fps maximum; an assumption, the thesis gives
-    /// none), minimum interval 0.2 s.
+    /// none), minimum interval 0.2 s, the thesis camera's 4.65 um pitch.
     fn default() -> Self {
         CameraTiming {
             delay: 0.0025,
             exposure: 0.07,
             readout: 0.0125,
             min_interval: 0.2,
+            pitch_mm: 0.00465,
         }
     }
 }
@@ -44,6 +48,7 @@ impl CameraTiming {
     /// Checks that the times are finite, the exposure positive and the others non-negative.
     pub fn validate(&self) -> Result<()> {
         crate::error::positive("exposure", self.exposure)?;
+        crate::error::positive("pixel pitch (mm)", self.pitch_mm)?;
         for (what, x) in [
             ("delay", self.delay),
             ("readout", self.readout),
@@ -69,7 +74,8 @@ pub struct Frame {
     pub trigger_t: f64,
     /// `trigger_t + delay`, s.
     pub exposure_start: f64,
-    /// `exposure_start + exposure`, s.
+    /// `exposure_start` plus the frame's exposure (the camera's, or the one
+    /// an exposure-controlled policy chose), s.
     pub exposure_end: f64,
     /// MMBM of the decision sample, mm/s.
     pub mmbm_trigger_mm_s: f64,
@@ -77,6 +83,17 @@ pub struct Frame {
     pub mmbm_exposure_mm_s: f64,
     /// False when a quality gate discarded the frame.
     pub kept: bool,
+    /// Sensor gain relative to the nominal exposure's (1 unless an
+    /// exposure-controlled policy shortened the exposure: then
+    /// `nominal / chosen`, which keeps the image as bright).
+    pub gain: f64,
+}
+
+impl Frame {
+    /// The frame's exposure, s.
+    pub fn exposure_s(&self) -> f64 {
+        self.exposure_end - self.exposure_start
+    }
 }
 
 /// The prefix integral of a piecewise-linear series, for exposure averages.
