@@ -108,28 +108,42 @@ impl Noise {
     /// Applies the model to linear radiances `pixels` (0..1, any layout)
     /// exposed for `exposure_s`, in place, with the RNG stream `stream`
     /// (0 for a frame; another value for a second image of the same frame,
-    /// e.g. its sharp twin). Deterministic for a given seed and stream.
+    /// e.g. its sharp twin). Deterministic for a given seed and stream: the
+    /// values are cut into chunks of [`Noise::CHUNK`], each drawn from its own
+    /// RNG (seeded by seed, stream and chunk number), in parallel.
     pub fn apply(&self, pixels: &mut [f32], exposure_s: f64, stream: u64) -> Result<()> {
+        use rayon::prelude::*;
         self.validate()?;
-        let mut rng = StdRng::seed_from_u64(self.seed ^ stream.wrapping_mul(0x9E37_79B9_7F4A_7C15));
         let read = Normal::new(0.0, self.read_noise_e)
             .map_err(|e| Error::invalid("noise.read_noise_e", e.to_string()))?;
         let (k, max_dn) = (self.gain(), self.max_dn());
         let scale = self.phi_e_per_s * exposure_s;
-        for p in pixels.iter_mut() {
-            let mu = scale * (*p as f64).clamp(0.0, f64::MAX);
-            let shot = if mu > 0.0 && mu.is_finite() {
-                Poisson::new(mu)
-                    .map_err(|e| Error::invalid("noise", format!("mean {mu} e-: {e}")))?
-                    .sample(&mut rng)
-            } else {
-                0.0
-            };
-            let e = (shot + read.sample(&mut rng)).clamp(0.0, self.full_well_e);
-            *p = ((k * e).round().clamp(0.0, max_dn) / max_dn) as f32;
-        }
-        Ok(())
+        let base = self.seed ^ stream.wrapping_mul(0x9E37_79B9_7F4A_7C15);
+        pixels
+            .par_chunks_mut(Self::CHUNK)
+            .enumerate()
+            .try_for_each(|(c, chunk)| {
+                let mut rng = StdRng::seed_from_u64(
+                    base ^ (c as u64 + 1).wrapping_mul(0xD1B5_4A32_D192_ED03),
+                );
+                for p in chunk.iter_mut() {
+                    let mu = scale * (*p as f64).clamp(0.0, f64::MAX);
+                    let shot = if mu > 0.0 && mu.is_finite() {
+                        Poisson::new(mu)
+                            .map_err(|e| Error::invalid("noise", format!("mean {mu} e-: {e}")))?
+                            .sample(&mut rng)
+                    } else {
+                        0.0
+                    };
+                    let e = (shot + read.sample(&mut rng)).clamp(0.0, self.full_well_e);
+                    *p = ((k * e).round().clamp(0.0, max_dn) / max_dn) as f32;
+                }
+                Ok(())
+            })
     }
+
+    /// Values per RNG chunk of [`Noise::apply`].
+    pub const CHUNK: usize = 16384;
 }
 
 #[cfg(test)]

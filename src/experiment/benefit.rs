@@ -70,7 +70,7 @@ pub fn baseline(policies: &[String]) -> Option<usize> {
     policies
         .iter()
         .position(|p| p == "fixed:5")
-        .or_else(|| policies.iter().position(|p| p.starts_with("fixed:")))
+        .or_else(|| policies.iter().position(|p| super::measure::is_baseline(p)))
 }
 
 fn estimate(value: f64, mut draws: Vec<f64>) -> Estimate {
@@ -264,11 +264,45 @@ pub fn headline_md(hs: &[Headline], policies: &[String]) -> String {
                 h.policy, r.value, r.lo, r.hi
             );
         }
+        // The ceiling: at the baseline's rate no policy gets more frames.
+        let fps = base.as_ref().and_then(|b| {
+            b.strip_prefix("fixed:")?
+                .split('@')
+                .next()?
+                .parse::<f64>()
+                .ok()
+        });
+        let bh = hs
+            .iter()
+            .find(|h| h.gait == g && Some(&h.policy) == base.as_ref());
+        if let (Some(fps), Some(bh), Some(b)) = (fps, bh, &base) {
+            let cap = fps / bh.sharp_fps.value;
+            if cap.is_finite() {
+                s += &format!(
+                    "- {g}: at `{b}`'s rate a policy takes at most {fps} frames/s, and `{b}` already gets {:.2} \
+                     sharp frames/s ({:.0} % of its frames), so no policy at that rate can exceed {cap:.2}x here{}.\n",
+                    bh.sharp_fps.value,
+                    100.0 * bh.sharp_fps.value / fps,
+                    if cap < 1.5 {
+                        ": the 1.5x goal is out of reach with this camera and light"
+                    } else {
+                        ""
+                    }
+                );
+            }
+        }
     }
-    // The forecast's share of the oracle's gain (blur) over the thesis rule,
-    // for every forecast:X run beside threshold:X and oracle:X.
-    for h in hs.iter().filter(|h| h.policy.starts_with("forecast:")) {
-        let x = h.policy["forecast:".len()..]
+    // The predictors' share of the oracle's gain (blur) over the thesis rule,
+    // for every forecast:X or phase:X run beside threshold:X and oracle:X.
+    for h in hs
+        .iter()
+        .filter(|h| h.policy.starts_with("forecast:") || h.policy.starts_with("phase:"))
+    {
+        let x = h
+            .policy
+            .split(':')
+            .nth(1)
+            .unwrap_or("")
             .split(':')
             .next()
             .unwrap_or("");

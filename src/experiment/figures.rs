@@ -44,10 +44,10 @@ pub fn write_all(
             (t0 + 8.0).min(t.last().copied().unwrap_or(t0 + 8.0)),
         );
         for (p, frames) in &w.runs {
-            if !(p.starts_with("fixed")
+            if !(super::measure::is_baseline(p)
                 || p == "threshold:0.4"
                 || p.starts_with("oracle")
-                || p.starts_with("forecast"))
+                || p.starts_with("phase"))
             {
                 continue;
             }
@@ -61,7 +61,11 @@ pub fn write_all(
                 .nth(1)
                 .and_then(|x| x.parse::<f64>().ok())
                 .filter(|_| !p.starts_with("fixed"));
-            let name = format!("trace_{}_{}.png", w.name, p.replace([':', '.', '@'], "_"));
+            let name = format!(
+                "trace_{}_{}.png",
+                w.name,
+                p.replace([':', '.', '@', '+'], "_")
+            );
             mmbm_trace(
                 &out.join(&name),
                 &format!(

@@ -3,7 +3,7 @@
 //! 5.1, 6.1 and 6.2 recomputed per walk and policy).
 
 use super::config::ExperimentConfig;
-use super::measure::{FrameMeasure, FrameRecord};
+use super::measure::{is_baseline, FrameMeasure, FrameRecord};
 use super::walk::Walk;
 use crate::stats;
 use crate::trigger::{prediction_error, summary_over};
@@ -241,7 +241,7 @@ pub fn table_6(stats: &[PolicyStats]) -> String {
     for st in stats {
         let fixed = stats
             .iter()
-            .find(|x| x.walk == st.walk && x.policy.starts_with("fixed"))
+            .find(|x| x.walk == st.walk && is_baseline(&x.policy))
             .map(|x| x.kept as i64);
         let lost = fixed.map_or("-".into(), |k| (k - st.kept as i64).to_string());
         let succ = st.success_pct();
@@ -297,7 +297,7 @@ pub fn baseline_note(stats: &[PolicyStats]) -> String {
     let mut s = String::new();
     for st in stats
         .iter()
-        .filter(|x| x.policy.starts_with("fixed") && x.rendered > 0)
+        .filter(|x| is_baseline(&x.policy) && x.rendered > 0)
     {
         let pct = |k: usize| 100.0 * k as f64 / st.rendered as f64;
         let _ = write!(
@@ -347,10 +347,10 @@ pub fn quality_note(cfg: &ExperimentConfig, check: Option<(f64, f64, f64)>) -> S
 /// Prose: what the simulation found, compared with the thesis.
 pub fn findings(stats: &[PolicyStats]) -> String {
     let mut s = String::from("## Findings\n\n");
-    for st in stats.iter().filter(|x| x.policy.starts_with("fixed")) {
+    for st in stats.iter().filter(|x| is_baseline(&x.policy)) {
         let others: Vec<&PolicyStats> = stats
             .iter()
-            .filter(|x| x.walk == st.walk && !x.policy.starts_with("fixed"))
+            .filter(|x| x.walk == st.walk && !is_baseline(&x.policy))
             .collect();
         s += &format!(
             "- {} walk, baseline `{}`: {} frames, blob success {:.0} %, mean JNBM {:.3}, mean blur {:.1} px (p95 {:.1}).\n",
@@ -370,7 +370,7 @@ pub fn findings(stats: &[PolicyStats]) -> String {
         }
     }
     // The headline comparison of the thesis: fixed 5 fps against MMBM triggering at 0.4.
-    for base in stats.iter().filter(|x| x.policy.starts_with("fixed")) {
+    for base in stats.iter().filter(|x| is_baseline(&x.policy)) {
         let Some(th) = stats
             .iter()
             .find(|x| x.walk == base.walk && x.policy == "threshold:0.4")

@@ -32,7 +32,7 @@ use std::collections::VecDeque;
 ///   ticks of the known touchdowns, with `r` the time from `t_i + u` to the
 ///   next tick (which folds each touchdown's jitter about its tick into the
 ///   spread). The two are blended linearly from the first to the second as
-///   `(s + u) / P_c` goes from 0.3 to 0.7, and the forecast is mean plus
+///   `(s + u) / P` goes from 0.3 to 0.7, and the forecast is mean plus
 ///   [`Phase::RISK`] standard deviations over the folded cycles (a phase
 ///   where some cycles were shaken is avoided). An exposure ending less than
 ///   [`Phase::MARGIN`] `sigma_c` before the next tick is not taken.
@@ -73,6 +73,9 @@ impl Phase {
     pub const LOCK: f64 = 0.1;
     /// A period is the shortest autocorrelation peak reaching this share of the highest.
     pub const SHORTEST: f64 = 0.5;
+    /// The first period estimate needs this much log, s (later ones use
+    /// [`Forecast::WINDOW`], or the whole log while it is shorter).
+    pub const FIRST_WINDOW: f64 = 2.5;
     /// Fewest previous cycles before the fold is used.
     pub const MIN_CYCLES: usize = 2;
     /// Shortest interval between touchdowns, in periods.
@@ -320,7 +323,14 @@ impl Policy for Phase {
         let keep = Forecast::WINDOW.max((Self::CYCLES as f64 + 2.0) * Forecast::WINDOW / 2.0);
         self.hist.trim_before(now - keep - 1.0);
         if now - self.estimated_at >= Forecast::REESTIMATE {
-            self.period = estimate_period(&self.hist, &mut self.bins, t0, now, Self::SHORTEST);
+            self.period = estimate_period(
+                &self.hist,
+                &mut self.bins,
+                t0,
+                now,
+                Self::SHORTEST,
+                Forecast::WINDOW.min(now - t0).max(Self::FIRST_WINDOW),
+            );
             self.crossing = match (percentile(&self.bins, 25.0), percentile(&self.bins, 99.0)) {
                 (Some(lo), Some(hi)) if self.period.is_some() && hi > lo => {
                     Some(lo + 0.5 * (hi - lo))

@@ -85,12 +85,12 @@ impl Policy for Oracle {
     }
 }
 
-/// The gait period (s) from the last [`Forecast::WINDOW`] s of `hist` before
-/// `now`: box-averaged into [`Forecast::BIN`]-s bins (left in `bins`, raw),
-/// the mean removed, the normalised autocorrelation over lags
-/// [`Forecast::MIN_LAG`] .. `WINDOW / 2`; the shortest lag at a local maximum
-/// reaching `ratio` of the highest correlation, refined by a parabola. `None`
-/// before `WINDOW` s of log or when the highest correlation is below
+/// The gait period (s) from the last `window` s of `hist` before `now`:
+/// box-averaged into [`Forecast::BIN`]-s bins (left in `bins`, raw), the mean
+/// removed, the normalised autocorrelation over lags [`Forecast::MIN_LAG`] ..
+/// `window / 2`; the shortest lag at a local maximum reaching `ratio` of the
+/// highest correlation, refined by a parabola. `None` before `window` s of
+/// log or when the highest correlation is below
 /// [`Forecast::MIN_CORR`] (not periodic).
 pub(super) fn estimate_period(
     hist: &Integral,
@@ -98,12 +98,13 @@ pub(super) fn estimate_period(
     t0: f64,
     now: f64,
     ratio: f64,
+    window: f64,
 ) -> Option<f64> {
-    if now - t0 < Forecast::WINDOW {
+    if now - t0 < window {
         return None;
     }
-    let nb = (Forecast::WINDOW / Forecast::BIN).round() as usize;
-    let a = now - Forecast::WINDOW;
+    let nb = (window / Forecast::BIN).round() as usize;
+    let a = now - window;
     bins.clear();
     for b in 0..nb {
         let lo = a + b as f64 * Forecast::BIN;
@@ -265,7 +266,7 @@ impl Policy for Forecast {
         }
         let (t0, now) = (obs.t0, obs.now());
         if now - self.estimated_at >= Self::REESTIMATE {
-            self.period = estimate_period(&self.hist, &mut self.bins, t0, now, 0.8);
+            self.period = estimate_period(&self.hist, &mut self.bins, t0, now, 0.8, Self::WINDOW);
             self.estimated_at = now;
         }
         let timing = obs.timing;
