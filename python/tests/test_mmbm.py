@@ -105,7 +105,7 @@ def test_series_equals_cli(walk):
 def test_trigger_equals_cli(walk):
     g = mmbm.read_gyro(walk)
     m = mmbm.series(g["t"], g["omega"])
-    pols = ["fixed:5", "threshold:0.4", "oracle:0.4", "deadline:5"]
+    pols = ["fixed:5", "threshold:0.4", "oracle:0.4", "deadline:5", "phase:0.4", "fixed:5+exp:2:0.01"]
     got = mmbm.trigger(g["t"], m, pols, exposure=0.07)
     args = ["trigger", "--gyro", str(walk), "--exposure", "0.07"]
     for p in pols:
@@ -114,9 +114,11 @@ def test_trigger_equals_cli(walk):
     assert len(got) == len(rows) > 0
     for a, b in zip(got, rows):
         assert a["policy"] == b["policy"]
-        for k in ("trigger_t", "exposure_start", "exposure_end", "mmbm_trigger_mm_s", "mmbm_exposure_mm_s"):
+        for k in ("trigger_t", "exposure_start", "exposure_end", "mmbm_trigger_mm_s", "mmbm_exposure_mm_s", "gain"):
             assert a[k] == float(b[k]), k
         assert int(a["kept"]) == int(b["kept"])
+    # Exposure control chose shorter exposures with a higher gain somewhere.
+    assert any(a["gain"] > 1.0 for a in got if a["policy"].endswith("+exp:2:0.01"))
 
 
 def test_render_equals_cli(tmp_path):

@@ -16,15 +16,20 @@ use std::path::PathBuf;
 #[command(
     after_help = "Policies (X in mm/s, or pNN = NN-th percentile of the whole log's MMBM, an offline calibration that
 looks at the future, so not causal: `mmbm live` refuses it; FPS at most 1000):
-  fixed:FPS[@PHASE]  threshold:X  adaptive[:X[:FPS]]  oracle:X[:H]  forecast:X[:H]
+  fixed:FPS[@PHASE]  threshold:X  adaptive[:X[:FPS]]  oracle:X[:H]  forecast:X[:H]  phase:X[:H]
   gate:X[:FPS[@PHASE]]  gate0:X[:FPS[@PHASE]]  deadline:FPS[:X]
   (gate keeps a fixed-rate frame when its exposure-averaged MMBM is <= X; gate0, the thesis's test, when
-  the MMBM at the exposure start, i.e. of the decision sample, is)
+  the MMBM at the exposure start, i.e. of the decision sample, is; phase learns the gait's cycle from
+  its touchdowns)
+Exposure control: any policy followed by +exp:B[:TMIN] exposes each frame for
+  clamp(B x pitch / MMBM, TMIN, --exposure) s (predicted blur within B px; TMIN default 0.001) and raises
+  the gain by --exposure / that; the CSV's gain column says by how much.
 
 Examples:
   mmbm simulate --gait moderate --duration 16 --out walk.csv
   mmbm trigger --gyro walk.csv --policy fixed:5 --policy threshold:0.4 --exposure 0.07 --out frames.csv
-  mmbm trigger --gyro walk.csv --policy oracle:0.4 --policy forecast:0.4 --exposure 0.07 --summary
+  mmbm trigger --gyro walk.csv --policy oracle:0.4 --policy phase:0.4 --exposure 0.07 --summary
+  mmbm trigger --gyro walk.csv --policy fixed:5+exp:2:0.02 --policy deadline:5+exp:3 --exposure 0.07 --summary
   mmbm trigger --gyro ../shared/data/running_phone/gyro.csv --policy threshold:p20 --exposure 0.02 --summary"
 )]
 pub struct TriggerArgs {

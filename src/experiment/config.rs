@@ -150,17 +150,21 @@ impl ExperimentConfig {
     /// policy rendered at the `default` preset) with realistic frames: the
     /// thesis camera's global shutter and lens, and sensor noise (EMVA 1288
     /// defaults: 2.5 e- read noise, 10,000 e- full well, 8 bits, seed 1) at
-    /// [`ExperimentConfig::DEMO_LIGHT_E_PER_S`].
+    /// [`ExperimentConfig::DEMO_LIGHT_E_PER_S`], with the gain set as a
+    /// camera operator would for that light: a white pixel fills the 8-bit
+    /// range in the 70 ms exposure (255 DN / 1,400 e- = 0.182 DN/e-).
     pub fn demo() -> Self {
+        let d = Self::default();
         ExperimentConfig {
             camera: CameraSection {
                 noise: Some(Noise {
                     seed: 1,
+                    gain_dn_per_e: Some(255.0 / (Self::DEMO_LIGHT_E_PER_S * d.exposure_s)),
                     ..Noise::at_light(Self::DEMO_LIGHT_E_PER_S)
                 }),
                 ..CameraSection::default()
             },
-            ..Self::default()
+            ..d
         }
     }
 
@@ -260,5 +264,23 @@ impl ExperimentConfig {
     /// The configuration as TOML (written into the report).
     pub fn to_toml(&self) -> String {
         toml::to_string_pretty(self).unwrap_or_else(|e| format!("# could not serialise: {e}"))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn demo_camera_fills_the_range_at_the_nominal_exposure() {
+        let d = ExperimentConfig::demo();
+        let n = d.camera.noise.expect("the demo has sensor noise");
+        // White: 20,000 e-/s x 70 ms = 1,400 e-, times the gain = 255 DN.
+        let white = n.phi_e_per_s * d.exposure_s * n.gain();
+        assert!((white - n.max_dn()).abs() < 1e-9, "{white}");
+        assert!(n.validate().is_ok());
+        // The ideal camera stays the experiment's default.
+        assert!(ExperimentConfig::default().camera.noise.is_none());
+        assert_eq!(ExperimentConfig::demo_full().camera.noise, Some(n));
     }
 }
