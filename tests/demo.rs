@@ -1,0 +1,90 @@
+//! The README's first command, end to end: `mmbm demo` (about 3 minutes on
+//! 2 cores). Its report must lead with the headline, and the README's seed-1
+//! table ("What the demo finds") must be what the demo measures.
+
+use std::collections::HashMap;
+use std::process::Command;
+
+/// Cells of the Markdown table rows starting with `prefix`.
+fn rows<'a>(text: &'a str, prefix: &str) -> Vec<Vec<&'a str>> {
+    text.lines()
+        .filter(|l| l.starts_with(prefix))
+        .map(|l| l.trim_matches('|').split('|').map(str::trim).collect())
+        .collect()
+}
+
+fn num(s: &str) -> f64 {
+    s.trim_end_matches(" %")
+        .parse()
+        .unwrap_or_else(|_| panic!("'{s}' is not a number"))
+}
+
+#[test]
+fn demo_report_matches_the_readme() {
+    let d = tempfile::tempdir().unwrap();
+    let out = d.path().join("report");
+    let o = Command::new(env!("CARGO_BIN_EXE_mmbm"))
+        .args(["demo", "--quiet", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    let frames = std::fs::read_to_string(out.join("frames.csv")).unwrap();
+    // The report leads with sharp frames per second, computed sentences after it.
+    let first = report.find("## ").unwrap();
+    assert!(report[first..].starts_with("## Headline: sharp frames per second"));
+    assert!(report.contains("so no policy at that rate can exceed"));
+    assert!(report.contains("`phase:0.4` recovers"));
+    assert!(report.contains("## Image metrics against the ground truth"));
+    // Every kept frame of the 12 policies rendered, with the new columns.
+    let header = frames.lines().next().unwrap();
+    assert!(
+        header.ends_with("blur_h_px,blur_v_px,jnbm_2d,cpbd_2d,gain"),
+        "{header}"
+    );
+    let rendered = header.split(',').position(|c| c == "rendered").unwrap();
+    let cells = |l: &str| l.split(',').nth(rendered).map(str::to_string);
+    let n = frames
+        .lines()
+        .skip(1)
+        .filter(|l| cells(l).as_deref() == Some("1"))
+        .count();
+    // 832 triggered, 17 of them discarded by gate:0.8.
+    assert_eq!((frames.lines().count() - 1, n), (832, 815));
+
+    // Table 6 of the report: policy -> cells.
+    let header6: Vec<&str> = rows(&report, "| walk | policy | frames kept")[0].clone();
+    let col = |name: &str| header6.iter().position(|h| *h == name).unwrap();
+    let t6: HashMap<&str, Vec<&str>> = rows(&report, "| moderate |")
+        .into_iter()
+        .filter(|r| r.len() == header6.len())
+        .map(|r| (r[1], r))
+        .collect();
+    let readme =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/README.md")).unwrap();
+    let section = &readme[readme.find("#### What the demo finds").unwrap()..];
+    let start = section.find("| policy |").unwrap();
+    let section = &section[start..start + section[start..].find("\n\n").unwrap()];
+    let quoted = rows(section, "| ");
+    // The header and 12 policies (the |---| rule does not start with "| ").
+    assert_eq!(quoted.len(), 13, "{section}");
+    for r in quoted.iter().skip(1) {
+        let got = &t6[r[0]];
+        let cmp = |readme_cell: &str, name: &str, tol: f64| {
+            let (a, b) = (num(readme_cell), num(got[col(name)]));
+            assert!(
+                (a - b).abs() <= tol,
+                "{}: README {a} vs demo {b} ({name})",
+                r[0]
+            );
+        };
+        cmp(r[1], "frames kept", 0.0);
+        cmp(r[2], "success %", 0.051);
+        cmp(r[3], "success % fixed threshold", 0.051);
+        cmp(r[4], "mean blur px", 0.051);
+        cmp(r[5], "p95 blur px", 0.051);
+        cmp(r[6], "mean blur effect", 0.0006);
+        cmp(r[7], "mean JNBM", 0.0006);
+    }
+}
