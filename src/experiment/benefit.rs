@@ -266,11 +266,8 @@ pub fn headline_md(hs: &[Headline], policies: &[String]) -> String {
         }
         // The ceiling: at the baseline's rate no policy gets more frames.
         let fps = base.as_ref().and_then(|b| {
-            b.strip_prefix("fixed:")?
-                .split('@')
-                .next()?
-                .parse::<f64>()
-                .ok()
+            let rate = b.strip_prefix("fixed:")?;
+            crate::trigger::parse_rate(rate, b).ok().map(|(fps, _)| fps)
         });
         let bh = hs
             .iter()
@@ -298,14 +295,7 @@ pub fn headline_md(hs: &[Headline], policies: &[String]) -> String {
         .iter()
         .filter(|h| h.policy.starts_with("forecast:") || h.policy.starts_with("phase:"))
     {
-        let x = h
-            .policy
-            .split(':')
-            .nth(1)
-            .unwrap_or("")
-            .split(':')
-            .next()
-            .unwrap_or("");
+        let x = h.policy.split(':').nth(1).unwrap_or("");
         let find = |name: String| hs.iter().find(|o| o.gait == h.gait && o.policy == name);
         if let (Some(t), Some(o)) = (find(format!("threshold:{x}")), find(format!("oracle:{x}"))) {
             let gain = t.blur_px.value - o.blur_px.value;

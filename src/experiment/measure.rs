@@ -164,13 +164,26 @@ pub struct ImageMetrics {
 /// Computes the image metrics of an sRGB frame.
 pub fn image_metrics(img: &image::RgbImage) -> ImageMetrics {
     let gray = crate::assess::luma(img);
-    ImageMetrics {
-        jnbm: crate::assess::jnbm(&gray).unwrap_or(f64::NAN),
-        cpbd: crate::assess::cpbd(&gray).unwrap_or(f64::NAN),
-        jnbm_2d: crate::assess::jnbm_2d(&gray).unwrap_or(f64::NAN),
-        cpbd_2d: crate::assess::cpbd_2d(&gray).unwrap_or(f64::NAN),
-        blur_effect: crate::assess::blur_effect(&gray).unwrap_or(f64::NAN),
-        laplacian_var: crate::assess::laplacian_var(&gray).unwrap_or(f64::NAN),
+    // All six at once (each metric shares its edge maps with its 2d variant);
+    // an image without a whole 64x64 block has no JNBM or CPBD, but may
+    // still have the other two.
+    match crate::assess::assess(&gray) {
+        Ok(a) => ImageMetrics {
+            jnbm: a.jnbm.unwrap_or(f64::NAN),
+            cpbd: a.cpbd,
+            jnbm_2d: a.jnbm_2d.unwrap_or(f64::NAN),
+            cpbd_2d: a.cpbd_2d,
+            blur_effect: a.blur_effect,
+            laplacian_var: a.laplacian_var,
+        },
+        Err(_) => ImageMetrics {
+            jnbm: f64::NAN,
+            cpbd: f64::NAN,
+            jnbm_2d: f64::NAN,
+            cpbd_2d: f64::NAN,
+            blur_effect: crate::assess::blur_effect(&gray).unwrap_or(f64::NAN),
+            laplacian_var: crate::assess::laplacian_var(&gray).unwrap_or(f64::NAN),
+        },
     }
 }
 
@@ -368,25 +381,32 @@ pub fn render_and_measure(
 }
 
 /// Mean horizontal and vertical path lengths (px) over the exposure: the
-/// tracks of the blur maps ([`render::maps::track`], 64 steps) of the pixel
+/// tracks of the blur maps ([`render::maps::tracks`], 64 steps) of the pixel
 /// centres of a 32 x 24 grid, summing `|dx|` and `|dy|` along each (pixels
 /// whose track is lost are left out). Their sum bounds the path length from
 /// above (a diagonal track counts in both).
 pub fn axis_blur(cam: &Camera, target: &Target, traj: &Trajectory) -> (f64, f64) {
     let (nx, ny) = (32, 24);
+    let points: Vec<(f64, f64)> = (0..ny)
+        .flat_map(|j| {
+            (0..nx).map(move |i| {
+                (
+                    (i as f64 + 0.5) * cam.width as f64 / nx as f64,
+                    (j as f64 + 0.5) * cam.height as f64 / ny as f64,
+                )
+            })
+        })
+        .collect();
     let (mut h, mut v, mut n) = (0.0, 0.0, 0usize);
-    for j in 0..ny {
-        for i in 0..nx {
-            let x = (i as f64 + 0.5) * cam.width as f64 / nx as f64;
-            let y = (j as f64 + 0.5) * cam.height as f64 / ny as f64;
-            if let Some(tr) = render::maps::track(cam, target, traj, x, y, 64) {
-                for w in tr.windows(2) {
-                    h += (w[1].0 - w[0].0).abs();
-                    v += (w[1].1 - w[0].1).abs();
-                }
-                n += 1;
-            }
+    for tr in render::maps::tracks(cam, target, traj, &points, 64)
+        .into_iter()
+        .flatten()
+    {
+        for w in tr.windows(2) {
+            h += (w[1].0 - w[0].0).abs();
+            v += (w[1].1 - w[0].1).abs();
         }
+        n += 1;
     }
     if n == 0 {
         (f64::NAN, f64::NAN)

@@ -3,7 +3,7 @@
 //! blur into horizontal and vertical motion. Every sentence is computed.
 
 use super::measure::{FrameMeasure, FrameRecord};
-use crate::stats::spearman;
+use crate::stats::{mean, spearman};
 
 /// One image metric: its name, whether higher means sharper, and its value.
 struct Metric {
@@ -65,7 +65,7 @@ pub fn metrics_md(records: &[FrameRecord]) -> String {
     );
     let finite_mean = |x: &[f64]| {
         let f: Vec<f64> = x.iter().copied().filter(|v| v.is_finite()).collect();
-        f.iter().sum::<f64>() / f.len().max(1) as f64
+        mean(&f).unwrap_or(0.0)
     };
     let (mh, mv) = (finite_mean(&h), finite_mean(&v));
     let vshare = 100.0 * mv / (mh + mv);
@@ -97,16 +97,17 @@ pub fn metrics_md(records: &[FrameRecord]) -> String {
         let (rb, rh, rv) = (spearman(&x, &blur), spearman(&x, &h), spearman(&x, &v));
         // Oriented so that positive = follows the truth.
         let sign = if m.sharper_is_higher { -1.0 } else { 1.0 };
-        let verdict = match rb.map(|r| sign * r) {
-            None => "undefined".to_string(),
-            Some(r) if r >= 0.5 => "follows the blur".into(),
-            Some(r) if r > 0.0 => "follows it weakly".into(),
+        let oriented = rb.map(|r| sign * r);
+        let verdict = match oriented {
+            None => "undefined",
+            Some(r) if r >= 0.5 => "follows the blur",
+            Some(r) if r > 0.0 => "follows it weakly",
             Some(_) => {
                 wrong.push(m.name);
-                "wrong direction".into()
+                "wrong direction"
             }
         };
-        if let Some(r) = rb.map(|r| sign * r) {
+        if let Some(r) = oriented {
             if best.is_none_or(|(_, b)| r > b) {
                 best = Some((m.name, r));
             }

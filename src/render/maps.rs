@@ -107,12 +107,34 @@ pub fn track(
     y: f64,
     steps: usize,
 ) -> Option<Vec<(f64, f64)>> {
+    track_from(cam, target, &inv_poses(traj, steps), x, y)
+}
+
+/// [`track`] for many pixel positions `points` (px), the poses computed once.
+pub fn tracks(
+    cam: &Camera,
+    target: &Target,
+    traj: &Trajectory,
+    points: &[(f64, f64)],
+    steps: usize,
+) -> Vec<Option<Vec<(f64, f64)>>> {
+    let poses = inv_poses(traj, steps);
+    points
+        .iter()
+        .map(|&(x, y)| track_from(cam, target, &poses, x, y))
+        .collect()
+}
+
+fn track_from(
+    cam: &Camera,
+    target: &Target,
+    poses: &[(DMat3, DVec3)],
+    x: f64,
+    y: f64,
+) -> Option<Vec<(f64, f64)>> {
     let id: Pose = (glam::DQuat::IDENTITY, DVec3::ZERO);
     let p0 = target.intersect(cam, &id, x, y)?;
-    inv_poses(traj, steps)
-        .iter()
-        .map(|p| proj(cam, p, p0))
-        .collect()
+    poses.iter().map(|p| proj(cam, p, p0)).collect()
 }
 
 fn path_disp(

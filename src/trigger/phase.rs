@@ -313,9 +313,7 @@ impl Policy for Phase {
         Ok(())
     }
     fn decide(&mut self, obs: &Observation) -> bool {
-        let last = self.hist.last_time().unwrap_or(f64::NEG_INFINITY);
-        let new = obs.t.partition_point(|&s| s <= last);
-        for k in new..obs.t.len() {
+        for k in obs.unseen(self.hist.last_time()) {
             self.push(obs.t[k], obs.mmbm[k]);
         }
         let (t0, now) = (obs.t0, obs.now());

@@ -52,6 +52,13 @@ impl Observation<'_> {
         self.mmbm[self.mmbm.len() - 1]
     }
 
+    /// Indices into `t` / `mmbm` of the samples after time `last` (s): the
+    /// ones a policy that keeps its own history has not seen yet.
+    pub fn unseen(&self, last: Option<f64>) -> std::ops::Range<usize> {
+        let last = last.unwrap_or(f64::NEG_INFINITY);
+        self.t.partition_point(|&s| s <= last)..self.t.len()
+    }
+
     /// Time of the sample before the decision sample, s.
     pub fn previous_time(&self) -> Option<f64> {
         self.t.len().checked_sub(2).map(|k| self.t[k])

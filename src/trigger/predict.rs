@@ -252,9 +252,7 @@ impl Policy for Forecast {
         Ok(())
     }
     fn decide(&mut self, obs: &Observation) -> bool {
-        let last = self.hist.last_time().unwrap_or(f64::NEG_INFINITY);
-        let new = obs.t.partition_point(|&s| s <= last);
-        for k in new..obs.t.len() {
+        for k in obs.unseen(self.hist.last_time()) {
             self.hist.push(obs.t[k], obs.mmbm[k]);
         }
         // The forecast looks back at most WINDOW (period estimate) or a
