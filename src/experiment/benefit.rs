@@ -16,6 +16,7 @@
 use super::measure::FrameRecord;
 use super::walk::Walk;
 use crate::stats::percentile;
+use crate::trigger::{Family, PolicySpec};
 use rand::{Rng, SeedableRng};
 
 /// Block length, s.
@@ -41,8 +42,8 @@ pub struct Estimate {
 pub struct Headline {
     /// Gait (or log) name.
     pub gait: String,
-    /// Policy string.
-    pub policy: String,
+    /// The policy.
+    pub policy: PolicySpec,
     /// Seeds pooled.
     pub seeds: Vec<u64>,
     /// Blocks resampled.
@@ -66,11 +67,11 @@ struct Block {
 }
 
 /// The baseline policy: `fixed:5` if run, else the first `fixed:*`.
-pub fn baseline(policies: &[String]) -> Option<usize> {
+pub fn baseline(policies: &[PolicySpec]) -> Option<usize> {
     policies
         .iter()
-        .position(|p| p == "fixed:5")
-        .or_else(|| policies.iter().position(|p| super::measure::is_baseline(p)))
+        .position(|p| p.as_str() == "fixed:5")
+        .or_else(|| policies.iter().position(|p| p.is_baseline()))
 }
 
 fn estimate(value: f64, mut draws: Vec<f64>) -> Estimate {
@@ -91,7 +92,11 @@ fn estimate(value: f64, mut draws: Vec<f64>) -> Estimate {
 }
 
 /// The headline of every gait and policy (policies in configuration order).
-pub fn headlines(walks: &[Walk], records: &[FrameRecord], policies: &[String]) -> Vec<Headline> {
+pub fn headlines(
+    walks: &[Walk],
+    records: &[FrameRecord],
+    policies: &[PolicySpec],
+) -> Vec<Headline> {
     let mut gaits: Vec<&str> = Vec::new();
     for w in walks {
         if !gaits.contains(&w.gait.as_str()) {
@@ -119,7 +124,7 @@ pub fn headlines(walks: &[Walk], records: &[FrameRecord], policies: &[String]) -
             }
             for r in records.iter().filter(|r| r.walk == w.name) {
                 let (Some(pi), Some(m)) = (
-                    policies.iter().position(|p| *p == r.frame.policy),
+                    policies.iter().position(|p| p.as_str() == r.frame.policy),
                     r.measure.as_ref(),
                 ) else {
                     continue;
@@ -169,7 +174,7 @@ pub fn headlines(walks: &[Walk], records: &[FrameRecord], policies: &[String]) -
             });
             let recs = records
                 .iter()
-                .filter(|r| &r.frame.policy == p && ws.iter().any(|w| w.name == r.walk));
+                .filter(|r| r.frame.policy == p.as_str() && ws.iter().any(|w| w.name == r.walk));
             let (mut rendered, mut kept) = (0, 0);
             for r in recs {
                 kept += usize::from(r.frame.kept);
@@ -201,7 +206,7 @@ fn ci(e: &Estimate, digits: usize) -> String {
 
 /// The headline section of the report (its numbers and its sentences both
 /// computed from `hs`).
-pub fn headline_md(hs: &[Headline], policies: &[String]) -> String {
+pub fn headline_md(hs: &[Headline], policies: &[PolicySpec]) -> String {
     let mut s = String::from("## Headline: sharp frames per second\n\n");
     let Some(first) = hs.first() else {
         return s + "No frames.\n\n";
@@ -245,7 +250,7 @@ pub fn headline_md(hs: &[Headline], policies: &[String]) -> String {
         let best = hs
             .iter()
             .filter(|h| h.gait == g && Some(&h.policy) != base.as_ref())
-            .filter(|h| crate::trigger::parse_policy(&h.policy).is_ok_and(|p| p.is_causal()))
+            .filter(|h| h.policy.is_causal())
             .filter_map(|h| h.ratio.map(|r| (h, r)))
             .max_by(|a, b| a.1.value.total_cmp(&b.1.value));
         if let (Some((h, r)), Some(b)) = (best, &base) {
@@ -265,10 +270,7 @@ pub fn headline_md(hs: &[Headline], policies: &[String]) -> String {
             );
         }
         // The ceiling: at the baseline's rate no policy gets more frames.
-        let fps = base.as_ref().and_then(|b| {
-            let rate = b.strip_prefix("fixed:")?;
-            crate::trigger::parse_rate(rate, b).ok().map(|(fps, _)| fps)
-        });
+        let fps = base.as_ref().and_then(|b| b.rate.map(|r| r.fps));
         let bh = hs
             .iter()
             .find(|h| h.gait == g && Some(&h.policy) == base.as_ref());
@@ -291,13 +293,22 @@ pub fn headline_md(hs: &[Headline], policies: &[String]) -> String {
     }
     // The predictors' share of the oracle's gain (blur) over the thesis rule,
     // for every forecast:X or phase:X run beside threshold:X and oracle:X.
-    for h in hs
-        .iter()
-        .filter(|h| h.policy.starts_with("forecast:") || h.policy.starts_with("phase:"))
-    {
-        let x = h.policy.split(':').nth(1).unwrap_or("");
-        let find = |name: String| hs.iter().find(|o| o.gait == h.gait && o.policy == name);
-        if let (Some(t), Some(o)) = (find(format!("threshold:{x}")), find(format!("oracle:{x}"))) {
+    // (Without exposure control: the comparison is between decision rules.)
+    for h in hs.iter().filter(|h| {
+        matches!(h.policy.family, Family::Forecast | Family::Phase) && h.policy.exposure.is_none()
+    }) {
+        // The thesis rule and the oracle at the same threshold (the oracle at
+        // its default horizon), neither with exposure control.
+        let find = |family: Family| {
+            hs.iter().find(|o| {
+                o.gait == h.gait
+                    && o.policy.family == family
+                    && o.policy.threshold == h.policy.threshold
+                    && o.policy.exposure.is_none()
+                    && (family != Family::Oracle || o.policy.horizon == Some(0.2))
+            })
+        };
+        if let (Some(t), Some(o)) = (find(Family::Threshold), find(Family::Oracle)) {
             let gain = t.blur_px.value - o.blur_px.value;
             if gain > 0.0 {
                 s += &format!(
@@ -386,7 +397,10 @@ mod tests {
 
     #[test]
     fn paired_ratio_and_intervals() {
-        let policies = vec!["fixed:5".to_string(), "threshold:0.4".to_string()];
+        let policies: Vec<PolicySpec> = ["fixed:5", "threshold:0.4"]
+            .iter()
+            .map(|p| p.parse().unwrap())
+            .collect();
         let walks = vec![walk(1), walk(2)];
         // Same pattern in every 2-s block: fixed 10 frames, 5 sharp (2.5/s,
         // blur 4 px); threshold 8 frames, all sharp (4/s, blur 2 px).

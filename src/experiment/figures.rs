@@ -11,6 +11,7 @@ use crate::io::atomic::write_atomic_path;
 use crate::io::images::{linear_to_srgb8, save_rgb8};
 use crate::metric::Scene;
 use crate::plot::{ensure_font, plot_error};
+use crate::trigger::Family;
 use plotters::prelude::*;
 use std::collections::HashMap;
 use std::path::Path;
@@ -44,10 +45,9 @@ pub fn write_all(
             (t0 + 8.0).min(t.last().copied().unwrap_or(t0 + 8.0)),
         );
         for (p, frames) in &w.runs {
-            if !(super::measure::is_baseline(p)
-                || p == "threshold:0.4"
-                || p.starts_with("oracle")
-                || p.starts_with("phase"))
+            if !(p.is_baseline()
+                || p.is_thesis_rule()
+                || matches!(p.family, Family::Oracle | Family::Phase))
             {
                 continue;
             }
@@ -56,15 +56,11 @@ pub fn write_all(
                 .filter(|f| f.kept)
                 .map(|f| (f.trigger_t, f.exposure_start, f.exposure_end))
                 .collect();
-            let th = p
-                .split(':')
-                .nth(1)
-                .and_then(|x| x.parse::<f64>().ok())
-                .filter(|_| !p.starts_with("fixed"));
+            let th = p.threshold_mm_s();
             let name = format!(
                 "trace_{}_{}.png",
                 w.name,
-                p.replace([':', '.', '@', '+'], "_")
+                p.as_str().replace([':', '.', '@', '+'], "_")
             );
             mmbm_trace(
                 &out.join(&name),
@@ -86,10 +82,10 @@ pub fn write_all(
             .map(|(p, _)| {
                 let v = records
                     .iter()
-                    .filter(|r| r.walk == w.name && &r.frame.policy == p)
+                    .filter(|r| r.walk == w.name && r.frame.policy == p.as_str())
                     .filter_map(|r| r.measure.as_ref().map(|m| m.blur_px))
                     .collect();
-                (p.clone(), v)
+                (p.to_string(), v)
             })
             .collect();
         let name = format!("blur_hist_{}.png", w.name);

@@ -10,12 +10,6 @@ use crate::render::{self, Backend, Quality, RenderJob, Target, Trajectory};
 use crate::trigger::Frame;
 use std::time::Instant;
 
-/// True for a plain fixed-rate policy (`fixed:FPS[@PHASE]`), the baseline
-/// the others are compared with; `fixed:5+exp:2` (exposure control) is not.
-pub fn is_baseline(policy: &str) -> bool {
-    policy.starts_with("fixed") && !policy.contains('+')
-}
-
 /// A 2-D point: board coordinates (m) or pixel coordinates (px).
 type Point2 = (f64, f64);
 

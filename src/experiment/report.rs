@@ -3,10 +3,10 @@
 //! 5.1, 6.1 and 6.2 recomputed per walk and policy).
 
 use super::config::ExperimentConfig;
-use super::measure::{is_baseline, FrameMeasure, FrameRecord};
+use super::measure::{FrameMeasure, FrameRecord};
 use super::walk::Walk;
 use crate::stats;
-use crate::trigger::{prediction_error, summary_over};
+use crate::trigger::{prediction_error, summary_over, PolicySpec};
 use std::fmt::Write as _;
 
 /// Columns of `frames.csv` (the first six are the contract).
@@ -87,7 +87,7 @@ pub struct PolicyStats {
     /// Walk name.
     pub walk: String,
     /// Policy string.
-    pub policy: String,
+    pub policy: PolicySpec,
     /// Frames triggered.
     pub triggered: usize,
     /// Frames kept (a gate discards some).
@@ -142,7 +142,7 @@ pub fn policy_stats(walks: &[Walk], records: &[FrameRecord]) -> Vec<PolicyStats>
         for (p, frames) in &w.runs {
             let rs: Vec<_> = records
                 .iter()
-                .filter(|r| r.walk == w.name && &r.frame.policy == p)
+                .filter(|r| r.walk == w.name && r.frame.policy == p.as_str())
                 .filter_map(|r| r.measure.as_ref())
                 .collect();
             let blur: Vec<f64> = rs.iter().map(|m| m.blur_px).collect();
@@ -241,7 +241,7 @@ pub fn table_6(stats: &[PolicyStats]) -> String {
     for st in stats {
         let fixed = stats
             .iter()
-            .find(|x| x.walk == st.walk && is_baseline(&x.policy))
+            .find(|x| x.walk == st.walk && x.policy.is_baseline())
             .map(|x| x.kept as i64);
         let lost = fixed.map_or("-".into(), |k| (k - st.kept as i64).to_string());
         let succ = st.success_pct();
@@ -297,7 +297,7 @@ pub fn baseline_note(stats: &[PolicyStats]) -> String {
     let mut s = String::new();
     for st in stats
         .iter()
-        .filter(|x| is_baseline(&x.policy) && x.rendered > 0)
+        .filter(|x| x.policy.is_baseline() && x.rendered > 0)
     {
         let pct = |k: usize| 100.0 * k as f64 / st.rendered as f64;
         let _ = write!(
@@ -347,10 +347,10 @@ pub fn quality_note(cfg: &ExperimentConfig, check: Option<(f64, f64, f64)>) -> S
 /// Prose: what the simulation found, compared with the thesis.
 pub fn findings(stats: &[PolicyStats]) -> String {
     let mut s = String::from("## Findings\n\n");
-    for st in stats.iter().filter(|x| is_baseline(&x.policy)) {
+    for st in stats.iter().filter(|x| x.policy.is_baseline()) {
         let others: Vec<&PolicyStats> = stats
             .iter()
-            .filter(|x| x.walk == st.walk && !is_baseline(&x.policy))
+            .filter(|x| x.walk == st.walk && !x.policy.is_baseline())
             .collect();
         s += &format!(
             "- {} walk, baseline `{}`: {} frames, blob success {:.0} %, mean JNBM {:.3}, mean blur {:.1} px (p95 {:.1}).\n",
@@ -370,20 +370,21 @@ pub fn findings(stats: &[PolicyStats]) -> String {
         }
     }
     // The headline comparison of the thesis: fixed 5 fps against MMBM triggering at 0.4.
-    for base in stats.iter().filter(|x| is_baseline(&x.policy)) {
+    for base in stats.iter().filter(|x| x.policy.is_baseline()) {
         let Some(th) = stats
             .iter()
-            .find(|x| x.walk == base.walk && x.policy == "threshold:0.4")
+            .find(|x| x.walk == base.walk && x.policy.is_thesis_rule())
         else {
             continue;
         };
         s += &format!(
-            "\nOn the {} walk, MMBM triggering at 0.4 mm/s (`threshold:0.4`, the thesis rule) against `{}`: \
+            "\nOn the {} walk, MMBM triggering at 0.4 mm/s (`{}`, the thesis rule) against `{}`: \
              blob success {:.0} % -> {:.0} %, mean ground-truth blur {:.1} -> {:.1} px (p95 {:.1} -> {:.1}), \
              mean blur effect {:.3} -> {:.3} (lower = sharper), mean JNBM {:.3} -> {:.3}, with {} instead of {} frames. \
              The thesis (real SensoRHex, chapter 6) found blob success rising from about 50 % to 62-82 % and mean \
              JNBM from 0.36 to 0.49.\n",
             base.walk,
+            th.policy,
             base.policy,
             base.success_pct(),
             th.success_pct(),
@@ -428,7 +429,7 @@ pub fn report_md(
         "Rendered {rendered} frames in {seconds:.1} s (mean render {mean_ms:.0} ms per frame, quality preset `{}`).\n\n",
         cfg.quality
     );
-    let policies: Vec<String> = walks
+    let policies: Vec<PolicySpec> = walks
         .first()
         .map(|w| w.runs.iter().map(|(p, _)| p.clone()).collect())
         .unwrap_or_default();

@@ -38,7 +38,7 @@ pub fn exposure_sweep(
     let Some((_, frames)) = walk
         .runs
         .iter()
-        .find(|(p, _)| super::measure::is_baseline(p))
+        .find(|(p, _)| p.is_baseline())
         .or_else(|| walk.runs.first())
     else {
         return Ok(Vec::new());

@@ -6,7 +6,7 @@ use crate::error::Result;
 use crate::io::gyro::{read_log, GyroOptions, GyroSample};
 use crate::metric::{Method, Scene};
 use crate::sim::{simulate, Gait, GaitConfig};
-use crate::trigger::{self, parse_policy, CameraTiming, Frame};
+use crate::trigger::{self, CameraTiming, Frame, PolicySpec};
 use std::str::FromStr;
 
 /// One walk (simulated or a real log) with its MMBM series and every policy's frames.
@@ -26,7 +26,7 @@ pub struct Walk {
     /// Distance to the target per sample, m.
     pub distance: Vec<f64>,
     /// `(policy, frames)` in configuration order.
-    pub runs: Vec<(String, Vec<Frame>)>,
+    pub runs: Vec<(PolicySpec, Vec<Frame>)>,
 }
 
 /// Builds a walk from the configuration: the simulation of `gait` with
@@ -69,9 +69,9 @@ pub fn make_walk(
     let timing = timing(cfg);
     let mut runs = Vec::new();
     for p in &cfg.policies {
-        let mut policy = parse_policy(p)?;
-        let frames = trigger::run(&samples, &mmbm, policy.as_mut(), &timing)?;
-        runs.push((p.clone(), frames));
+        let spec = PolicySpec::parse(p)?;
+        let frames = trigger::run(&samples, &mmbm, spec.build().as_mut(), &timing)?;
+        runs.push((spec, frames));
     }
     let seed = if cfg.gyro.is_some() { 0 } else { seed };
     Ok(Walk {

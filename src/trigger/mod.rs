@@ -57,8 +57,7 @@ mod timing;
 
 pub use exposure::Exposure;
 pub use live::{Event, Live};
-pub use parse::parse_policy;
-pub(crate) use parse::parse_rate;
+pub use parse::{parse_policy, ExposureControl, Family, PolicySpec, Rate, THESIS_POLICY};
 pub use phase::Phase;
 pub use policy::{Level, LogView, Observation, Policy};
 pub use predict::{Forecast, Oracle};

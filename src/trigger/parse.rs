@@ -1,5 +1,7 @@
 //! The policy parser: `name:args` strings (grammar in the module docs of
-//! [`crate::trigger`]) to boxed [`Policy`] values.
+//! [`crate::trigger`]) to a typed [`PolicySpec`], parsed once, which knows
+//! its family, rate, threshold, causality and exposure control, and builds
+//! the boxed [`Policy`] that runs.
 
 use super::exposure::Exposure;
 use super::phase::Phase;
@@ -49,7 +51,7 @@ fn parse_fps(s: &str, what: &str, spec: &str) -> Result<f64> {
 }
 
 /// Parses `FPS[@PHASE]`.
-pub(crate) fn parse_rate(s: &str, spec: &str) -> Result<(f64, f64)> {
+fn parse_rate(s: &str, spec: &str) -> Result<(f64, f64)> {
     let (f, p) = match s.split_once('@') {
         Some((f, p)) => (f, parse_num(p, "phase", spec)?),
         None => (s, 0.0),
@@ -68,78 +70,380 @@ const GRAMMAR: &str = "fixed:FPS[@PHASE], threshold:X, adaptive[:X[:FPS]], oracl
 forecast:X[:H], phase:X[:H], gate:X[:FPS[@PHASE]], gate0:X[:FPS[@PHASE]] or deadline:FPS[:X] (X in mm/s or pNN), \
 each optionally followed by +exp:B[:TMIN] (exposure control: blur budget B px, shortest exposure TMIN s)";
 
-/// Parses a policy string (grammar in the module docs). The policy keeps the
-/// string exactly as given for the `policy` column.
+/// Parses a policy string (grammar in the module docs) and builds the policy.
+/// The policy keeps the string exactly as given for the `policy` column.
 pub fn parse_policy(spec: &str) -> Result<Box<dyn Policy>> {
-    if let Some((base, modifier)) = spec.split_once('+') {
+    Ok(PolicySpec::parse(spec)?.build())
+}
+
+/// The thesis's rule at its threshold (thesis ch. 6): three falling MMBM
+/// samples below 0.4 mm/s.
+pub const THESIS_POLICY: &str = "threshold:0.4";
+
+/// The family of a policy (its name before the first `:`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Family {
+    /// `fixed:FPS[@PHASE]`.
+    Fixed,
+    /// `threshold:X`, the thesis rule.
+    Threshold,
+    /// `adaptive[:X[:FPS]]`.
+    Adaptive,
+    /// `oracle:X[:H]` (needs the future).
+    Oracle,
+    /// `forecast:X[:H]`.
+    Forecast,
+    /// `phase:X[:H]`.
+    Phase,
+    /// `gate:X[:FPS[@PHASE]]`.
+    Gate,
+    /// `gate0:X[:FPS[@PHASE]]`.
+    Gate0,
+    /// `deadline:FPS[:X]`.
+    Deadline,
+}
+
+impl Family {
+    /// The family's name as written in a policy string.
+    pub fn name(self) -> &'static str {
+        match self {
+            Family::Fixed => "fixed",
+            Family::Threshold => "threshold",
+            Family::Adaptive => "adaptive",
+            Family::Oracle => "oracle",
+            Family::Forecast => "forecast",
+            Family::Phase => "phase",
+            Family::Gate => "gate",
+            Family::Gate0 => "gate0",
+            Family::Deadline => "deadline",
+        }
+    }
+
+    fn from_name(s: &str) -> Option<Self> {
+        [
+            Family::Fixed,
+            Family::Threshold,
+            Family::Adaptive,
+            Family::Oracle,
+            Family::Forecast,
+            Family::Phase,
+            Family::Gate,
+            Family::Gate0,
+            Family::Deadline,
+        ]
+        .into_iter()
+        .find(|f| f.name() == s)
+    }
+}
+
+/// A frame rate with its phase.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Rate {
+    /// Frames per second, in `(0, MAX_FPS]`.
+    pub fps: f64,
+    /// Offset of the first slot after the log's start, s (`@PHASE`; 0 when not given).
+    pub phase: f64,
+}
+
+/// Exposure control (`+exp:B[:TMIN]`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ExposureControl {
+    /// Blur budget, px.
+    pub budget_px: f64,
+    /// Shortest exposure, s.
+    pub min_exposure_s: f64,
+}
+
+/// A policy string parsed once: what the experiment, the figures, the report,
+/// `live` and Python ask of a policy without re-reading its text.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PolicySpec {
+    text: String,
+    base: String,
+    /// The family.
+    pub family: Family,
+    /// The frame rate: the schedule's (`fixed`, `gate`, `gate0`, `deadline`;
+    /// 5 fps when a gate gives none) or the target (`adaptive`, default 2.5).
+    pub rate: Option<Rate>,
+    /// The MMBM threshold (every family but `fixed`; optional for `deadline`).
+    pub threshold: Option<Level>,
+    /// The forecast horizon, s (`oracle`, `forecast`, `phase`; default 0.2).
+    pub horizon: Option<f64>,
+    /// Exposure control, when the string ends in `+exp:B[:TMIN]`.
+    pub exposure: Option<ExposureControl>,
+}
+
+impl PolicySpec {
+    /// Parses a policy string (grammar in the module docs of [`crate::trigger`]).
+    pub fn parse(spec: &str) -> Result<Self> {
+        if let Some((base, modifier)) = spec.split_once('+') {
+            let bad = |msg: &str| {
+                Error::invalid("policy", format!("'{spec}': {msg}; expected {GRAMMAR}"))
+            };
+            let mut inner = PolicySpec::parse(base)?;
+            let parts: Vec<&str> = modifier.trim().split(':').collect();
+            let (budget, tmin) = match parts.as_slice() {
+                ["exp", b] => (*b, None),
+                ["exp", b, t] => (*b, Some(*t)),
+                _ => return Err(bad("after '+' expected exp:B[:TMIN]")),
+            };
+            let budget_px = parse_pos(budget, "blur budget (px)", spec)?;
+            let min_exposure_s = match tmin {
+                Some(t) => parse_pos(t, "shortest exposure (s)", spec)?,
+                None => Exposure::MIN_EXPOSURE,
+            };
+            inner.text = spec.to_string();
+            inner.exposure = Some(ExposureControl {
+                budget_px,
+                min_exposure_s,
+            });
+            return Ok(inner);
+        }
+        let parts: Vec<&str> = spec.trim().split(':').collect();
+        let name = parts[0].to_ascii_lowercase();
+        let args = &parts[1..];
         let bad =
             |msg: &str| Error::invalid("policy", format!("'{spec}': {msg}; expected {GRAMMAR}"));
-        let inner = parse_policy(base)?;
-        let parts: Vec<&str> = modifier.trim().split(':').collect();
-        let (budget, tmin) = match parts.as_slice() {
-            ["exp", b] => (*b, None),
-            ["exp", b, t] => (*b, Some(*t)),
-            _ => return Err(bad("after '+' expected exp:B[:TMIN]")),
+        let level = |s: &str| Level::parse(s.trim(), &format!("policy '{spec}' threshold"));
+        let rate = |r: &str| -> Result<Rate> {
+            let (fps, phase) = parse_rate(r, spec)?;
+            Ok(Rate { fps, phase })
         };
-        let budget = parse_pos(budget, "blur budget (px)", spec)?;
-        let tmin = match tmin {
-            Some(t) => parse_pos(t, "shortest exposure (s)", spec)?,
-            None => Exposure::MIN_EXPOSURE,
+        let fps_only = |f: &str, what: &str| -> Result<Rate> {
+            Ok(Rate {
+                fps: parse_fps(f, what, spec)?,
+                phase: 0.0,
+            })
         };
-        return Ok(Box::new(Exposure::new(spec, inner, budget, tmin)));
+        let Some(family) = Family::from_name(&name) else {
+            return Err(bad("unknown policy"));
+        };
+        let mut out = PolicySpec {
+            text: spec.to_string(),
+            base: spec.to_string(),
+            family,
+            rate: None,
+            threshold: None,
+            horizon: None,
+            exposure: None,
+        };
+        let default_gate = Rate {
+            fps: 5.0,
+            phase: 0.0,
+        };
+        match (family, args) {
+            (Family::Fixed, [r]) => out.rate = Some(rate(r)?),
+            (Family::Threshold, [x]) => out.threshold = Some(level(x)?),
+            (Family::Adaptive, []) => {
+                out.threshold = Some(Level::Abs(0.4));
+                out.rate = Some(fps_only("2.5", "target frame rate")?);
+            }
+            (Family::Adaptive, [x]) => {
+                out.threshold = Some(level(x)?);
+                out.rate = Some(fps_only("2.5", "target frame rate")?);
+            }
+            (Family::Adaptive, [x, f]) => {
+                out.threshold = Some(level(x)?);
+                out.rate = Some(fps_only(f, "target frame rate")?);
+            }
+            (Family::Oracle | Family::Forecast | Family::Phase, [x]) => {
+                out.threshold = Some(level(x)?);
+                out.horizon = Some(0.2);
+            }
+            (Family::Oracle | Family::Forecast | Family::Phase, [x, h]) => {
+                out.threshold = Some(level(x)?);
+                out.horizon = Some(parse_pos(h, "horizon", spec)?);
+            }
+            (Family::Gate | Family::Gate0, [x]) => {
+                out.threshold = Some(level(x)?);
+                out.rate = Some(default_gate);
+            }
+            (Family::Gate | Family::Gate0, [x, r]) => {
+                out.threshold = Some(level(x)?);
+                out.rate = Some(rate(r)?);
+            }
+            (Family::Deadline, [f]) => out.rate = Some(fps_only(f, "frame rate")?),
+            (Family::Deadline, [f, x]) => {
+                out.rate = Some(fps_only(f, "frame rate")?);
+                out.threshold = Some(level(x)?);
+            }
+            _ => return Err(bad("wrong number of ':' arguments")),
+        }
+        Ok(out)
     }
-    let parts: Vec<&str> = spec.trim().split(':').collect();
-    let name = parts[0].to_ascii_lowercase();
-    let args = &parts[1..];
-    let bad = |msg: &str| Error::invalid("policy", format!("'{spec}': {msg}; expected {GRAMMAR}"));
-    let level = |s: &str| Level::parse(s.trim(), &format!("policy '{spec}' threshold"));
-    let p: Box<dyn Policy> = match (name.as_str(), args) {
-        ("fixed", [r]) => {
-            let (fps, phase) = parse_rate(r, spec)?;
-            Box::new(Fixed::new(spec, fps, phase))
+
+    /// The string exactly as given (the `policy` column).
+    pub fn as_str(&self) -> &str {
+        &self.text
+    }
+
+    /// False for the policies that use knowledge of the future (the oracle).
+    pub fn is_causal(&self) -> bool {
+        self.family != Family::Oracle
+    }
+
+    /// True for a plain fixed-rate policy (`fixed:FPS[@PHASE]`), the baseline
+    /// the others are compared with; `fixed:5+exp:2` (exposure control) is not.
+    pub fn is_baseline(&self) -> bool {
+        self.family == Family::Fixed && self.exposure.is_none()
+    }
+
+    /// True for the thesis's rule at its threshold ([`THESIS_POLICY`], no exposure control).
+    pub fn is_thesis_rule(&self) -> bool {
+        self.family == Family::Threshold
+            && self.threshold == Some(Level::Abs(0.4))
+            && self.exposure.is_none()
+    }
+
+    /// The threshold in mm/s when it is one (not a percentile).
+    pub fn threshold_mm_s(&self) -> Option<f64> {
+        match self.threshold {
+            Some(Level::Abs(x)) => Some(x),
+            _ => None,
         }
-        ("threshold", [x]) => Box::new(Threshold::new(spec, level(x)?)),
-        ("adaptive", []) => Box::new(Adaptive::new(spec, Level::Abs(0.4), 2.5)),
-        ("adaptive", [x]) => Box::new(Adaptive::new(spec, level(x)?, 2.5)),
-        ("adaptive", [x, f]) => Box::new(Adaptive::new(
-            spec,
-            level(x)?,
-            parse_fps(f, "target frame rate", spec)?,
-        )),
-        ("oracle", [x]) => Box::new(Oracle::new(spec, level(x)?, 0.2)),
-        ("oracle", [x, h]) => {
-            Box::new(Oracle::new(spec, level(x)?, parse_pos(h, "horizon", spec)?))
+    }
+
+    /// The policy, ready to run (its `spec()` is [`Self::as_str`]).
+    pub fn build(&self) -> Box<dyn Policy> {
+        let inner = self.build_base();
+        match self.exposure {
+            Some(e) => Box::new(Exposure::new(
+                &self.text,
+                inner,
+                e.budget_px,
+                e.min_exposure_s,
+            )),
+            None => inner,
         }
-        ("forecast", [x]) => Box::new(Forecast::new(spec, level(x)?, 0.2)),
-        ("forecast", [x, h]) => Box::new(Forecast::new(
-            spec,
-            level(x)?,
-            parse_pos(h, "horizon", spec)?,
-        )),
-        ("phase", [x]) => Box::new(Phase::new(spec, level(x)?, 0.2)),
-        ("phase", [x, h]) => Box::new(Phase::new(spec, level(x)?, parse_pos(h, "horizon", spec)?)),
-        ("gate", [x]) => Box::new(Gate::new(spec, level(x)?, 5.0, 0.0)),
-        ("gate", [x, r]) => {
-            let (fps, phase) = parse_rate(r, spec)?;
-            Box::new(Gate::new(spec, level(x)?, fps, phase))
+    }
+
+    fn build_base(&self) -> Box<dyn Policy> {
+        let spec = self.base.as_str();
+        let level = self.threshold.unwrap_or(Level::Abs(0.0));
+        let rate = self.rate.unwrap_or(Rate {
+            fps: 5.0,
+            phase: 0.0,
+        });
+        let h = self.horizon.unwrap_or(0.2);
+        match self.family {
+            Family::Fixed => Box::new(Fixed::new(spec, rate.fps, rate.phase)),
+            Family::Threshold => Box::new(Threshold::new(spec, level)),
+            Family::Adaptive => Box::new(Adaptive::new(spec, level, rate.fps)),
+            Family::Oracle => Box::new(Oracle::new(spec, level, h)),
+            Family::Forecast => Box::new(Forecast::new(spec, level, h)),
+            Family::Phase => Box::new(Phase::new(spec, level, h)),
+            Family::Gate => Box::new(Gate::new(spec, level, rate.fps, rate.phase)),
+            Family::Gate0 => Box::new(Gate::at_start(spec, level, rate.fps, rate.phase)),
+            Family::Deadline => Box::new(Deadline::new(spec, rate.fps, self.threshold)),
         }
-        ("gate0", [x]) => Box::new(Gate::at_start(spec, level(x)?, 5.0, 0.0)),
-        ("gate0", [x, r]) => {
-            let (fps, phase) = parse_rate(r, spec)?;
-            Box::new(Gate::at_start(spec, level(x)?, fps, phase))
+    }
+}
+
+impl std::str::FromStr for PolicySpec {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self> {
+        PolicySpec::parse(s)
+    }
+}
+
+impl std::fmt::Display for PolicySpec {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.text)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn spec(s: &str) -> PolicySpec {
+        PolicySpec::parse(s).unwrap_or_else(|e| panic!("{s}: {e}"))
+    }
+
+    #[test]
+    fn typed_fields() {
+        let f = spec("fixed:5@0.1");
+        assert_eq!(f.family, Family::Fixed);
+        assert_eq!(
+            f.rate,
+            Some(Rate {
+                fps: 5.0,
+                phase: 0.1
+            })
+        );
+        assert!(f.is_baseline() && f.is_causal() && f.threshold.is_none());
+        let e = spec("fixed:5+exp:0.001:0.02");
+        assert!(!e.is_baseline());
+        assert_eq!(e.as_str(), "fixed:5+exp:0.001:0.02");
+        assert_eq!(
+            e.exposure,
+            Some(ExposureControl {
+                budget_px: 0.001,
+                min_exposure_s: 0.02
+            })
+        );
+        // `deadline:5` has a rate, not a 5 mm/s threshold.
+        let d = spec("deadline:5");
+        assert_eq!(d.threshold_mm_s(), None);
+        assert_eq!(d.rate.map(|r| r.fps), Some(5.0));
+        assert_eq!(
+            spec("deadline:5:p30").threshold,
+            Some(Level::Percentile(30.0))
+        );
+        let o = spec("oracle:0.4");
+        assert!(!o.is_causal());
+        assert_eq!((o.threshold_mm_s(), o.horizon), (Some(0.4), Some(0.2)));
+        assert!(!spec("oracle:0.4+exp:3").is_causal());
+        assert_eq!(
+            spec("gate:0.5").rate,
+            Some(Rate {
+                fps: 5.0,
+                phase: 0.0
+            })
+        );
+        assert_eq!(spec("adaptive").rate.map(|r| r.fps), Some(2.5));
+        assert!(spec(THESIS_POLICY).is_thesis_rule());
+        assert!(!spec("threshold:0.4+exp:2").is_thesis_rule());
+        assert_eq!(spec("PHASE:0.3:0.5").family, Family::Phase);
+    }
+
+    #[test]
+    fn build_keeps_the_string_and_causality() {
+        for s in [
+            "fixed:5",
+            "threshold:p20",
+            "adaptive:0.4:3",
+            "oracle:0.4:0.3",
+            "forecast:0.4",
+            "phase:0.4",
+            "gate:0.4:5@0.1",
+            "gate0:0.4",
+            "deadline:5:0.3",
+            "deadline:5+exp:3:0.02",
+        ] {
+            let p = spec(s);
+            let b = p.build();
+            assert_eq!(b.spec(), s);
+            assert_eq!(b.is_causal(), p.is_causal(), "{s}");
+            assert_eq!(p.to_string(), s);
         }
-        ("deadline", [f]) => Box::new(Deadline::new(spec, parse_fps(f, "frame rate", spec)?, None)),
-        ("deadline", [f, x]) => Box::new(Deadline::new(
-            spec,
-            parse_fps(f, "frame rate", spec)?,
-            Some(level(x)?),
-        )),
-        (
-            "fixed" | "threshold" | "adaptive" | "oracle" | "forecast" | "phase" | "gate" | "gate0"
-            | "deadline",
-            _,
-        ) => return Err(bad("wrong number of ':' arguments")),
-        _ => return Err(bad("unknown policy")),
-    };
-    Ok(p)
+    }
+
+    #[test]
+    fn bad_strings_are_refused() {
+        for s in [
+            "",
+            "fixed",
+            "fixed:0",
+            "fixed:5:1",
+            "nope:1",
+            "threshold:-1",
+            "fixed:5+exp",
+            "fixed:5+exp:0",
+            "gate:0.4:5@-1",
+            "deadline:2000",
+        ] {
+            assert!(PolicySpec::parse(s).is_err(), "{s}");
+        }
+    }
 }
