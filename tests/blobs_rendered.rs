@@ -11,7 +11,7 @@ use mmbm::{Camera, Twist};
 fn frame(tw: Twist, distance: f64) -> image::RgbImage {
     let cam = Camera::thesis().with_resolution(320, 240);
     let traj = Trajectory::from_twist(tw, 0.07).unwrap();
-    let mut job = RenderJob::new(cam, traj, Target::parse("blobs", distance).unwrap());
+    let mut job = RenderJob::new(cam, 0.07, traj, Target::parse("blobs", distance).unwrap());
     job.quality = Quality::Custom {
         min_samples: 64,
         max_spacing_px: 0.5,

@@ -41,7 +41,7 @@ fn rolling_blur_maps_follow_each_lines_window() {
         ..Camera::thesis().with_resolution(64, 48)
     };
     let traj = Trajectory::from_log(&samples, t0, tr + te, false).unwrap();
-    let mut job = cpu(RenderJob::new(cam, traj, Target::checker(0.02, 2.0)));
+    let mut job = cpu(RenderJob::new(cam, te, traj, Target::checker(0.02, 2.0)));
     job.with_maps = true;
     let out = render_frame(&job).unwrap();
     let maps = out.maps.unwrap();
@@ -78,6 +78,7 @@ fn noisy_render_follows_photon_transfer_and_is_seeded() {
     let te = 0.07;
     let job = cpu(RenderJob::new(
         cam,
+        te,
         Trajectory::from_twist(Twist::rotation(0.0, 0.0, 0.0), te).unwrap(),
         Target::blobs(1.0, 40.0),
     ));
@@ -159,6 +160,7 @@ fn distorted_still_checker_matches_supersampled_reference() {
     ] {
         let mut job = cpu(RenderJob::new(
             cam,
+            0.01,
             Trajectory::from_twist(Twist::default(), 0.01).unwrap(),
             target.clone(),
         ));
@@ -196,6 +198,7 @@ fn distorted_track_speed_equals_the_flow_formula() {
     let te = 1e-3;
     let mut job = cpu(RenderJob::new(
         cam,
+        te,
         Trajectory::from_twist(tw, te).unwrap(),
         target,
     ));
@@ -231,8 +234,10 @@ fn readout_beyond_the_trajectory_is_a_clear_error() {
         "readout_s",
     )];
     for (cam, key) in cases {
+        // An exposure of 0.01 s needs 0.06 s of motion with this readout.
         let e = render_frame(&cpu(RenderJob::new(
             cam,
+            0.01,
             traj.clone(),
             Target::checker(0.02, 1.0),
         )))
@@ -274,6 +279,7 @@ fn defocus_disc_has_the_spec_diameter() {
         target.background = [0.0; 3];
         let job = cpu(RenderJob::new(
             cam,
+            0.01,
             Trajectory::from_twist(Twist::default(), 0.01).unwrap(),
             target,
         ));
@@ -321,6 +327,7 @@ fn defocus_disc_has_the_spec_diameter() {
     };
     let mut job = cpu(RenderJob::new(
         cam,
+        0.01,
         Trajectory::from_twist(Twist::default(), 0.01).unwrap(),
         Target::checker(0.02, 1.0),
     ));
@@ -329,4 +336,37 @@ fn defocus_disc_has_the_spec_diameter() {
         .unwrap_err()
         .to_string()
         .contains("lattice"));
+}
+
+/// The job's exposure is explicit: a trajectory that does not span the
+/// readout plus the exposure, or an exposure that is not positive, is refused.
+#[test]
+fn exposure_and_trajectory_must_agree() {
+    let cam = Camera {
+        shutter: Shutter {
+            readout_s: 0.01,
+            direction: Readout::TopToBottom,
+        },
+        ..Camera::thesis().with_resolution(32, 24)
+    };
+    let traj = Trajectory::from_twist(Twist::rotation(0.1, 0.0, 0.0), 0.03).unwrap();
+    let target = Target::checker(0.02, 1.0);
+    // 0.02 s exposure + 0.01 s readout = 0.03 s: renders.
+    assert!(render_frame(&cpu(RenderJob::new(
+        cam,
+        0.02,
+        traj.clone(),
+        target.clone()
+    )))
+    .is_ok());
+    for (te, key) in [
+        (0.03, "trajectory"),
+        (0.0, "exposure"),
+        (f64::NAN, "exposure"),
+    ] {
+        let e = render_frame(&cpu(RenderJob::new(cam, te, traj.clone(), target.clone())))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains(key), "{te}: {e}");
+    }
 }

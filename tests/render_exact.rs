@@ -102,7 +102,9 @@ fn render_with(
     seed: u32,
     integrator: Integrator,
 ) -> Vec<f32> {
-    let mut j = RenderJob::new(cam, Trajectory::from_twist(tw, te).unwrap(), target);
+    // The trajectory spans the readout (a rolling shutter's) plus the exposure.
+    let span = cam.shutter.readout_s + te;
+    let mut j = RenderJob::new(cam, te, Trajectory::from_twist(tw, span).unwrap(), target);
     j.quality = q;
     j.integrator = integrator;
     j.backend = Backend::Cpu { threads: None };
@@ -180,11 +182,10 @@ fn rolling_shutter_translation_equals_exact_line_windows() {
             .collect();
         let tw = Twist::new(DVec3::ZERO, DVec3::new(vx, vy, 0.0));
         for integrator in [Integrator::Analytic, Integrator::Lattice] {
-            // The trajectory spans readout + exposure.
             let img = render_with(
                 cam,
                 tw,
-                tr + te,
+                te,
                 Target::checker(s, d),
                 Quality::Default,
                 0,

@@ -18,12 +18,18 @@ fn scenes(tex: &std::path::Path) -> Vec<(&'static str, RenderJob)> {
     vec![
         (
             "checker 6-DoF",
-            RenderJob::new(cam, Trajectory::from_twist(tw6, 0.04).unwrap(), checker),
+            RenderJob::new(
+                cam,
+                0.04,
+                Trajectory::from_twist(tw6, 0.04).unwrap(),
+                checker,
+            ),
         ),
         (
             "blobs roll",
             RenderJob::new(
                 cam,
+                0.05,
                 Trajectory::from_twist(roll, 0.05).unwrap(),
                 Target::blobs(0.5, 1.5),
             ),
@@ -32,6 +38,7 @@ fn scenes(tex: &std::path::Path) -> Vec<(&'static str, RenderJob)> {
             "image 6-DoF",
             RenderJob::new(
                 cam,
+                0.03,
                 Trajectory::from_twist(tw6, 0.03).unwrap(),
                 image.clone(),
             ),
@@ -50,6 +57,7 @@ fn scenes(tex: &std::path::Path) -> Vec<(&'static str, RenderJob)> {
                     },
                     ..cam
                 },
+                0.03,
                 Trajectory::from_twist(tw6, 0.03).unwrap(),
                 Target::blobs(0.5, 1.5),
             ),
@@ -66,6 +74,7 @@ fn scenes(tex: &std::path::Path) -> Vec<(&'static str, RenderJob)> {
                     }),
                     ..cam
                 },
+                0.03,
                 Trajectory::from_twist(tw6, 0.03).unwrap(),
                 image.clone(),
             ),
@@ -82,6 +91,7 @@ fn scenes(tex: &std::path::Path) -> Vec<(&'static str, RenderJob)> {
                     },
                     ..cam
                 },
+                0.04,
                 Trajectory::from_twist(tw6, 0.06).unwrap(),
                 {
                     let mut c = Target::checker(0.03, 1.2);
@@ -179,7 +189,7 @@ fn golden_renders() {
     ];
     let mut failures = vec![];
     for (name, tr, target) in cases {
-        let mut job = RenderJob::new(cam, tr, target);
+        let mut job = RenderJob::new(cam, tr.duration(), tr, target);
         job.with_maps = false;
         let out = render::render_frame(&job).unwrap();
         let path = dir.join(name);

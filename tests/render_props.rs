@@ -9,7 +9,8 @@ use mmbm::render::{self, project, Backend, Quality, RenderJob, Target, Trajector
 use mmbm::{Camera, Plane, Scene, Twist};
 
 fn cpu_job(cam: Camera, tr: Trajectory, t: Target, q: Quality) -> RenderJob {
-    let mut j = RenderJob::new(cam, tr, t);
+    // Global shutter: the exposure is the whole trajectory.
+    let mut j = RenderJob::new(cam, tr.duration(), tr, t);
     j.backend = Backend::Cpu { threads: None };
     j.quality = q;
     j
@@ -66,7 +67,7 @@ fn mean_path_over_exposure_equals_time_averaged_mmbm() {
     for (tw, tol) in cases {
         let target = Target::checker(0.1, 1.5);
         let tr = Trajectory::from_twist(tw, te).unwrap();
-        let maps = render::blur_maps(&cam, &target, &tr, 512);
+        let maps = render::blur_maps(&cam, &target, &tr, te, 512);
         let m = maps.means();
         // time-averaged exact MMBM, 8-point midpoint in time
         let nt = 8;

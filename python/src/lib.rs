@@ -408,6 +408,7 @@ fn render<'py>(
     t.validate_for(&camera).map_err(err)?;
     let job = RenderJob {
         camera,
+        exposure_s: exposure,
         trajectory,
         target: t,
         quality: quality.parse::<Quality>().map_err(err)?,

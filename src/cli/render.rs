@@ -219,6 +219,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
     };
     let job = RenderJob {
         camera,
+        exposure_s: a.exposure,
         trajectory,
         target,
         quality: a.quality.parse::<Quality>()?,

@@ -243,12 +243,14 @@ fn write_rgb(dir: &Path, stem: &str, o: &RenderOutput) -> Result<()> {
 pub fn make(p: &ItemParams, src: &Sources, dir: &Path) -> Result<ItemMeasures> {
     let cam = camera(p.resolution);
     let s = samples(p, src)?;
-    let traj = Trajectory::from_log(&s, p.start_s, p.exposure_s, p.use_velocity)?;
+    // The motion spans the readout (none: dataset cameras are global-shutter) plus the exposure.
+    let span = cam.shutter.readout_s + p.exposure_s;
+    let traj = Trajectory::from_log(&s, p.start_s, span, p.use_velocity)?;
     let tex = src.textures_dir.join(&p.texture);
     let spec = format!("image:{}:{}", tex.display(), p.texture_width_m);
     let mut target = Target::parse(&spec, p.distance_m)?;
     target.tilt_deg = p.tilt_deg;
-    let mut job = RenderJob::new(cam, traj, target.clone());
+    let mut job = RenderJob::new(cam, p.exposure_s, traj, target.clone());
     job.quality = p.quality.parse::<Quality>()?;
     job.backend = Backend::Cpu { threads: None };
     job.seed = p.seed as u32;

@@ -310,7 +310,7 @@ pub fn render_and_measure(
         }
     }
     let target = Target::parse(&cfg.target, distance)?;
-    let mut job = RenderJob::new(cam, traj.clone(), target.clone());
+    let mut job = RenderJob::new(cam, exposure, traj.clone(), target.clone());
     job.quality = quality;
     // Many frames: a hardware GPU, else the CPU twin (see `Backend::Bulk`).
     job.backend = Backend::Bulk;

@@ -154,22 +154,23 @@ pub fn table_lines(cam: &Camera) -> u32 {
     }
 }
 
-/// Exposure of each line, s: the trajectory spans the first line's exposure
-/// start to the last line's exposure end, `readout + exposure`.
-pub fn line_exposure(cam: &Camera, trajectory: &Trajectory) -> f64 {
-    trajectory.duration() - cam.shutter.readout_s
-}
-
 /// Time (s after the trajectory's start) of instant `m` of `n` of table line
-/// `line`: the line's delay plus the step midpoint of its own exposure.
-/// Without a readout this is [`instant`].
-pub fn line_instant(cam: &Camera, trajectory: &Trajectory, line: u32, m: u32, n: u32) -> f64 {
+/// `line`: the line's delay plus the step midpoint of its own exposure of
+/// `exposure_s` seconds. Without a readout this is [`instant`].
+pub fn line_instant(
+    cam: &Camera,
+    trajectory: &Trajectory,
+    exposure_s: f64,
+    line: u32,
+    m: u32,
+    n: u32,
+) -> f64 {
     if cam.shutter.is_global() {
         return instant(trajectory, m, n);
     }
     let c = line as f64 + 0.5;
     let delay = cam.shutter.delay_s(c, c, cam.width, cam.height);
-    delay + line_exposure(cam, trajectory) * (m as f64 + 0.5) / n as f64
+    delay + exposure_s * (m as f64 + 0.5) / n as f64
 }
 
 /// Table entries per instant: 1, or 3 with defocus (`H`, `dH/dlx`, `dH/dly`).
@@ -182,11 +183,13 @@ pub fn table_stride(cam: &Camera) -> u32 {
 }
 
 /// The homography table: `n` instants for each of [`table_lines`] lines
-/// (line-major: instant `line * n + m`), [`table_stride`] entries each, for upload.
+/// (line-major: instant `line * n + m`) over each line's exposure of
+/// `exposure_s` seconds, [`table_stride`] entries each, for upload.
 pub fn homographies(
     cam: &Camera,
     target: &Target,
     trajectory: &Trajectory,
+    exposure_s: f64,
     n: u32,
 ) -> Vec<GpuHomography> {
     let lines = table_lines(cam);
@@ -198,7 +201,7 @@ pub fn homographies(
     };
     let mut out = Vec::with_capacity((lines * n * table_stride(cam)) as usize);
     for e in 0..lines * n {
-        let t = line_instant(cam, trajectory, e / n, e % n, n);
+        let t = line_instant(cam, trajectory, exposure_s, e / n, e % n, n);
         let pose = trajectory.pose_at(t);
         let h = homography(cam, target, &pose);
         out.push(entry(h, h.determinant().abs()));

@@ -203,11 +203,18 @@ pub fn max_path_px(cam: &Camera, target: &Target, traj: &Trajectory) -> f64 {
 /// steps so that a chord is well under a pixel, e.g. `max_path_px / 0.25`).
 ///
 /// With a rolling shutter each pixel's path is over its own line's window
-/// (the trajectory spans readout + exposure; SPEC 9) and the speed is the
-/// path over the line's exposure.
-pub fn blur_maps(cam: &Camera, target: &Target, traj: &Trajectory, steps: usize) -> BlurMaps {
+/// of `exposure_s` seconds (the trajectory spans readout + exposure; SPEC 9)
+/// and the speed is the path over the line's exposure. With a global
+/// shutter the window is the whole trajectory.
+pub fn blur_maps(
+    cam: &Camera,
+    target: &Target,
+    traj: &Trajectory,
+    exposure_s: f64,
+    steps: usize,
+) -> BlurMaps {
     if !cam.shutter.is_global() {
-        return blur_maps_rolling(cam, target, traj, steps);
+        return blur_maps_rolling(cam, target, traj, exposure_s, steps);
     }
     let poses = inv_poses(traj, steps.max(1));
     let (w, h) = (cam.width as usize, cam.height as usize);
@@ -234,9 +241,14 @@ pub fn blur_maps(cam: &Camera, target: &Target, traj: &Trajectory, steps: usize)
 
 /// [`blur_maps`] with a rolling shutter: one pose table per line (row or
 /// column), over that line's exposure window.
-fn blur_maps_rolling(cam: &Camera, target: &Target, traj: &Trajectory, steps: usize) -> BlurMaps {
+fn blur_maps_rolling(
+    cam: &Camera,
+    target: &Target,
+    traj: &Trajectory,
+    te: f64,
+    steps: usize,
+) -> BlurMaps {
     let steps = steps.max(1);
-    let te = traj.duration() - cam.shutter.readout_s;
     let rows = cam.shutter.direction.is_rows();
     let (w, h) = (cam.width as usize, cam.height as usize);
     let (lines, len) = if rows { (h, w) } else { (w, h) };

@@ -47,17 +47,21 @@ pub const MAX_PIXEL_SAMPLES: u64 = 1 << 40;
 /// Most entries of a rolling-shutter homography table (lines x instants; 48 bytes each).
 pub const MAX_TABLE: u64 = 1 << 21;
 
-/// Checks what the renderer supports of the camera: a readout shorter than
-/// the trajectory (which spans readout + exposure).
-fn check_camera(cam: &Camera, trajectory: &Trajectory) -> Result<()> {
-    let te = kernel::line_exposure(cam, trajectory);
-    if te.is_nan() || te <= 0.0 {
+/// Checks the job's timing: a positive exposure, and a trajectory that spans
+/// the camera's readout plus the exposure (first line's exposure start to the
+/// last line's exposure end).
+fn check_timing(job: &RenderJob) -> Result<()> {
+    crate::error::positive("exposure", job.exposure_s)?;
+    let readout = job.camera.shutter.readout_s;
+    let span = readout + job.exposure_s;
+    let dur = job.trajectory.duration();
+    if (dur - span).abs() > 1e-9 * span.max(1.0) {
         return Err(Error::invalid(
-            "readout_s",
+            "trajectory",
             format!(
-                "the trajectory ({} s) must span the readout ({} s) plus a positive exposure",
-                trajectory.duration(),
-                cam.shutter.readout_s
+                "spans {dur} s, but an exposure of {} s with the camera's readout_s {readout} s \
+                 needs {span} s (readout + exposure)",
+                job.exposure_s
             ),
         ));
     }
@@ -224,9 +228,12 @@ impl fmt::Display for Integrator {
 pub struct RenderJob {
     /// Camera intrinsics.
     pub camera: Camera,
+    /// Exposure of each line, s (the whole frame's with a global shutter).
+    pub exposure_s: f64,
     /// Camera motion from the first line's exposure start to the last line's
-    /// exposure end: the exposure, plus the camera's rolling-shutter readout
-    /// when it has one (each line is exposed over its own window, SPEC 9).
+    /// exposure end: [`Self::exposure_s`] plus the camera's rolling-shutter
+    /// readout when it has one (each line is exposed over its own window,
+    /// SPEC 9). Checked when the job renders.
     pub trajectory: Trajectory,
     /// The target.
     pub target: Target,
@@ -243,10 +250,13 @@ pub struct RenderJob {
 }
 
 impl RenderJob {
-    /// Default quality, automatic backend, seed 0, with maps.
-    pub fn new(camera: Camera, trajectory: Trajectory, target: Target) -> Self {
+    /// A frame exposed `exposure_s` seconds per line along `trajectory` (which
+    /// spans the camera's readout plus the exposure): default quality,
+    /// automatic backend, seed 0, with maps.
+    pub fn new(camera: Camera, exposure_s: f64, trajectory: Trajectory, target: Target) -> Self {
         RenderJob {
             camera,
+            exposure_s,
             trajectory,
             target,
             quality: Quality::Default,
@@ -330,7 +340,7 @@ fn render_frame_stream(job: &RenderJob, stream: u64) -> Result<RenderOutput> {
             ),
         ));
     }
-    check_camera(cam, &job.trajectory)?;
+    check_timing(job)?;
     let lmax = maps::max_path_px(cam, &job.target, &job.trajectory);
     let is_image = matches!(job.target.kind, TargetKind::Image { .. });
     let defocus = cam.lens.is_some();
@@ -379,13 +389,11 @@ fn render_frame_stream(job: &RenderJob, stream: u64) -> Result<RenderOutput> {
             ),
         ));
     }
-    let mut homs = kernel::homographies(cam, &job.target, &job.trajectory, n);
+    let mut homs = kernel::homographies(cam, &job.target, &job.trajectory, job.exposure_s, n);
     // The bounding box over every line's instants: the whole span, as finely.
     // With distortion, straight target edges image as curves, and defocus
     // spreads them: the whole image.
-    let span_n = (n as f64 * job.trajectory.duration()
-        / kernel::line_exposure(cam, &job.trajectory))
-    .ceil() as u32;
+    let span_n = (n as f64 * job.trajectory.duration() / job.exposure_s).ceil() as u32;
     let bbox = if cam.distortion.is_none() && !defocus {
         kernel::target_bbox(cam, &job.target, &job.trajectory, span_n.max(n))
     } else {
@@ -412,15 +420,11 @@ fn render_frame_stream(job: &RenderJob, stream: u64) -> Result<RenderOutput> {
     };
     let mut rgb = rgb;
     if let Some(noise) = &cam.noise {
-        noise.apply(
-            &mut rgb,
-            kernel::line_exposure(cam, &job.trajectory),
-            stream,
-        )?;
+        noise.apply(&mut rgb, job.exposure_s, stream)?;
     }
     let maps = job.with_maps.then(|| {
         let steps = ((lmax / 0.25).ceil() as usize).clamp(64, 4096);
-        maps::blur_maps(cam, &job.target, &job.trajectory, steps)
+        maps::blur_maps(cam, &job.target, &job.trajectory, job.exposure_s, steps)
     });
     Ok(RenderOutput {
         width: cam.width,

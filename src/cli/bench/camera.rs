@@ -124,7 +124,7 @@ fn render() -> Result<()> {
             .into_iter()
             .enumerate()
         {
-            let mut j = RenderJob::new(cam, Trajectory::from_twist(tw, span)?, target.clone());
+            let mut j = RenderJob::new(cam, te, Trajectory::from_twist(tw, span)?, target.clone());
             j.with_maps = false;
             j.backend = backend;
             let mut best = f64::INFINITY;

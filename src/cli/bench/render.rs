@@ -21,7 +21,7 @@ fn job(target: &Target, path_px: f64) -> Result<RenderJob> {
     let probe = Trajectory::from_twist(tw, 0.05)?;
     let l0 = maps::max_path_px(&cam, target, &probe);
     let te = 0.05 * path_px / l0;
-    let mut j = RenderJob::new(cam, Trajectory::from_twist(tw, te)?, target.clone());
+    let mut j = RenderJob::new(cam, te, Trajectory::from_twist(tw, te)?, target.clone());
     j.quality = Quality::Default;
     j.with_maps = false;
     Ok(j)
