@@ -49,5 +49,5 @@ pub mod trigger;
 
 pub use camera::Camera;
 pub use error::{Error, Result};
-pub use metric::{mmbm, Method, Mmbm, Scene};
+pub use metric::{mmbm, AnyMethod, Method, Mmbm, Scene};
 pub use model::motion::{Plane, Twist};

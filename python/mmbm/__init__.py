@@ -346,11 +346,11 @@ def trigger(
     t: ArrayLike,
     mmbm: ArrayLike,
     policy: Union[str, Sequence[str]],
-    exposure: float,
-    delay: float = 0.0025,
-    readout: float = 0.0125,
-    min_interval: float = 0.2,
-    pitch_mm: float = 0.00465,
+    exposure: float = _mmbm.DEFAULT_EXPOSURE_S,
+    delay: float = _mmbm.DEFAULT_DELAY_S,
+    readout: float = _mmbm.DEFAULT_READOUT_S,
+    min_interval: float = _mmbm.DEFAULT_MIN_INTERVAL_S,
+    pitch_mm: float = _mmbm.DEFAULT_PITCH_MM,
 ) -> List[Dict[str, Any]]:
     """Runs trigger policies (``fixed:5``, ``threshold:0.4``, ``oracle:0.4``,
     ...; see ``mmbm trigger --help``) on an MMBM series (``t`` s, ``mmbm``

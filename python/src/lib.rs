@@ -8,9 +8,10 @@ use glam::DVec3;
 use mmbm::camera::Camera;
 use mmbm::gpu::Backend;
 use mmbm::io::gyro::{parse_rotation, GyroOptions, GyroSample};
-use mmbm::metric::{Method, Scene};
+use mmbm::metric::{AnyMethod, Scene};
 use mmbm::model::motion::{Plane, Twist};
 use mmbm::render::{Integrator, Quality, RenderJob, Target, Trajectory};
+use mmbm::trigger::CameraTiming;
 use numpy::ndarray::{Array1, Array2, Array3};
 use numpy::{IntoPyArray, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::exceptions::{PyOSError, PyValueError};
@@ -145,13 +146,22 @@ fn metric<'py>(
         camera: camera(cam)?,
         plane: plane(plane_)?,
     };
-    let method: Method = method.parse().map_err(err)?;
+    let method: AnyMethod = method.parse().map_err(err)?;
     let (w, v) = (rows3(&omega)?, rows3(&velocity)?);
     let out = py
         .detach(|| {
             w.iter()
                 .zip(&v)
-                .map(|(w, v)| mmbm::mmbm(&scene, &Twist::new(*w, *v), method).map(|m| m.mm_s))
+                .map(|(w, v)| {
+                    let tw = Twist::new(*w, *v);
+                    match method {
+                        AnyMethod::Cpu(m) => mmbm::mmbm(&scene, &tw, m),
+                        AnyMethod::Gpu { width, height } => scene
+                            .validate_for(&tw)
+                            .and_then(|_| mmbm::field::mmbm_gpu(&scene, &tw, width, height)),
+                    }
+                    .map(|m| m.mm_s)
+                })
                 .collect::<mmbm::Result<Vec<f64>>>()
         })
         .map_err(err)?;
@@ -312,14 +322,7 @@ fn samples_dict<'py>(py: Python<'py>, s: &[GyroSample]) -> PyResult<Bound<'py, P
 }
 
 fn backend(b: &str) -> PyResult<Backend> {
-    match b {
-        "auto" => Ok(Backend::Auto),
-        "gpu" => Ok(Backend::Gpu),
-        "cpu" => Ok(Backend::Cpu { threads: None }),
-        _ => Err(PyValueError::new_err(format!(
-            "backend '{b}': expected auto, gpu or cpu"
-        ))),
-    }
+    b.parse::<Backend>().map_err(err)
 }
 
 /// The flow field (px/s) at every pixel centre: `(H, W, 2)` float32.
@@ -516,7 +519,7 @@ fn trigger<'py>(
             depth: None,
         })
         .collect();
-    let timing = mmbm::trigger::CameraTiming {
+    let timing = CameraTiming {
         delay,
         exposure,
         readout,
@@ -581,5 +584,11 @@ fn _mmbm(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(simulate, m)?)?;
     m.add_function(wrap_pyfunction!(trigger, m)?)?;
     m.add_function(wrap_pyfunction!(read_exr, m)?)?;
+    // The camera timing's defaults, from their one place in the library.
+    m.add("DEFAULT_DELAY_S", CameraTiming::DEFAULT_DELAY_S)?;
+    m.add("DEFAULT_EXPOSURE_S", CameraTiming::DEFAULT_EXPOSURE_S)?;
+    m.add("DEFAULT_READOUT_S", CameraTiming::DEFAULT_READOUT_S)?;
+    m.add("DEFAULT_MIN_INTERVAL_S", CameraTiming::DEFAULT_MIN_INTERVAL_S)?;
+    m.add("DEFAULT_PITCH_MM", CameraTiming::DEFAULT_PITCH_MM)?;
     Ok(())
 }

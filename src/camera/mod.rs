@@ -1,9 +1,11 @@
 //! The camera (SPEC sections 1 and 9): pinhole intrinsics ([`intrinsics`]),
 //! lens distortion ([`distortion`]), rolling shutter ([`shutter`]), sensor
-//! noise ([`noise`]), thin-lens defocus ([`lens`]) and the files that describe
+//! noise ([`noise`]), thin-lens defocus ([`lens`]), blur in px of an MMBM over
+//! an exposure ([`blur`]) and the files that describe
 //! them, Gyroflow lens profiles included ([`file`]). This layer imports
 //! nothing above `error`.
 
+pub mod blur;
 pub mod distortion;
 pub mod file;
 pub mod intrinsics;
@@ -11,6 +13,7 @@ pub mod lens;
 pub mod noise;
 pub mod shutter;
 
+pub use blur::{blur_px, exposure_for_blur};
 pub use distortion::Distortion;
 pub use intrinsics::{Camera, SensorRect};
 pub use lens::Lens;

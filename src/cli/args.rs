@@ -3,6 +3,7 @@
 use clap::Args;
 use glam::DVec3;
 use mmbm::error::{Error, Result};
+use mmbm::trigger::CameraTiming;
 use mmbm::{Camera, Plane};
 use std::path::{Path, PathBuf};
 
@@ -210,7 +211,7 @@ pub struct TimingArgs {
         allow_negative_numbers = true,
         long,
         value_name = "S",
-        default_value_t = 0.0025
+        default_value_t = CameraTiming::DEFAULT_DELAY_S
     )]
     pub delay: f64,
     /// Readout t_r after the exposure, s.
@@ -218,7 +219,7 @@ pub struct TimingArgs {
         allow_negative_numbers = true,
         long,
         value_name = "S",
-        default_value_t = 0.0125
+        default_value_t = CameraTiming::DEFAULT_READOUT_S
     )]
     pub readout: f64,
     /// Minimum interval between MMBM-triggered frames, s.
@@ -226,7 +227,7 @@ pub struct TimingArgs {
         allow_negative_numbers = true,
         long,
         value_name = "S",
-        default_value_t = 0.2
+        default_value_t = CameraTiming::DEFAULT_MIN_INTERVAL_S
     )]
     pub min_interval: f64,
 }
@@ -234,8 +235,8 @@ pub struct TimingArgs {
 impl TimingArgs {
     /// The camera timing with exposure `exposure` (s) and pixel pitch
     /// `pitch_mm` (mm); validated by its users.
-    pub fn timing(&self, exposure: f64, pitch_mm: f64) -> mmbm::trigger::CameraTiming {
-        mmbm::trigger::CameraTiming {
+    pub fn timing(&self, exposure: f64, pitch_mm: f64) -> CameraTiming {
+        CameraTiming {
             delay: self.delay,
             exposure,
             readout: self.readout,

@@ -3,8 +3,9 @@
 use super::args::{parse_vec3, CameraArgs, SceneArgs};
 use clap::Args;
 use glam::DVec3;
+use mmbm::camera::blur_px;
 use mmbm::error::Result;
-use mmbm::{Method, Scene, Twist};
+use mmbm::{AnyMethod, Scene, Twist};
 
 /// MMBM of one twist.
 #[derive(Args, Debug)]
@@ -38,7 +39,7 @@ pub struct EvalArgs {
 }
 
 pub fn run(a: EvalArgs) -> Result<()> {
-    let method: Method = a.method.parse()?;
+    let method: AnyMethod = a.method.parse()?;
     let scene = Scene {
         camera: a.camera.camera()?,
         plane: a.scene.plane()?,
@@ -48,11 +49,11 @@ pub fn run(a: EvalArgs) -> Result<()> {
     }
     let tw = Twist::new(a.omega, a.velocity.unwrap_or(DVec3::ZERO));
     let m = match method {
-        Method::Gpu { width, height } => {
+        AnyMethod::Gpu { width, height } => {
             scene.validate_for(&tw)?;
             mmbm::field::mmbm_gpu(&scene, &tw, width, height)?
         }
-        _ => mmbm::mmbm(&scene, &tw, method)?,
+        AnyMethod::Cpu(method) => mmbm::mmbm(&scene, &tw, method)?,
     };
     if a.json {
         let mut o = serde_json::json!({
@@ -66,7 +67,7 @@ pub fn run(a: EvalArgs) -> Result<()> {
         }
         if let Some(te) = a.exposure {
             o["exposure_s"] = serde_json::json!(te);
-            o["blur_px"] = serde_json::json!(m.px_s * te);
+            o["blur_px"] = serde_json::json!(blur_px(m.mm_s, te, scene.camera.pitch_x_mm));
         }
         println!("{o}");
     } else {
@@ -76,7 +77,10 @@ pub fn run(a: EvalArgs) -> Result<()> {
         }
         println!(")");
         if let Some(te) = a.exposure {
-            println!("blur over {te} s: {:.4} px", m.px_s * te);
+            println!(
+                "blur over {te} s: {:.4} px",
+                blur_px(m.mm_s, te, scene.camera.pitch_x_mm)
+            );
         }
     }
     Ok(())

@@ -38,7 +38,7 @@ pub struct FlowArgs {
         allow_negative_numbers = true,
         long,
         value_name = "S",
-        default_value_t = 0.07
+        default_value_t = mmbm::trigger::CameraTiming::DEFAULT_EXPOSURE_S
     )]
     pub exposure: f64,
     #[command(flatten)]

@@ -3,12 +3,12 @@
 use super::args::{CameraArgs, SceneArgs};
 use super::series::GyroArgs;
 use clap::Args;
-use mmbm::error::Result;
+use mmbm::error::{Error, Result};
 use mmbm::io::frames::read_frames;
 use mmbm::io::gyro::read_log;
 use mmbm::series::frames::{frame_mmbm, select_sharpest};
 use mmbm::series::SeriesOptions;
-use mmbm::{Method, Scene};
+use mmbm::{AnyMethod, Scene};
 use std::io::Write;
 use std::path::PathBuf;
 
@@ -58,7 +58,15 @@ pub struct FramesArgs {
 }
 
 pub fn run(a: FramesArgs) -> Result<()> {
-    let method: Method = a.method.parse()?;
+    let method = match a.method.parse::<AnyMethod>()? {
+        AnyMethod::Cpu(m) => m,
+        AnyMethod::Gpu { .. } => {
+            return Err(Error::invalid(
+                "method",
+                "gpu is not available for frames (each line has its own window); use riemann, gauss or exact",
+            ))
+        }
+    };
     let camera = super::args::with_log_readout(a.camera.camera()?, &a.gyro)?;
     let opts = SeriesOptions {
         scene: Scene {

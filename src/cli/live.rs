@@ -48,7 +48,7 @@ pub struct LiveArgs {
         allow_negative_numbers = true,
         long,
         value_name = "S",
-        default_value_t = 0.07
+        default_value_t = mmbm::trigger::CameraTiming::DEFAULT_EXPOSURE_S
     )]
     pub exposure: f64,
     #[command(flatten)]
@@ -221,12 +221,6 @@ impl Decider {
 
 pub fn run(a: LiveArgs) -> Result<()> {
     let method: Method = a.method.parse()?;
-    if matches!(method, Method::Gpu { .. }) {
-        return Err(Error::invalid(
-            "--method",
-            "live decisions use a CPU method (riemann, gauss or exact)",
-        ));
-    }
     let camera = a.camera.camera()?;
     // A rolling shutter keeps the camera busy for its line readout as well.
     let timing = a

@@ -106,9 +106,9 @@ pub struct RenderOpts {
     /// lattice (supersampled area and time).
     #[arg(long, default_value = "auto")]
     pub integrator: String,
-    /// auto (GPU if any, else CPU), gpu, or cpu.
+    /// auto (GPU if any, else CPU), gpu, cpu, or bulk (a hardware GPU, else CPU).
     #[arg(long, default_value = "auto")]
-    pub backend: String,
+    pub backend: Backend,
     /// Seed of the per-pixel sample shifts.
     #[arg(long, default_value_t = 0)]
     pub seed: u32,
@@ -206,17 +206,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
         target.background = [b.x as f32, b.y as f32, b.z as f32];
     }
     target.validate_for(&camera)?;
-    let backend = match a.backend.as_str() {
-        "auto" => Backend::Auto,
-        "gpu" => Backend::Gpu,
-        "cpu" => Backend::Cpu { threads: None },
-        b => {
-            return Err(Error::invalid(
-                "--backend",
-                format!("'{b}': expected auto, gpu or cpu"),
-            ))
-        }
-    };
+    let backend = a.backend;
     let job = RenderJob {
         camera,
         exposure_s: a.exposure,

@@ -5,7 +5,7 @@ use clap::Args;
 use mmbm::error::Result;
 use mmbm::io::gyro::{parse_rotation, AngleUnit, GyroOptions, GyroReader, TimeUnit};
 use mmbm::series::{self, SeriesOptions};
-use mmbm::{Method, Scene};
+use mmbm::{AnyMethod, Method, Scene};
 use std::path::PathBuf;
 
 /// Options for reading a gyro log (shared by the commands that read one).
@@ -86,13 +86,17 @@ pub struct SeriesArgs {
 }
 
 pub fn run(a: SeriesArgs) -> Result<()> {
-    let method: Method = a.method.parse()?;
+    let method: AnyMethod = a.method.parse()?;
     let opts = SeriesOptions {
         scene: Scene {
             camera: a.camera.camera()?,
             plane: a.scene.plane()?,
         },
-        method,
+        // (Unused by the GPU evaluator.)
+        method: match method {
+            AnyMethod::Cpu(m) => m,
+            AnyMethod::Gpu { .. } => Method::default(),
+        },
         use_velocity: a.use_velocity,
     };
     if let Some(p) = &opts.scene.plane {
@@ -100,8 +104,12 @@ pub fn run(a: SeriesArgs) -> Result<()> {
     }
     let reader = GyroReader::open(&a.gyro, a.gyro_opts.options()?)?;
     let mut eval: Box<series::BatchFn> = match method {
-        Method::Gpu { width, height } => mmbm::series::gpu::series_evaluator(opts, width, height)?,
-        _ => Box::new(move |b: &[mmbm::io::gyro::GyroSample]| series::eval_batch_cpu(b, &opts)),
+        AnyMethod::Gpu { width, height } => {
+            mmbm::series::gpu::series_evaluator(opts, width, height)?
+        }
+        AnyMethod::Cpu(_) => {
+            Box::new(move |b: &[mmbm::io::gyro::GyroSample]| series::eval_batch_cpu(b, &opts))
+        }
     };
     let pitch = opts.scene.camera.pitch_x_mm;
     if let Some(te) = a.exposure {

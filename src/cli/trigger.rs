@@ -41,7 +41,12 @@ pub struct TriggerArgs {
     #[arg(long, required = true)]
     pub policy: Vec<String>,
     /// Exposure t_e, s (thesis: 0.05, 0.07).
-    #[arg(allow_negative_numbers = true, long, value_name = "S")]
+    #[arg(
+        allow_negative_numbers = true,
+        long,
+        value_name = "S",
+        default_value_t = mmbm::trigger::CameraTiming::DEFAULT_EXPOSURE_S
+    )]
     pub exposure: f64,
     #[command(flatten)]
     pub timing: TimingArgs,
@@ -107,9 +112,6 @@ fn summary_text(frames: &[Frame], spec: &str, duration: f64, pitch_mm: f64) -> S
 
 pub fn run(a: TriggerArgs) -> Result<()> {
     let method: Method = a.method.parse()?;
-    if matches!(method, Method::Gpu { .. }) {
-        return Err(Error::invalid("--method", "trigger uses a CPU method"));
-    }
     let camera = super::args::with_log_readout(a.camera.camera()?, &a.gyro)?;
     // A rolling shutter keeps the camera busy for its line readout as well.
     let timing = a

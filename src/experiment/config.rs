@@ -5,6 +5,7 @@
 
 use crate::camera::{Distortion, Lens, Noise, Readout};
 use crate::error::{Error, Result};
+use crate::trigger::CameraTiming;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -107,10 +108,10 @@ impl Default for ExperimentConfig {
             ]
             .map(String::from)
             .to_vec(),
-            exposure_s: 0.07,
-            delay_s: 0.0025,
-            readout_s: 0.0125,
-            min_interval_s: 0.2,
+            exposure_s: CameraTiming::DEFAULT_EXPOSURE_S,
+            delay_s: CameraTiming::DEFAULT_DELAY_S,
+            readout_s: CameraTiming::DEFAULT_READOUT_S,
+            min_interval_s: CameraTiming::DEFAULT_MIN_INTERVAL_S,
             target: "blobs".into(),
             start_distance_m: 6.0,
             min_distance_m: 1.5,

@@ -33,6 +33,23 @@ pub enum Backend {
     },
 }
 
+impl std::str::FromStr for Backend {
+    type Err = Error;
+    /// `auto`, `gpu`, `cpu` (rayon's global pool) or `bulk`.
+    fn from_str(s: &str) -> Result<Self> {
+        match s {
+            "auto" => Ok(Backend::Auto),
+            "gpu" => Ok(Backend::Gpu),
+            "cpu" => Ok(Backend::Cpu { threads: None }),
+            "bulk" => Ok(Backend::Bulk),
+            _ => Err(Error::invalid(
+                "backend",
+                format!("'{s}': expected auto, gpu, cpu or bulk"),
+            )),
+        }
+    }
+}
+
 /// A [`Backend`] resolved against the machine: the device, or the CPU twin.
 #[derive(Clone, Copy)]
 pub enum Resolved {

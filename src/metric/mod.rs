@@ -6,7 +6,10 @@
 //! - [`Method::Gauss`]: tensor Gauss-Legendre, `n_u x n_v` nodes (a real-time rule);
 //! - [`Method::Exact`]: adaptive Gauss-Kronrod cubature to a relative tolerance,
 //!   with an error estimate;
-//! - [`Method::Gpu`]: full-resolution per-pixel field on the GPU (see `crate::gpu`).
+//!
+//! [`AnyMethod`] adds `gpu[:WxH]`, the full-resolution per-pixel field on the
+//! GPU (evaluated by `crate::field::mmbm_gpu`, not here), for the doors that
+//! offer it (`eval`, `series`, Python's `metric`).
 
 mod avx2;
 mod exact;
@@ -44,6 +47,13 @@ pub enum Method {
         /// Relative tolerance of the adaptive cubature.
         tol: f64,
     },
+}
+
+/// A CPU [`Method`] or the full field on the GPU (`gpu[:WxH]`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum AnyMethod {
+    /// A CPU rule.
+    Cpu(Method),
     /// Full field on the GPU at `width x height` samples (`gpu` = sensor resolution, or `gpu:WxH`).
     Gpu {
         /// Samples per row (0: the sensor's width).
@@ -52,6 +62,52 @@ pub enum Method {
         height: u32,
     },
 }
+
+impl Default for AnyMethod {
+    fn default() -> Self {
+        AnyMethod::Cpu(Method::default())
+    }
+}
+
+impl FromStr for AnyMethod {
+    type Err = Error;
+
+    /// Parses `gpu[:WxH]` or a CPU [`Method`].
+    fn from_str(s: &str) -> Result<Self> {
+        let (name, arg) = match s.split_once(':') {
+            Some((n, a)) => (n, Some(a)),
+            None => (s, None),
+        };
+        match (name.trim().to_ascii_lowercase().as_str(), arg) {
+            ("gpu", None) => Ok(AnyMethod::Gpu {
+                width: 0,
+                height: 0,
+            }),
+            ("gpu", Some(a)) => {
+                let (width, height) = parse_dims(a, "grid")?;
+                Ok(AnyMethod::Gpu { width, height })
+            }
+            ("riemann" | "gauss" | "exact", _) => s.parse::<Method>().map(AnyMethod::Cpu),
+            _ => Err(Error::invalid(
+                "method",
+                format!("'{s}': expected {ALL_METHODS}"),
+            )),
+        }
+    }
+}
+
+impl fmt::Display for AnyMethod {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match *self {
+            AnyMethod::Cpu(m) => m.fmt(f),
+            AnyMethod::Gpu { width: 0, .. } => write!(f, "gpu"),
+            AnyMethod::Gpu { width, height } => write!(f, "gpu:{width}x{height}"),
+        }
+    }
+}
+
+const CPU_METHODS: &str = "riemann[:NUxNV], gauss[:N] or exact[:TOL]";
+const ALL_METHODS: &str = "riemann[:NUxNV], gauss[:N], exact[:TOL] or gpu[:WxH]";
 
 impl Default for Method {
     fn default() -> Self {
@@ -78,8 +134,9 @@ fn parse_dims(s: &str, what: &str) -> Result<(u32, u32)> {
 impl FromStr for Method {
     type Err = Error;
 
-    /// Parses `riemann[:NUxNV]`, `gauss[:N|:NUxNV]`, `exact[:TOL]`, `gpu[:WxH]`
-    /// (grid rules within [`MAX_GRID_POINTS`] and [`MAX_GAUSS_NODES`]).
+    /// Parses `riemann[:NUxNV]`, `gauss[:N|:NUxNV]` or `exact[:TOL]` (grid
+    /// rules within [`MAX_GRID_POINTS`] and [`MAX_GAUSS_NODES`]). `gpu` is
+    /// refused with a pointer to [`AnyMethod`]'s doors.
     fn from_str(s: &str) -> Result<Self> {
         let (name, arg) = match s.split_once(':') {
             Some((n, a)) => (n, Some(a)),
@@ -121,17 +178,16 @@ impl FromStr for Method {
                     })?;
                 Ok(Method::Exact { tol })
             }
-            ("gpu", None) => Ok(Method::Gpu {
-                width: 0,
-                height: 0,
-            }),
-            ("gpu", Some(a)) => {
-                let (width, height) = parse_dims(a, "grid")?;
-                Ok(Method::Gpu { width, height })
-            }
+            ("gpu", _) => Err(Error::invalid(
+                "method",
+                format!(
+                    "'{s}': the GPU field is not a CPU method (only eval, series and Python's metric \
+                     offer gpu); expected {CPU_METHODS}"
+                ),
+            )),
             _ => Err(Error::invalid(
                 "method",
-                format!("'{s}': expected riemann[:NUxNV], gauss[:N], exact[:TOL] or gpu[:WxH]"),
+                format!("'{s}': expected {CPU_METHODS}"),
             )),
         }?;
         let too_big = |what: String| {
@@ -165,8 +221,6 @@ impl fmt::Display for Method {
             Method::Riemann { nu, nv } => write!(f, "riemann:{nu}x{nv}"),
             Method::Gauss { nu, nv } => write!(f, "gauss:{nu}x{nv}"),
             Method::Exact { tol } => write!(f, "exact:{tol:e}"),
-            Method::Gpu { width: 0, .. } => write!(f, "gpu"),
-            Method::Gpu { width, height } => write!(f, "gpu:{width}x{height}"),
         }
     }
 }
@@ -222,8 +276,8 @@ impl Scene {
     }
 }
 
-/// Computes MMBM with a CPU method. Validates inputs first. `Method::Gpu` is
-/// rejected here: use [`crate::field::mmbm_gpu`].
+/// Computes MMBM with a CPU method. Validates inputs first. (The GPU field
+/// is `crate::field::mmbm_gpu`.)
 pub fn mmbm(scene: &Scene, tw: &Twist, method: Method) -> Result<Mmbm> {
     scene.validate_for(tw)?;
     let poly = scene.flow_poly(tw);
@@ -264,12 +318,6 @@ pub fn mmbm_poly(cam: &Camera, poly: &FlowPoly, method: Method) -> Result<Mmbm> 
                 exact_with(|u, v| distorted_speed(cam, poly, u, v), &rect, tol)
             };
             (r.value, Some(r.error), r.evaluations)
-        }
-        Method::Gpu { .. } => {
-            return Err(Error::invalid(
-                "method",
-                "gpu is evaluated by crate::gpu, not by the CPU metric",
-            ))
         }
     };
     if !mm_s.is_finite() {
@@ -321,7 +369,7 @@ pub struct Evaluator {
 }
 
 impl Evaluator {
-    /// Prepares `method` for `camera` (`Method::Gpu` is rejected).
+    /// Prepares `method` for `camera`.
     pub fn new(camera: &Camera, method: Method) -> Result<Self> {
         camera.validate()?;
         let r = camera.sensor_rect();
@@ -329,12 +377,6 @@ impl Evaluator {
             Method::Riemann { nu, nv } => Some(GridRule::riemann(&r, nu, nv).distorted(camera)?),
             Method::Gauss { nu, nv } => Some(GridRule::gauss(&r, nu, nv).distorted(camera)?),
             Method::Exact { .. } => None,
-            Method::Gpu { .. } => {
-                return Err(Error::invalid(
-                    "method",
-                    "gpu is evaluated by crate::gpu, not by the CPU metric",
-                ))
-            }
         };
         Ok(Evaluator {
             camera: *camera,

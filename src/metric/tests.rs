@@ -267,9 +267,21 @@ fn bad_inputs_are_errors() {
 
 #[test]
 fn method_strings_round_trip() {
-    for s in ["riemann:8x6", "gauss:5x5", "gpu", "gpu:320x240"] {
+    for s in ["riemann:8x6", "gauss:5x5"] {
         assert_eq!(s.parse::<Method>().unwrap().to_string(), s);
     }
+    for s in ["riemann:8x6", "gauss:5x5", "gpu", "gpu:320x240"] {
+        assert_eq!(s.parse::<AnyMethod>().unwrap().to_string(), s);
+    }
+    // The GPU field is not a CPU method: the type cannot hold it.
+    let e = "gpu".parse::<Method>().unwrap_err().to_string();
+    assert!(e.contains("not a CPU method"), "{e}");
+    assert_eq!(
+        "gauss:4x3".parse::<AnyMethod>().unwrap(),
+        AnyMethod::Cpu(Method::Gauss { nu: 4, nv: 3 })
+    );
+    let e = "simpson".parse::<AnyMethod>().unwrap_err().to_string();
+    assert!(e.contains("gpu[:WxH]"), "{e}");
     assert_eq!(
         "riemann".parse::<Method>().unwrap(),
         Method::Riemann { nu: 8, nv: 6 }

@@ -43,7 +43,7 @@ impl FrameMmbm {
     /// Blur length over the exposure, px: exposure MMBM x `t_e` / pitch.
     pub fn blur_px(&self, cam: &Camera) -> Option<f64> {
         self.exposure_mm_s
-            .map(|m| m * self.exposure_s / cam.pitch_x_mm)
+            .map(|m| crate::camera::blur_px(m, self.exposure_s, cam.pitch_x_mm))
     }
 }
 
@@ -114,12 +114,6 @@ pub fn frame_mmbm(
     let groups = match opts.method {
         Method::Riemann { .. } | Method::Gauss { .. } => Some(line_groups(&cam, opts.method)?),
         Method::Exact { .. } => None,
-        Method::Gpu { .. } => {
-            return Err(Error::invalid(
-                "method",
-                "gpu is not available for frames (each line has its own window); use riemann, gauss or exact",
-            ))
-        }
     };
     let t: Vec<f64> = samples.iter().map(|s| s.t).collect();
     let (first, last) = (t[0], t[t.len() - 1]);

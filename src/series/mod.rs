@@ -189,8 +189,11 @@ pub fn run<W: Write>(
                 }
                 if let Some(te) = exposure_s {
                     out.write_all(b",").map_err(werr)?;
-                    out.write_all(d.format(m / pitch_mm * te).as_bytes())
-                        .map_err(werr)?;
+                    out.write_all(
+                        d.format(crate::camera::blur_px(*m, te, pitch_mm))
+                            .as_bytes(),
+                    )
+                    .map_err(werr)?;
                 }
                 out.write_all(b"\n").map_err(werr)?;
             }

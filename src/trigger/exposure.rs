@@ -45,7 +45,8 @@ impl Exposure {
     pub fn exposure_for(&self, m: f64, timing: &CameraTiming) -> f64 {
         let t_max = timing.exposure;
         if m > 0.0 {
-            (self.budget_px * timing.pitch_mm / m).clamp(self.min_exposure.min(t_max), t_max)
+            crate::camera::exposure_for_blur(self.budget_px, m, timing.pitch_mm)
+                .clamp(self.min_exposure.min(t_max), t_max)
         } else {
             t_max
         }

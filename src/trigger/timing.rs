@@ -25,16 +25,29 @@ impl Default for CameraTiming {
     /// none), minimum interval 0.2 s, the thesis camera's 4.65 um pitch.
     fn default() -> Self {
         CameraTiming {
-            delay: 0.0025,
-            exposure: 0.07,
-            readout: 0.0125,
-            min_interval: 0.2,
-            pitch_mm: 0.00465,
+            delay: Self::DEFAULT_DELAY_S,
+            exposure: Self::DEFAULT_EXPOSURE_S,
+            readout: Self::DEFAULT_READOUT_S,
+            min_interval: Self::DEFAULT_MIN_INTERVAL_S,
+            pitch_mm: Self::DEFAULT_PITCH_MM,
         }
     }
 }
 
 impl CameraTiming {
+    /// Default decision-to-exposure delay `t_d`, s (thesis: 2-3 ms).
+    pub const DEFAULT_DELAY_S: f64 = 0.0025;
+    /// Default exposure `t_e`, s (thesis ch. 6).
+    pub const DEFAULT_EXPOSURE_S: f64 = 0.07;
+    /// Default readout `t_r` after the exposure, s (a 640 x 480 Flea2 at its
+    /// 80 fps maximum; an assumption, the thesis gives none).
+    pub const DEFAULT_READOUT_S: f64 = 0.0125;
+    /// Default minimum interval between MMBM-triggered frames, s (the
+    /// thesis's fair comparison with 5 fps).
+    pub const DEFAULT_MIN_INTERVAL_S: f64 = 0.2;
+    /// Default pixel pitch, mm: the thesis camera's 4.65 um.
+    pub const DEFAULT_PITCH_MM: f64 = 0.00465;
+
     /// The timing of a rolling-shutter camera (SPEC 9): its last line's
     /// exposure ends `rolling_readout_s` after the first line's, so the camera
     /// is busy that much longer before the readout `t_r` that follows.
