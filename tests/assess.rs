@@ -1,6 +1,8 @@
 //! Image blur metrics against scikit-image/SciPy reference values and on
 //! images with a known, growing blur.
 
+mod common;
+
 use image::{GrayImage, Luma};
 use mmbm::assess::{
     assess, blur_effect, blur_effect_axes, cpbd, jnbm, jnbm_report, laplacian_var, load_grey,
@@ -202,15 +204,11 @@ fn undefined_and_bad_inputs() {
     assert!(e.contains("missing.png"), "{e}");
 }
 
-fn bin() -> std::process::Command {
-    std::process::Command::new(env!("CARGO_BIN_EXE_mmbm"))
-}
-
 #[test]
 fn cli_json_in_argument_order() {
     let v = values();
     let names = ["camera_motion9.png", "camera.png"];
-    let out = bin()
+    let out = common::mmbm_cmd()
         .arg("assess")
         .args(names.iter().map(|n| fixture(n)))
         .arg("--json")
@@ -239,7 +237,7 @@ fn cli_json_in_argument_order() {
 
 #[test]
 fn cli_text_and_errors() {
-    let out = bin()
+    let out = common::mmbm_cmd()
         .arg("assess")
         .arg(fixture("bars.png"))
         .output()
@@ -249,7 +247,7 @@ fn cli_text_and_errors() {
     assert!(s.contains("jnbm") && s.contains("bars.png"), "{s}");
     assert!(s.contains("jnbm_2d") && s.contains("cpbd_2d"), "{s}");
 
-    let out = bin()
+    let out = common::mmbm_cmd()
         .arg("assess")
         .arg(fixture("camera.png"))
         .arg(fixture("nope.png"))

@@ -1,6 +1,8 @@
 //! Blob extraction on synthesized images of the thesis board: sharp -> 16/16
 //! OK, heavy motion blur -> failure.
 
+mod common;
+
 use image::RgbImage;
 use mmbm::board::blobs::{evaluate, extract, BlobParams};
 use mmbm::board::{board_centres_px, Board};
@@ -144,10 +146,6 @@ fn no_red_no_blobs() {
     assert!(extract(&img, &bad).is_err());
 }
 
-fn bin() -> std::process::Command {
-    std::process::Command::new(env!("CARGO_BIN_EXE_mmbm"))
-}
-
 #[test]
 fn cli_blobs() {
     let dir = tempfile::tempdir().unwrap();
@@ -162,7 +160,7 @@ fn cli_blobs() {
         .unwrap();
     let mask = dir.path().join("mask.png");
     for (img, ok) in [(&sharp, true), (&blurred, false)] {
-        let out = bin()
+        let out = common::mmbm_cmd()
             .args([
                 "blobs",
                 img.to_str().unwrap(),
@@ -200,7 +198,7 @@ fn cli_blobs() {
         serde_json::json!({"centres_px": exp, "pitch_px": pitch}).to_string(),
     )
     .unwrap();
-    let out = bin()
+    let out = common::mmbm_cmd()
         .args([
             "blobs",
             sharp.to_str().unwrap(),
@@ -213,13 +211,13 @@ fn cli_blobs() {
     assert!(out.status.success() && s.contains("OK"), "{s}");
 
     // errors: camera/image size mismatch, unreadable image
-    let out = bin()
+    let out = common::mmbm_cmd()
         .args(["blobs", sharp.to_str().unwrap(), "--distance", "6"])
         .output()
         .unwrap();
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("320x240"));
-    let out = bin()
+    let out = common::mmbm_cmd()
         .args(["blobs", "/nonexistent/x.png"])
         .output()
         .unwrap();

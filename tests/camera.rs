@@ -2,12 +2,13 @@
 //! profiles) against independent computations: finite differences of the
 //! projection, brute-force sensor means, hand-computed profile values.
 
+mod common;
+
 use glam::DVec3;
 use mmbm::camera::{Distortion, Readout};
 use mmbm::model::flow::flow_distorted;
 use mmbm::{mmbm, Camera, Method, Plane, Scene, Twist};
 use std::path::PathBuf;
-use std::process::Command;
 
 fn fixture(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -296,7 +297,7 @@ fn explicit_defaults_change_nothing() {
     );
     assert_eq!(Camera::load(&explicit).unwrap(), Camera::thesis());
     let run = |cam: Option<&PathBuf>, method: &str| {
-        let mut c = Command::new(env!("CARGO_BIN_EXE_mmbm"));
+        let mut c = common::mmbm_cmd();
         c.args(["eval", "--omega", "0.3,-0.2,0.5", "--method", method]);
         if let Some(p) = cam {
             c.arg("--camera").arg(p);

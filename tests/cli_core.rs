@@ -1,14 +1,9 @@
 //! End-to-end checks of the core CLI contract: `eval`, `series`, `tables`.
 
-use std::path::Path;
-use std::process::{Command, Output};
+mod common;
 
-fn mmbm(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_mmbm"))
-        .args(args)
-        .output()
-        .expect("run mmbm")
-}
+use common::mmbm;
+use std::path::Path;
 
 fn json(args: &[&str]) -> serde_json::Value {
     let o = mmbm(args);

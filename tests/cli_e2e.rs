@@ -2,22 +2,9 @@
 //! `simulate`, `trigger`, `render --maps --psf --sharp`, `tables --plot`, and
 //! the blur length of `eval`/`series --exposure`.
 
-use std::path::Path;
-use std::process::{Command, Output};
+mod common;
 
-fn mmbm(dir: &Path, args: &[&str]) -> Output {
-    let o = Command::new(env!("CARGO_BIN_EXE_mmbm"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .unwrap();
-    assert!(
-        o.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    o
-}
+use common::mmbm_ok_in;
 
 #[test]
 fn simulate_then_trigger() {
@@ -27,7 +14,7 @@ fn simulate_then_trigger() {
         let args = "simulate --gait fast --duration 4 --rate 500 --seed 3 --out";
         let mut argv: Vec<&str> = args.split(' ').collect();
         argv.push(out);
-        mmbm(p, &argv);
+        mmbm_ok_in(p, &argv);
     }
     let a = std::fs::read_to_string(p.join("a.csv")).unwrap();
     assert_eq!(
@@ -38,7 +25,7 @@ fn simulate_then_trigger() {
     let rows: Vec<&str> = a.lines().filter(|l| !l.starts_with('#')).collect();
     assert_eq!(rows[0], "t,wx,wy,wz,vx,vy,vz");
     assert_eq!(rows.len() - 1, 2000, "4 s at 500 Hz");
-    let o = mmbm(
+    let o = mmbm_ok_in(
         p,
         &[
             "trigger",
@@ -67,7 +54,7 @@ fn simulate_then_trigger() {
             "{l}"
         );
     }
-    let o = mmbm(
+    let o = mmbm_ok_in(
         p,
         &[
             "trigger",
@@ -87,7 +74,7 @@ fn simulate_then_trigger() {
 fn render_writes_image_maps_psf_and_sharp() {
     let d = tempfile::tempdir().unwrap();
     let p = d.path();
-    mmbm(
+    mmbm_ok_in(
         p,
         &[
             "render",
@@ -135,7 +122,7 @@ fn render_writes_image_maps_psf_and_sharp() {
 #[test]
 fn tables_plot_is_a_png() {
     let d = tempfile::tempdir().unwrap();
-    mmbm(d.path(), &["tables", "--plot", "fig.png"]);
+    mmbm_ok_in(d.path(), &["tables", "--plot", "fig.png"]);
     let img = image::open(d.path().join("fig.png")).unwrap();
     assert!(img.width() >= 400 && img.height() >= 300);
 }
@@ -144,15 +131,15 @@ fn tables_plot_is_a_png() {
 fn exposure_gives_the_blur_length() {
     let d = tempfile::tempdir().unwrap();
     let p = d.path();
-    let o = mmbm(
+    let o = mmbm_ok_in(
         p,
         &["eval", "--omega", "1,1,1", "--exposure", "0.05", "--json"],
     );
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     let px = v["mmbm_px_s"].as_f64().unwrap();
     assert_eq!(v["blur_px"].as_f64().unwrap(), px * 0.05);
-    mmbm(p, &["simulate", "--duration", "1", "--out", "w.csv"]);
-    let o = mmbm(p, &["series", "--gyro", "w.csv", "--exposure", "0.07"]);
+    mmbm_ok_in(p, &["simulate", "--duration", "1", "--out", "w.csv"]);
+    let o = mmbm_ok_in(p, &["series", "--gyro", "w.csv", "--exposure", "0.07"]);
     let out = String::from_utf8(o.stdout).unwrap();
     let mut lines = out.lines();
     assert_eq!(lines.next().unwrap(), "t,mmbm_mm_s,mmbm_px_s,blur_px");

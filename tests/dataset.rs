@@ -4,11 +4,11 @@
 
 mod common;
 
+use common::mmbm_in;
 use mmbm::dataset::item::{make, FILES};
 use mmbm::dataset::{self, DatasetConfig, ManifestLine, Shard, Sources};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 fn textures() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("assets/textures")
@@ -117,7 +117,7 @@ fn a_killed_run_resumes_to_the_same_bytes() {
     std::fs::write(&toml, cfg.to_toml().unwrap()).unwrap();
     let out = d.path().join("out");
     let start = || {
-        Command::new(env!("CARGO_BIN_EXE_mmbm"))
+        common::mmbm_cmd()
             .args(["dataset", "--quiet", "--config"])
             .arg(&toml)
             .arg("--out")
@@ -151,14 +151,6 @@ fn a_killed_run_resumes_to_the_same_bytes() {
     let b = items_and_manifest(&out);
     assert_eq!(a, b, "resumed run differs from an uninterrupted one");
     assert!(!tree(&out).keys().any(|k| k.contains(".partial")));
-}
-
-fn mmbm_in(dir: &Path, args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_mmbm"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .unwrap()
 }
 
 #[test]
@@ -237,7 +229,7 @@ fn scheduler_environments_pick_the_shard() {
     };
     std::fs::write(&toml, cfg.to_toml().unwrap()).unwrap();
     let run = |env: &[(&str, &str)], extra: &[&str]| {
-        let mut c = Command::new(env!("CARGO_BIN_EXE_mmbm"));
+        let mut c = common::mmbm_cmd();
         c.args(["dataset", "--quiet", "--config"])
             .arg(&toml)
             .arg("--out")

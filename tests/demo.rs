@@ -2,8 +2,9 @@
 //! 2 cores). Its report must lead with the headline, and the README's seed-1
 //! table ("What the demo finds") must be what the demo measures.
 
+mod common;
+
 use std::collections::HashMap;
-use std::process::Command;
 
 /// Cells of the Markdown table rows starting with `prefix`.
 fn rows<'a>(text: &'a str, prefix: &str) -> Vec<Vec<&'a str>> {
@@ -23,7 +24,7 @@ fn num(s: &str) -> f64 {
 fn demo_report_matches_the_readme() {
     let d = tempfile::tempdir().unwrap();
     let out = d.path().join("report");
-    let o = Command::new(env!("CARGO_BIN_EXE_mmbm"))
+    let o = common::mmbm_cmd()
         .args(["demo", "--quiet", "--out"])
         .arg(&out)
         .output()

@@ -14,7 +14,6 @@ use mmbm::series::{mmbm_series, SeriesOptions};
 use mmbm::trigger::Integral;
 use mmbm::{Camera, Method, Scene};
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 fn opts(camera: Camera, method: Method) -> SeriesOptions {
     SeriesOptions {
@@ -233,10 +232,7 @@ fn yaw_ramp_closed_form_and_directions() {
 }
 
 fn run(args: &[&str]) -> (bool, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_mmbm"))
-        .args(args)
-        .output()
-        .unwrap();
+    let out = common::mmbm(args);
     (
         out.status.success(),
         String::from_utf8_lossy(&out.stdout).into(),

@@ -2,6 +2,8 @@
 //! mutations (replaced, inserted and deleted bytes) of valid files give a
 //! value or an error, never a panic; an error names the file.
 
+mod common;
+
 use mmbm::experiment::ExperimentConfig;
 use mmbm::io::gyro::{read_log, GyroOptions};
 use mmbm::io::lines::LineParser;
@@ -155,7 +157,7 @@ proptest! {
 fn exr_mutations() {
     let d = tempfile::tempdir().unwrap();
     let src = d.path().join("f.exr");
-    let o = std::process::Command::new(env!("CARGO_BIN_EXE_mmbm"))
+    let o = common::mmbm_cmd()
         .args([
             "render",
             "--omega",

@@ -4,13 +4,15 @@
 //! takes `--gyro`; malformed files are errors that name the file, the line
 //! of the `.gcsv` file and the column or header key.
 
+mod common;
+
+use common::mmbm;
 use glam::{DMat3, DVec3};
 use mmbm::io::gcsv::{
     camera_matrix, is_gcsv, orientation_matrix, read_header, ReadoutDirection, GYROFLOW_TO_CAMERA,
 };
 use mmbm::io::gyro::{read_log, AngleUnit, GyroOptions, GyroSample, TimeUnit};
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 fn walk() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/gcsv/walk.gcsv")
@@ -341,13 +343,6 @@ fn missing_scales_and_bad_files_are_errors() {
     }
 }
 
-fn mmbm(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_mmbm"))
-        .args(args)
-        .output()
-        .unwrap()
-}
-
 /// The fixture as a plain gyro CSV, computed here.
 fn equivalent_csv(samples_from_raw: &[[f64; 4]]) -> String {
     let mut s = String::from("t,wx,wy,wz\n");
@@ -432,7 +427,7 @@ fn frames_use_the_gcsv_readout() {
         "frames.csv",
         "t_start,exposure_s\n1.001,0.002\n1.050,0.002\n",
     );
-    let out = Command::new(env!("CARGO_BIN_EXE_mmbm"))
+    let out = common::mmbm_cmd()
         .args(["frames", "--gyro"])
         .arg(walk())
         .arg("--frames")

@@ -2,10 +2,11 @@
 //! integral. Tests that need an adapter skip (with a printed line) without one,
 //! unless MMBM_REQUIRE_GPU=1.
 
+mod common;
+
 use glam::DVec3;
 use mmbm::field::cpu as flow_cpu;
 use mmbm::field::{flow_field_gpu, mmbm_gpu, FlowRunner, Grid, TwistGpu};
-use mmbm::gpu::context::gpu_or_skip;
 use mmbm::io::gyro::GyroSample;
 use mmbm::series::gpu::series_evaluator;
 use mmbm::series::{eval_batch_cpu, SeriesOptions};
@@ -77,7 +78,7 @@ fn check_field(scene: &Scene, tw: &Twist) {
 /// GPU = twin exactly, 3.1e-7 of the max speed from the f64 formula).
 #[test]
 fn gpu_field_with_distortion() {
-    if gpu_or_skip("gpu_field_with_distortion").is_none() {
+    if common::gpu().is_none() {
         return;
     }
     let opencv = Camera {
@@ -119,7 +120,7 @@ fn gpu_field_with_distortion() {
 
 #[test]
 fn gpu_field_matches_twin_and_formula() {
-    if gpu_or_skip("gpu_field_matches_twin_and_formula").is_none() {
+    if common::gpu().is_none() {
         return;
     }
     let thesis = Scene::thesis();
@@ -138,7 +139,7 @@ fn gpu_field_matches_twin_and_formula() {
 #[test]
 fn gpu_field_signs_follow_the_formula() {
     // Independent of the twin: pitch up (wx > 0) moves every point down (+v), at f*wx/p_y px/s in the centre.
-    if gpu_or_skip("gpu_field_signs_follow_the_formula").is_none() {
+    if common::gpu().is_none() {
         return;
     }
     let s = Scene::thesis();
@@ -168,7 +169,7 @@ fn gpu_field_signs_follow_the_formula() {
 
 #[test]
 fn gpu_mean_matches_exact_integral() {
-    if gpu_or_skip("gpu_mean_matches_exact_integral").is_none() {
+    if common::gpu().is_none() {
         return;
     }
     let cam = Camera::thesis();
@@ -235,7 +236,7 @@ fn twists(n: usize) -> Vec<(Twist, Option<Plane>)> {
 
 #[test]
 fn batched_matches_single_and_cpu() {
-    if gpu_or_skip("batched_matches_single_and_cpu").is_none() {
+    if common::gpu().is_none() {
         return;
     }
     let cam = Camera::thesis();
@@ -290,7 +291,7 @@ fn samples(n: usize) -> Vec<GyroSample> {
 
 #[test]
 fn series_evaluator_matches_cpu_series() {
-    if gpu_or_skip("series_evaluator_matches_cpu_series").is_none() {
+    if common::gpu().is_none() {
         return;
     }
     let batch = samples(300);
@@ -331,7 +332,7 @@ fn series_evaluator_matches_cpu_series() {
 }
 
 fn mmbm_bin() -> Command {
-    let mut c = Command::new(env!("CARGO_BIN_EXE_mmbm"));
+    let mut c = common::mmbm_cmd();
     let d = std::env::temp_dir().join("mmbm-test-xdg");
     let _ = std::fs::create_dir_all(&d);
     c.env("XDG_RUNTIME_DIR", d);
@@ -368,7 +369,7 @@ fn no_adapter_is_a_clear_error_not_a_panic() {
 
 #[test]
 fn flow_command_writes_exr_and_quiver() {
-    if gpu_or_skip("flow_command_writes_exr_and_quiver").is_none() {
+    if common::gpu().is_none() {
         return;
     }
     let d = tempfile::tempdir().unwrap();

@@ -9,7 +9,7 @@ use mmbm::series::mmbm_series;
 use mmbm::trigger::{self, CameraTiming, Event, Frame, Live};
 use std::io::Write;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output, Stdio};
+use std::process::{Output, Stdio};
 
 /// Every causal policy form, with thresholds that make each trigger often.
 const CAUSAL: &[&str] = &[
@@ -30,13 +30,9 @@ const CAUSAL: &[&str] = &[
     "deadline:5:0.4",
 ];
 
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_mmbm"))
-}
-
 fn simulated_walk(dir: &Path) -> PathBuf {
     let p = dir.join("walk.csv");
-    let o = bin()
+    let o = common::mmbm_cmd()
         .args([
             "simulate",
             "--gait",
@@ -131,7 +127,7 @@ fn oracle_and_percentiles_are_refused() {
         let msg = e.to_string();
         assert!(msg.contains(p), "{msg}");
     }
-    let o = bin()
+    let o = common::mmbm_cmd()
         .args(["live", "--policy", "oracle:0.4"])
         .stdin(Stdio::null())
         .output()
@@ -142,7 +138,7 @@ fn oracle_and_percentiles_are_refused() {
 
 /// Runs `mmbm live` with `input` on stdin.
 fn live_cli(args: &[&str], input: &[u8]) -> Output {
-    let mut child = bin()
+    let mut child = common::mmbm_cmd()
         .arg("live")
         .args(args)
         .stdin(Stdio::piped())
@@ -171,7 +167,7 @@ fn json_lines(o: &Output) -> Vec<serde_json::Value> {
 
 /// `trigger_t` of every frame of `mmbm trigger` on `log`.
 fn offline_cli(log: &Path, policy: &str, exposure: &str) -> Vec<f64> {
-    let o = bin()
+    let o = common::mmbm_cmd()
         .args([
             "trigger",
             "--policy",
@@ -247,7 +243,7 @@ fn json_lines_and_replay_match_csv_stdin() {
     let args = ["--policy", "threshold:0.4", "--policy", "fixed:5"];
     let a = live_cli(&args, &std::fs::read(&walk).unwrap());
     let b = live_cli(&args, js.as_bytes());
-    let c = bin()
+    let c = common::mmbm_cmd()
         .arg("live")
         .args(args)
         .args(["--speed", "0", "--replay"])
@@ -336,7 +332,7 @@ fn udp_datagrams_are_decided() {
         s.local_addr().unwrap().port()
     };
     let addr = format!("127.0.0.1:{port}");
-    let child = bin()
+    let child = common::mmbm_cmd()
         .args(["live", "--policy", "fixed:5", "--all", "--idle-exit", "1.5"])
         .args(["--udp", &addr])
         .stdout(Stdio::piped())

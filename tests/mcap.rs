@@ -2,9 +2,11 @@
 //! (`tests/fixtures/mcap/make_imu_mcap.py`) reads as the CSV the same script
 //! printed, through the library and every command that takes `--gyro`.
 
+mod common;
+
+use common::mmbm;
 use mmbm::io::gyro::{read_log, GyroOptions};
 use std::path::PathBuf;
-use std::process::Command;
 
 fn fixture(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -17,13 +19,6 @@ fn with_topic(topic: &str) -> GyroOptions {
         topic: Some(topic.into()),
         ..GyroOptions::default()
     }
-}
-
-fn mmbm(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_mmbm"))
-        .args(args)
-        .output()
-        .unwrap()
 }
 
 #[test]

@@ -1,7 +1,8 @@
 //! GPU kernel vs its CPU twin, per pixel, and the golden renders.
 
+mod common;
+
 use glam::DVec3;
-use mmbm::gpu::context::gpu_or_skip;
 use mmbm::io::images::{read_rgb8, save_rgb8, write_png_linear_rgb};
 use mmbm::render::{self, Backend, Integrator, Quality, RenderJob, Target, Trajectory};
 use mmbm::{Camera, Twist};
@@ -116,7 +117,7 @@ fn test_texture(dir: &std::path::Path) -> PathBuf {
 
 #[test]
 fn gpu_matches_cpu_twin_per_pixel() {
-    let Some(ctx) = gpu_or_skip("gpu_matches_cpu_twin_per_pixel") else {
+    let Some(ctx) = common::gpu() else {
         return;
     };
     eprintln!("adapter: {}", ctx.description);

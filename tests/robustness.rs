@@ -5,8 +5,9 @@
 
 mod common;
 
+use common::mmbm_in;
 use std::path::Path;
-use std::process::{Command, Output, Stdio};
+use std::process::{Command, Stdio};
 
 /// A gyro log with a 5 s gap after its first second.
 fn gap_log() -> String {
@@ -72,15 +73,6 @@ fn one_red_pixel_png() -> Vec<u8> {
     let mut out = std::io::Cursor::new(Vec::new());
     img.write_to(&mut out, image::ImageFormat::Png).unwrap();
     out.into_inner()
-}
-
-fn mmbm_in(dir: &Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_mmbm"))
-        .args(args)
-        .current_dir(dir)
-        .stdin(Stdio::null())
-        .output()
-        .unwrap()
 }
 
 /// Names in `dir` besides the input files.
@@ -302,7 +294,7 @@ fn outputs_never_replace_what_they_point_at() {
 #[test]
 fn an_interrupt_removes_temporary_files() {
     let d = tempfile::tempdir().unwrap();
-    let mut child = Command::new(env!("CARGO_BIN_EXE_mmbm"))
+    let mut child = common::mmbm_cmd()
         .args(["series", "--gyro", "-", "--out", "o.csv"])
         .current_dir(d.path())
         .stdin(Stdio::piped())
@@ -347,7 +339,7 @@ fn an_interrupt_removes_temporary_files() {
 #[test]
 fn real_logs_at_absurd_rates_are_refused_quickly() {
     if let Some(car) = common::shared_log("dashboard_car") {
-        let o = Command::new(env!("CARGO_BIN_EXE_mmbm"))
+        let o = common::mmbm_cmd()
             .args([
                 "trigger",
                 "--policy",

@@ -116,19 +116,3 @@ pub fn gpu() -> Result<&'static GpuContext> {
         .as_ref()
         .map_err(|e| Error::Gpu(e.trim_start_matches("GPU: ").to_string()))
 }
-
-/// For tests: `Some(ctx)` when a device exists; `None` (and a line on stderr
-/// saying the test was skipped) when none does and `MMBM_REQUIRE_GPU` is not
-/// set; panics with the adapter error when `MMBM_REQUIRE_GPU=1`.
-pub fn gpu_or_skip(test: &str) -> Option<&'static GpuContext> {
-    match gpu() {
-        Ok(c) => Some(c),
-        Err(e) => {
-            if std::env::var("MMBM_REQUIRE_GPU").is_ok_and(|v| v == "1") {
-                panic!("{test}: MMBM_REQUIRE_GPU=1 but {e}");
-            }
-            eprintln!("SKIPPED {test}: {e}");
-            None
-        }
-    }
-}
