@@ -73,7 +73,12 @@ fn direct(samples: &[GyroSample], cam: &Camera, f: &VideoFrame, nu: u32, nv: u32
 fn shared_frames(name: &str) -> Option<(Vec<GyroSample>, Vec<VideoFrame>)> {
     let gyro = common::shared_log(name)?;
     let frames = read_frames(&gyro.with_file_name("frames.csv")).unwrap();
-    Some((read_log(&gyro, GyroOptions::default()).unwrap(), frames))
+    Some((
+        read_log(&gyro, GyroOptions::default())
+            .unwrap()
+            .into_samples(),
+        frames,
+    ))
 }
 
 fn example_camera(name: &str) -> Camera {

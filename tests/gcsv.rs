@@ -361,8 +361,13 @@ fn every_gyro_command_takes_gcsv() {
         "walk.csv",
         &equivalent_csv(&raw_rows(&walk_text())),
     );
-    let from_csv: Vec<GyroSample> = read_log(&csv, GyroOptions::default()).unwrap();
-    assert_eq!(from_csv, read_log(&walk(), GyroOptions::default()).unwrap());
+    let from_csv: Vec<GyroSample> = read_log(&csv, GyroOptions::default())
+        .unwrap()
+        .into_samples();
+    assert_eq!(
+        from_csv,
+        read_log(&walk(), GyroOptions::default()).unwrap().samples()
+    );
     let (g, c) = (walk(), csv);
     let (g, c) = (g.to_str().unwrap(), c.to_str().unwrap());
     let runs: [Vec<&str>; 3] = [

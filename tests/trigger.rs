@@ -528,7 +528,7 @@ fn bad_inputs_are_errors() {
     let s = log(&grid(10, 0.01));
     let mut p = parse_policy("fixed:5").unwrap();
     assert!(run(&s, &[0.0; 9], p.as_mut(), &CameraTiming::default()).is_err());
-    assert!(run(&[], &[], p.as_mut(), &CameraTiming::default()).is_err());
+    assert!(run::<f64>(&[], &[], p.as_mut(), &CameraTiming::default()).is_err());
     let bad = CameraTiming {
         exposure: -1.0,
         ..CameraTiming::default()

@@ -292,10 +292,20 @@ fn read_gyro<'py>(
         time_offset,
         topic,
     };
-    let s = py
+    let log = py
         .detach(|| mmbm::io::gyro::read_log(&path, opts))
         .map_err(err)?;
-    samples_dict(py, &s)
+    let d = samples_dict(py, &log)?;
+    // The file's own rolling-shutter readout (a Gyroflow .gcsv header's).
+    if let Some(r) = log.readout() {
+        d.set_item("readout_s", r.readout_s)?;
+        if let Some(dir) = r.direction {
+            // The camera files' name of the direction, e.g. "top-to-bottom".
+            let name = serde_json::to_value(dir).map_err(|e| PyValueError::new_err(e.to_string()))?;
+            d.set_item("readout_direction", name.as_str().unwrap_or_default())?;
+        }
+    }
+    Ok(d)
 }
 
 fn samples_dict<'py>(py: Python<'py>, s: &[GyroSample]) -> PyResult<Bound<'py, PyDict>> {
@@ -510,15 +520,6 @@ fn trigger<'py>(
 ) -> PyResult<Vec<Bound<'py, PyDict>>> {
     let t = t.as_slice()?.to_vec();
     let m = mmbm_mm_s.as_slice()?.to_vec();
-    let samples: Vec<GyroSample> = t
-        .iter()
-        .map(|&t| GyroSample {
-            t,
-            omega: DVec3::ZERO,
-            velocity: None,
-            depth: None,
-        })
-        .collect();
     let timing = CameraTiming {
         delay,
         exposure,
@@ -531,7 +532,8 @@ fn trigger<'py>(
         let f = py
             .detach(|| {
                 let mut policy = mmbm::trigger::parse_policy(p)?;
-                mmbm::trigger::run(&samples, &m, policy.as_mut(), &timing)
+                // The runner uses only the times: no samples are made up.
+                mmbm::trigger::run(&t, &m, policy.as_mut(), &timing)
             })
             .map_err(err)?;
         frames.extend(f);

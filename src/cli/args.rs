@@ -135,21 +135,19 @@ impl CameraArgs {
 /// `camera` with the rolling-shutter readout of a Gyroflow `.gcsv` log
 /// (`frame_readout_time`, `frame_readout_direction`) when the camera gives
 /// none (a camera file's or `--rolling-readout`'s readout wins).
-pub fn with_log_readout(mut camera: Camera, gyro: &std::path::Path) -> Result<Camera> {
-    if camera.shutter.is_global() && mmbm::io::gcsv::is_gcsv(gyro) {
-        let h = mmbm::io::gcsv::read_header(gyro)?;
-        if let Some(r) = h.readout_s {
-            camera.shutter.readout_s = r;
-            if let Some(d) = h.readout_direction {
-                camera.shutter.direction = d;
-            }
-            camera.validate()?;
-            eprintln!(
-                "rolling shutter from {}: readout {r} s, {:?}",
-                gyro.display(),
-                camera.shutter.direction
-            );
-        }
+pub fn with_log_readout(
+    camera: Camera,
+    log: &mmbm::model::log::ImuLog,
+    gyro: &std::path::Path,
+) -> Result<Camera> {
+    let (camera, applied) = log.apply_readout(camera)?;
+    if applied {
+        eprintln!(
+            "rolling shutter from {}: readout {} s, {:?}",
+            gyro.display(),
+            camera.shutter.readout_s,
+            camera.shutter.direction
+        );
     }
     Ok(camera)
 }

@@ -67,7 +67,11 @@ pub fn run(a: FramesArgs) -> Result<()> {
             ))
         }
     };
-    let camera = super::args::with_log_readout(a.camera.camera()?, &a.gyro)?;
+    let camera = a.camera.camera()?;
+    mmbm::error::finite("--gap", a.gap)?;
+    let frames = read_frames(&a.frames)?;
+    let samples = read_log(&a.gyro, a.gyro_opts.options()?)?;
+    let camera = super::args::with_log_readout(camera, &samples, &a.gyro)?;
     let opts = SeriesOptions {
         scene: Scene {
             camera,
@@ -76,9 +80,6 @@ pub fn run(a: FramesArgs) -> Result<()> {
         method,
         use_velocity: a.use_velocity,
     };
-    mmbm::error::finite("--gap", a.gap)?;
-    let frames = read_frames(&a.frames)?;
-    let samples = read_log(&a.gyro, a.gyro_opts.options()?)?;
     let (rows, outside) = frame_mmbm(&samples, &opts, &frames)?;
     if !outside.is_empty() {
         let list: Vec<String> = outside.iter().take(8).map(|k| k.to_string()).collect();

@@ -284,7 +284,7 @@ pub fn run(a: LiveArgs) -> Result<()> {
                 format!("must be >= 0, got {}", a.speed),
             ));
         }
-        let samples = mmbm::io::gyro::read_log(path, gyro_opts)?;
+        let samples = mmbm::io::gyro::read_log(path, gyro_opts)?.into_samples();
         let t0 = samples.first().map_or(0.0, |s| s.t);
         let start = Instant::now();
         for (k, s) in samples.into_iter().enumerate() {

@@ -171,21 +171,25 @@ pub fn run(args: RenderArgs) -> Result<()> {
     if let Some((w, h)) = a.resolution {
         camera = camera.with_resolution(w, h);
     }
-    if let Some(g) = &a.gyro {
-        camera = super::args::with_log_readout(camera, g)?;
-    }
+    let log = match &a.gyro {
+        Some(g) => {
+            let log = mmbm::io::gyro::read_log(g, a.gyro_opts.options()?)?;
+            camera = super::args::with_log_readout(camera, &log, g)?;
+            Some(log)
+        }
+        None => None,
+    };
     // A rolling shutter exposes each line over its own window: the motion
     // spans the readout plus the exposure.
     let span = a.exposure + camera.shutter.readout_s;
-    let trajectory = match (&a.omega, &a.gyro) {
-        (Some(w), None) => {
+    let trajectory = match (&a.omega, &a.gyro, &log) {
+        (Some(w), None, _) => {
             Trajectory::from_twist(Twist::new(*w, a.velocity.unwrap_or_default()), span)?
         }
-        (None, Some(path)) => {
+        (None, Some(path), Some(log)) => {
             let at =
                 a.at.ok_or_else(|| Error::invalid("--at", "required with --gyro"))?;
-            let samples = mmbm::io::gyro::read_log(path, a.gyro_opts.options()?)?;
-            Trajectory::from_log(&samples, at, span, a.use_velocity)
+            Trajectory::from_imu_log(log, at, span, a.use_velocity)
                 .map_err(|e| Error::invalid("--gyro", format!("{}: {e}", path.display())))?
         }
         _ => {

@@ -112,17 +112,19 @@ fn summary_text(frames: &[Frame], spec: &str, duration: f64, pitch_mm: f64) -> S
 
 pub fn run(a: TriggerArgs) -> Result<()> {
     let method: Method = a.method.parse()?;
-    let camera = super::args::with_log_readout(a.camera.camera()?, &a.gyro)?;
+    let mut policies = Vec::new();
+    for p in &a.policy {
+        policies.push(trigger::parse_policy(p)?);
+    }
+    let camera = a.camera.camera()?;
+    let samples = read_log(&a.gyro, a.gyro_opts.options()?)?;
+    let camera = super::args::with_log_readout(camera, &samples, &a.gyro)?;
     // A rolling shutter keeps the camera busy for its line readout as well.
     let timing = a
         .timing
         .timing(a.exposure, camera.pitch_x_mm)
         .with_rolling_readout(camera.shutter.readout_s);
     timing.validate()?;
-    let mut policies = Vec::new();
-    for p in &a.policy {
-        policies.push(trigger::parse_policy(p)?);
-    }
     let opts = SeriesOptions {
         scene: Scene {
             camera,
@@ -131,7 +133,6 @@ pub fn run(a: TriggerArgs) -> Result<()> {
         method,
         use_velocity: a.use_velocity,
     };
-    let samples = read_log(&a.gyro, a.gyro_opts.options()?)?;
     let m = mmbm::series::mmbm_series_with(&samples, &opts)?;
     let duration = samples[samples.len() - 1].t - samples[0].t;
     let mut all = Vec::new();

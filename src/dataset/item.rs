@@ -8,6 +8,7 @@ use crate::field::flow_field;
 use crate::io::gyro::{read_log, GyroOptions, GyroSample};
 use crate::io::images::write_exr;
 use crate::metric::{mmbm, Method, Scene};
+use crate::model::log::ImuLog;
 use crate::model::motion::{Plane, Twist};
 use crate::render::{self, Backend, Quality, RenderJob, RenderOutput, Target, Trajectory};
 use crate::sim::{simulate, GaitConfig};
@@ -66,7 +67,7 @@ pub struct Sources {
     pub textures_dir: PathBuf,
     /// Texture file names, sorted.
     pub textures: Vec<String>,
-    logs: HashMap<PathBuf, Vec<GyroSample>>,
+    logs: HashMap<PathBuf, ImuLog>,
 }
 
 impl Sources {
@@ -173,14 +174,14 @@ fn camera(res: [u32; 2]) -> Camera {
 }
 
 /// The samples an item's motion is a window of.
-fn samples(p: &ItemParams, src: &Sources) -> Result<Vec<GyroSample>> {
+fn samples(p: &ItemParams, src: &Sources) -> Result<ImuLog> {
     match MotionSource::parse(&p.motion)? {
-        MotionSource::Sim(g) => simulate(
+        MotionSource::Sim(g) => ImuLog::new(simulate(
             &GaitConfig::preset(g),
             SIM_SETTLE_S + 1.0 + p.exposure_s + 0.5,
             600.0,
             p.seed,
-        ),
+        )?),
         MotionSource::Log(path) => match src.logs.get(&path) {
             Some(s) => Ok(s.clone()),
             None => read_log(&path, GyroOptions::default()),
@@ -245,7 +246,7 @@ pub fn make(p: &ItemParams, src: &Sources, dir: &Path) -> Result<ItemMeasures> {
     let s = samples(p, src)?;
     // The motion spans the readout (none: dataset cameras are global-shutter) plus the exposure.
     let span = cam.shutter.readout_s + p.exposure_s;
-    let traj = Trajectory::from_log(&s, p.start_s, span, p.use_velocity)?;
+    let traj = Trajectory::from_imu_log(&s, p.start_s, span, p.use_velocity)?;
     let tex = src.textures_dir.join(&p.texture);
     let spec = format!("image:{}:{}", tex.display(), p.texture_width_m);
     let mut target = Target::parse(&spec, p.distance_m)?;

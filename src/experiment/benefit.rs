@@ -340,14 +340,17 @@ mod tests {
     use crate::trigger::Frame;
 
     fn walk(seed: u64) -> Walk {
-        let samples = (0..=200)
-            .map(|k| GyroSample {
-                t: k as f64 * 0.1,
-                omega: glam::DVec3::ZERO,
-                velocity: None,
-                depth: None,
-            })
-            .collect();
+        let samples = crate::model::log::ImuLog::new(
+            (0..=200)
+                .map(|k| GyroSample {
+                    t: k as f64 * 0.1,
+                    omega: glam::DVec3::ZERO,
+                    velocity: None,
+                    depth: None,
+                })
+                .collect(),
+        )
+        .unwrap();
         Walk {
             name: format!("w-s{seed}"),
             gait: "w".into(),

@@ -295,7 +295,7 @@ pub fn render_and_measure(
     // spans the readout plus the exposure.
     let rolling = cam.shutter.readout_s;
     let exposure = frame.exposure_s();
-    let traj = Trajectory::from_log(
+    let traj = Trajectory::from_imu_log(
         &walk.samples,
         frame.exposure_start,
         exposure + rolling,

@@ -3,8 +3,9 @@
 
 use super::config::ExperimentConfig;
 use crate::error::Result;
-use crate::io::gyro::{read_log, GyroOptions, GyroSample};
+use crate::io::gyro::{read_log, GyroOptions};
 use crate::metric::{Method, Scene};
+use crate::model::log::ImuLog;
 use crate::sim::{simulate, Gait, GaitConfig};
 use crate::trigger::{self, CameraTiming, Frame, PolicySpec};
 use std::str::FromStr;
@@ -20,7 +21,7 @@ pub struct Walk {
     /// Simulation seed (0 for a log).
     pub seed: u64,
     /// The gyro samples (true motion and measurement).
-    pub samples: Vec<GyroSample>,
+    pub samples: ImuLog,
     /// Rotation-only MMBM per sample (8x6 grid), mm/s.
     pub mmbm: Vec<f64>,
     /// Distance to the target per sample, m.
@@ -49,7 +50,7 @@ pub fn make_walk(
             let g = GaitConfig::preset(gait);
             (
                 walk.to_string(),
-                simulate(&g, cfg.duration_s, cfg.rate_hz, seed)?,
+                ImuLog::new(simulate(&g, cfg.duration_s, cfg.rate_hz, seed)?)?,
             )
         }
     };

@@ -8,6 +8,8 @@
 //! field; errors name the file, line and column.
 
 use crate::error::{Error, Result};
+pub use crate::model::log::GyroSample;
+use crate::model::log::{is_gap, ImuLog, LogReadout};
 use glam::{DMat3, DVec3};
 use serde::{Deserialize, Serialize};
 use std::fs::File;
@@ -162,19 +164,6 @@ pub fn parse_rotation(s: &str) -> Result<DMat3> {
     Ok(m)
 }
 
-/// One gyro sample in the camera frame.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct GyroSample {
-    /// Time, s.
-    pub t: f64,
-    /// Angular velocity, rad/s.
-    pub omega: DVec3,
-    /// Linear velocity, m/s, when the log has `vx, vy, vz`.
-    pub velocity: Option<DVec3>,
-    /// Scene depth, m, when the log has `depth`.
-    pub depth: Option<f64>,
-}
-
 /// Streaming, validating reader of a gyro CSV.
 pub struct GyroReader {
     path: PathBuf,
@@ -192,12 +181,14 @@ pub struct GyroReader {
     warnings: Vec<String>,
     count: u64,
     failed: bool,
+    readout: Option<LogReadout>,
 }
 
 impl GyroReader {
     /// Opens `path` (`-`: standard input, named `<stdin>` in errors) and
     /// checks the header.
     pub fn open(path: &Path, opts: GyroOptions) -> Result<Self> {
+        let mut readout = None;
         let (file, path): (Box<dyn Read + Send>, &Path) = if path.as_os_str() == "-" {
             (Box::new(std::io::stdin()), Path::new("<stdin>"))
         } else if super::mcap::is_mcap(path) {
@@ -222,7 +213,13 @@ impl GyroReader {
             }
             // Converted to CSV one line at a time (constant memory), with
             // the same line numbers; a bad row is reported by the stream.
-            (Box::new(super::gcsv::CsvStream::open(path)?), path)
+            let stream = super::gcsv::CsvStream::open(path)?;
+            let h = stream.header();
+            readout = h.readout_s.map(|readout_s| LogReadout {
+                readout_s,
+                direction: h.readout_direction,
+            });
+            (Box::new(stream), path)
         } else {
             (
                 Box::new(File::open(path).map_err(|e| Error::io(path, e))?),
@@ -292,7 +289,13 @@ impl GyroReader {
             warnings: Vec::new(),
             count: 0,
             failed: false,
+            readout,
         })
+    }
+
+    /// The file's own rolling-shutter readout (a `.gcsv` header's), if any.
+    pub fn readout(&self) -> Option<LogReadout> {
+        self.readout
     }
 
     /// True when the log has `vx, vy, vz`.
@@ -421,13 +424,13 @@ impl GyroReader {
                     let med = v[N / 2];
                     self.median_dt = Some(med);
                     for &d in &v {
-                        if d > 5.0 * med {
+                        if is_gap(d, med) {
                             self.warn(format!("gap of {d:.6} s among the first {N} samples (median interval {med:.6} s)"));
                         }
                     }
                 }
             }
-            Some(med) if dt > 5.0 * med => self.warn(format!(
+            Some(med) if is_gap(dt, med) => self.warn(format!(
                 "{}:{line}: gap of {dt:.6} s before t = {t} s (median interval {med:.6} s)",
                 self.path.display()
             )),
@@ -488,12 +491,13 @@ fn csv_error(path: &Path, e: csv::Error, what: &str) -> Error {
 }
 
 /// Reads a whole log into memory (for windows and policies that need random
-/// access). Its warnings (gaps) are printed on stderr as `warning: ...`.
-pub fn read_log(path: &Path, opts: GyroOptions) -> Result<Vec<GyroSample>> {
+/// access), with the file's own readout where it has one. Its warnings
+/// (gaps) are printed on stderr as `warning: ...`.
+pub fn read_log(path: &Path, opts: GyroOptions) -> Result<ImuLog> {
     let mut r = GyroReader::open(path, opts)?;
     let samples = r.by_ref().collect::<Result<Vec<_>>>()?;
     r.print_warnings();
-    Ok(samples)
+    Ok(ImuLog::new(samples)?.with_readout(r.readout()))
 }
 
 #[cfg(test)]

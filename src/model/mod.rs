@@ -1,9 +1,11 @@
 //! The physical model (SPEC sections 1-2): the camera (its own layer-1 folder,
 //! [`crate::camera`]), its motion and the scene plane ([`motion`]), and the
-//! instantaneous image-plane flow they produce ([`flow`]). Everything else in
-//! the crate builds on these; this layer imports only `camera` and `error`.
+//! instantaneous image-plane flow they produce ([`flow`]), and the IMU log that
+//! measures the motion ([`log`]). Everything else in the crate builds on
+//! these; this layer imports only `camera`, `error` and `stats`.
 
 pub mod flow;
+pub mod log;
 pub mod motion;
 
 pub use crate::camera::Camera;

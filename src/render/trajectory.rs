@@ -8,6 +8,7 @@
 
 use crate::error::{positive, Error, Result};
 use crate::io::gyro::GyroSample;
+use crate::model::log::{check_times, is_gap, median_interval, min_interval, ImuLog};
 use crate::model::motion::Twist;
 use glam::{DMat3, DQuat, DVec3};
 
@@ -106,6 +107,28 @@ impl Trajectory {
         duration: f64,
         use_velocity: bool,
     ) -> Result<Self> {
+        check_times(samples, "gyro log")?;
+        let median = median_interval(samples).unwrap_or(0.0);
+        let dt_min = min_interval(samples).unwrap_or(f64::INFINITY);
+        Self::from_samples(samples, (median, dt_min), t0, duration, use_velocity)
+    }
+
+    /// [`Self::from_log`] on a validated log, whose median interval is
+    /// known (many frames of one log: no per-frame pass over the log).
+    pub fn from_imu_log(log: &ImuLog, t0: f64, duration: f64, use_velocity: bool) -> Result<Self> {
+        let median = log.median_interval().unwrap_or(0.0);
+        let dt_min = log.min_interval().unwrap_or(f64::INFINITY);
+        Self::from_samples(log.samples(), (median, dt_min), t0, duration, use_velocity)
+    }
+
+    /// `intervals`: the log's median and shortest sample interval, s.
+    fn from_samples(
+        samples: &[GyroSample],
+        (median, dt_min): (f64, f64),
+        t0: f64,
+        duration: f64,
+        use_velocity: bool,
+    ) -> Result<Self> {
         positive("exposure (s)", duration)?;
         crate::error::finite("exposure start --at (s)", t0)?;
         let (first, last) = match (samples.first(), samples.last()) {
@@ -136,11 +159,12 @@ impl Trajectory {
             }
         }
         // A gap in the log inside the window: no motion is known there.
-        let intervals: Vec<f64> = samples.windows(2).map(|w| w[1].t - w[0].t).collect();
-        let median = crate::stats::percentile(&intervals, 50.0).unwrap_or(0.0);
-        if let Some(w) = samples
+        let lo = samples.partition_point(|s| s.t <= t0).saturating_sub(1);
+        let hi = samples.partition_point(|s| s.t < t1).min(samples.len() - 1);
+        let window = &samples[lo..=hi];
+        if let Some(w) = window
             .windows(2)
-            .find(|w| w[1].t > t0 && w[0].t < t1 && w[1].t - w[0].t > 5.0 * median)
+            .find(|w| w[1].t > t0 && w[0].t < t1 && is_gap(w[1].t - w[0].t, median))
         {
             return Err(Error::invalid(
                 "exposure window",
@@ -153,7 +177,6 @@ impl Trajectory {
                 ),
             ));
         }
-        let dt_min = intervals.iter().copied().fold(f64::INFINITY, f64::min);
         let n = ((duration / dt_min * 16.0).ceil() as usize).clamp(512, 1 << 20);
         let h = duration / n as f64;
         let interp = |t: f64| -> (DVec3, DVec3) {

@@ -20,6 +20,7 @@ use crate::io::frames::VideoFrame;
 use crate::io::gyro::GyroSample;
 use crate::metric::{exact_with, gauss_points, point_speed, riemann_points, GridRule, Method};
 use crate::model::flow::FlowPoly;
+use crate::model::log::{check_times, Integral};
 use std::collections::BTreeMap;
 
 /// The exposure MMBM of one frame.
@@ -49,23 +50,8 @@ impl FrameMmbm {
 
 /// Mean over `[a, b]` of the piecewise-linear function through `(t[i], y[i])`
 /// (`t` increasing, covering `[a, b]`); the value at `a` when `b <= a`.
-pub fn window_mean(t: &[f64], y: &[f64], a: f64, b: f64) -> f64 {
-    let at = |x: f64, i: usize| y[i] + (y[i + 1] - y[i]) * (x - t[i]) / (t[i + 1] - t[i]);
-    if t.len() == 1 {
-        return y[0];
-    }
-    if b <= a {
-        let i = t.partition_point(|&s| s <= a).clamp(1, t.len() - 1) - 1;
-        return at(a, i);
-    }
-    let mut sum = 0.0;
-    for i in 0..t.len() - 1 {
-        let (lo, hi) = (a.max(t[i]), b.min(t[i + 1]));
-        if hi > lo {
-            sum += 0.5 * (hi - lo) * (at(lo, i) + at(hi, i));
-        }
-    }
-    sum / (b - a)
+fn window_mean(t: &[f64], y: &[f64], a: f64, b: f64) -> f64 {
+    Integral::new(t, y).mean(a, b)
 }
 
 /// The rule's nodes grouped by line: (delay per second of readout, rule of
@@ -111,6 +97,7 @@ pub fn frame_mmbm(
     if samples.len() < 2 {
         return Err(Error::invalid("gyro log", "needs at least 2 samples"));
     }
+    check_times(samples, "gyro log")?;
     let groups = match opts.method {
         Method::Riemann { .. } | Method::Gauss { .. } => Some(line_groups(&cam, opts.method)?),
         Method::Exact { .. } => None,
@@ -233,19 +220,4 @@ pub fn select_sharpest(frames: &[FrameMmbm], cam: &Camera, n: usize, gap_s: f64)
     }
     picked.sort_unstable();
     picked
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn window_mean_is_exact_for_piecewise_linear() {
-        let t = [0.0, 1.0, 3.0];
-        let y = [0.0, 2.0, 0.0];
-        // Integral over [0.5, 2]: 0.5*(1+2)*0.5 + 0.5*(2+1)*1 = 0.75 + 1.5 = 2.25.
-        assert!((window_mean(&t, &y, 0.5, 2.0) - 2.25 / 1.5).abs() < 1e-15);
-        assert_eq!(window_mean(&t, &y, 2.0, 2.0), 1.0);
-        assert_eq!(window_mean(&t, &y, 0.0, 3.0), 1.0);
-    }
 }

@@ -3,14 +3,15 @@
 use super::policy::{LogView, Observation, Policy};
 use super::timing::{CameraTiming, Frame, Integral};
 use crate::error::{Error, Result};
-use crate::io::gyro::GyroSample;
+use crate::model::log::{check_times, Timed};
 
-/// Runs `policy` over a log: `mmbm_mm_s[i]` is the MMBM of `samples[i]`.
+/// Runs `policy` over a log: `mmbm_mm_s[i]` is the MMBM at the time of
+/// `samples[i]` (gyro samples, or bare times in s: only the times are used).
 /// The policy sees, at each sample, only the samples up to it (the oracle
 /// also gets the whole log in [`Policy::prepare`]). Returns the frames in
 /// time order.
-pub fn run(
-    samples: &[GyroSample],
+pub fn run<S: Timed>(
+    samples: &[S],
     mmbm_mm_s: &[f64],
     policy: &mut dyn Policy,
     timing: &CameraTiming,
@@ -29,15 +30,9 @@ pub fn run(
     if samples.is_empty() {
         return Err(Error::invalid("gyro log", "no samples"));
     }
-    let t: Vec<f64> = samples.iter().map(|s| s.t).collect();
+    check_times(samples, "gyro log")?;
+    let t: Vec<f64> = samples.iter().map(Timed::time).collect();
     for i in 0..t.len() {
-        crate::error::finite("sample time", t[i])?;
-        if i > 0 && t[i] <= t[i - 1] {
-            return Err(Error::invalid(
-                "gyro log",
-                format!("time not strictly increasing at sample {i} (t = {})", t[i]),
-            ));
-        }
         let m = mmbm_mm_s[i];
         if !(m.is_finite() && m >= 0.0) {
             return Err(Error::invalid(

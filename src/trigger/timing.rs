@@ -2,6 +2,7 @@
 //! exposure average of the MMBM series ([`Integral`]).
 
 use crate::error::{Error, Result};
+pub use crate::model::log::Integral;
 
 /// Camera timing (thesis Fig. 5.1), seconds.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -106,109 +107,6 @@ impl Frame {
     /// The frame's exposure, s.
     pub fn exposure_s(&self) -> f64 {
         self.exposure_end - self.exposure_start
-    }
-}
-
-/// The prefix integral of a piecewise-linear series, for exposure averages.
-/// Can be built incrementally (`push`), which causal policies use on the
-/// samples they have seen.
-#[derive(Debug, Clone, Default)]
-pub struct Integral {
-    t: Vec<f64>,
-    m: Vec<f64>,
-    cum: Vec<f64>,
-}
-
-impl Integral {
-    /// The integral of `m` over times `t` (same length, `t` increasing).
-    pub fn new(t: &[f64], m: &[f64]) -> Self {
-        let mut s = Integral {
-            t: Vec::with_capacity(t.len()),
-            m: Vec::with_capacity(t.len()),
-            cum: Vec::with_capacity(t.len()),
-        };
-        for (&a, &b) in t.iter().zip(m) {
-            s.push(a, b);
-        }
-        s
-    }
-
-    /// Appends one sample (time after the previous one).
-    pub fn push(&mut self, t: f64, m: f64) {
-        let c = match (self.t.last(), self.m.last(), self.cum.last()) {
-            (Some(&t0), Some(&m0), Some(&c0)) => c0 + 0.5 * (t - t0) * (m + m0),
-            _ => 0.0,
-        };
-        self.t.push(t);
-        self.m.push(m);
-        self.cum.push(c);
-    }
-
-    /// Time of the last sample, s.
-    pub fn last_time(&self) -> Option<f64> {
-        self.t.last().copied()
-    }
-
-    /// Forgets samples before `t` (s), keeping the last one at or before it,
-    /// so means over windows from `t` on are unchanged (bit for bit: the
-    /// running integral is kept as it was). Drops in bulk, once at least half
-    /// of the samples are stale: amortised O(1) per sample.
-    pub fn trim_before(&mut self, t: f64) {
-        let j = self.t.partition_point(|&s| s <= t).saturating_sub(1);
-        if j > 0 && 2 * j >= self.t.len() {
-            self.t.drain(..j);
-            self.m.drain(..j);
-            self.cum.drain(..j);
-        }
-    }
-
-    /// Number of samples.
-    pub fn len(&self) -> usize {
-        self.t.len()
-    }
-
-    /// True when empty.
-    pub fn is_empty(&self) -> bool {
-        self.t.is_empty()
-    }
-
-    /// Interpolated value at `x` (held constant outside the samples).
-    pub fn value(&self, x: f64) -> f64 {
-        let n = self.t.len();
-        let j = self.t.partition_point(|&s| s <= x);
-        if j == 0 {
-            return self.m[0];
-        }
-        if j == n {
-            return self.m[n - 1];
-        }
-        let (t0, t1) = (self.t[j - 1], self.t[j]);
-        let a = (x - t0) / (t1 - t0);
-        self.m[j - 1] + a * (self.m[j] - self.m[j - 1])
-    }
-
-    /// Integral from the first sample to `x`.
-    fn upto(&self, x: f64) -> f64 {
-        let n = self.t.len();
-        let j = self.t.partition_point(|&s| s <= x);
-        if j == 0 {
-            return (x - self.t[0]) * self.m[0];
-        }
-        let (tj, mj) = (self.t[j - 1], self.m[j - 1]);
-        if j == n {
-            return self.cum[n - 1] + (x - tj) * mj;
-        }
-        let a = (x - tj) / (self.t[j] - tj);
-        let mx = mj + a * (self.m[j] - mj);
-        self.cum[j - 1] + 0.5 * (x - tj) * (mj + mx)
-    }
-
-    /// Time average over `[a, b]` (the value at `a` when `b <= a`).
-    pub fn mean(&self, a: f64, b: f64) -> f64 {
-        if b <= a {
-            return self.value(a);
-        }
-        (self.upto(b) - self.upto(a)) / (b - a)
     }
 }
 
