@@ -45,7 +45,9 @@
 //! | `P+exp:B[:TMIN]` | any policy `P` with exposure control: each frame's exposure shortened (and gain raised) so the blur the MMBM predicts stays within `B` px (see [`Exposure`]) |
 
 mod exposure;
+mod latency;
 mod live;
+mod pace;
 mod parse;
 mod phase;
 mod policy;
@@ -53,10 +55,13 @@ mod predict;
 mod rules;
 mod run;
 mod stats;
+mod stream;
 mod timing;
 
 pub use exposure::Exposure;
+pub use latency::Latency;
 pub use live::{Event, Live};
+pub use pace::check_speed;
 pub use parse::parse_policy;
 pub(crate) use parse::parse_rate;
 pub use phase::Phase;
@@ -68,4 +73,5 @@ pub use stats::{
     prediction_error, summary, summary_over, write_frames, ErrorStats, Summary, Table51,
     FRAME_HEADER,
 };
+pub use stream::{Stream, StreamControl, StreamEnd, StreamOptions, StreamOutcome, POLL};
 pub use timing::{exposure_means, CameraTiming, Frame, Integral};
