@@ -99,9 +99,9 @@ mod tests {
         }
         assert_eq!(l.len(), 100);
         let p50 = l.quantile_us(0.5);
-        assert!(p50 >= 50.0 && p50 <= 50.0 * 1.05, "{p50}");
+        assert!((50.0..=50.0 * 1.05).contains(&p50), "{p50}");
         let p99 = l.quantile_us(0.99);
-        assert!(p99 >= 99.0 && p99 <= 100.0, "{p99}");
+        assert!((99.0..=100.0).contains(&p99), "{p99}");
         assert_eq!(l.max_us(), 100.0);
         assert!(l.report().contains("over 100 samples"), "{}", l.report());
     }

@@ -43,6 +43,13 @@
 //! | `gate0:X[:FPS[@PHASE]]` | the same, on the MMBM at the exposure start (the decision sample): the thesis's test |
 //! | `deadline:FPS[:X]` | one frame per fixed-rate slot at the best causal instant (see [`Deadline`]) |
 //! | `P+exp:B[:TMIN]` | any policy `P` with exposure control: each frame's exposure shortened (and gain raised) so the blur the MMBM predicts stays within `B` px (see [`Exposure`]) |
+//!
+//! # Live
+//!
+//! [`Live`] runs one causal policy a sample at a time; [`Stream`] is the loop
+//! of `mmbm live` around it: samples from text lines, UDP datagrams or a
+//! replayed log, one MMBM evaluation per sample for every policy, JSON lines
+//! out, [`Latency`] statistics, stopped through a [`StreamControl`].
 
 mod exposure;
 mod latency;
