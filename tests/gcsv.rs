@@ -450,3 +450,36 @@ fn frames_use_the_gcsv_readout() {
     assert!(rows[1].ends_with(",0.002,0.01523"), "{}", rows[1]);
     assert!(rows[1].split(',').nth(2).unwrap().parse::<f64>().unwrap() > 0.0);
 }
+
+/// `mmbm live --replay` of a `.gcsv` log applies the header's readout (as
+/// `trigger` and `frames` do) when the camera gives none, and not when it
+/// gives its own.
+#[test]
+fn live_replay_uses_the_gcsv_readout() {
+    let run = |extra: &[&str]| {
+        let out = common::mmbm_cmd()
+            .args(["live", "--replay"])
+            .arg(walk())
+            .args([
+                "--speed",
+                "0",
+                "--policy",
+                "fixed:100",
+                "--exposure",
+                "0.001",
+            ])
+            .args(extra)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr).into_owned();
+        assert!(out.status.success(), "{err}");
+        err
+    };
+    let err = run(&[]);
+    assert!(
+        err.contains("rolling shutter from") && err.contains("readout 0.01523 s"),
+        "{err}"
+    );
+    let own = run(&["--rolling-readout", "0.005"]);
+    assert!(!own.contains("rolling shutter from"), "{own}");
+}

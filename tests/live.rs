@@ -357,3 +357,229 @@ fn udp_datagrams_are_decided() {
     assert_eq!(decisions[0]["trigger"], true);
     assert_eq!(decisions[19]["t"].as_f64(), Some(0.19));
 }
+
+/// Waits for `child` at most `secs` seconds (killed and failed after that).
+fn wait_for(child: &mut std::process::Child, secs: f64, what: &str) -> std::process::ExitStatus {
+    let start = std::time::Instant::now();
+    loop {
+        if let Some(st) = child.try_wait().unwrap() {
+            return st;
+        }
+        if start.elapsed().as_secs_f64() > secs {
+            let _ = child.kill();
+            panic!("{what}: still running after {secs} s");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+}
+
+fn interrupt(child: &std::process::Child) {
+    let st = std::process::Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(st.success());
+}
+
+/// Issue 23: a wait beyond what a `Duration` holds (a tiny `--speed`, huge
+/// time stamps, a huge `--idle-exit`) panicked (exit 101). It is a wait that
+/// lasts until Ctrl-C, which ends it with the statistics and exit 130.
+#[test]
+fn endless_waits_never_panic_and_ctrl_c_ends_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let walk = dir.path().join("walk.csv");
+    std::fs::write(&walk, "t,wx,wy,wz\n0,0.1,0.2,0.3\n0.01,0.1,0.2,0.3\n").unwrap();
+    let huge = dir.path().join("huge.csv");
+    std::fs::write(&huge, "t,wx,wy,wz\n0,0,0,0.1\n1.7e308,0,0,0.1\n").unwrap();
+    let port = {
+        let s = std::net::UdpSocket::bind("127.0.0.1:0").unwrap();
+        s.local_addr().unwrap().port()
+    };
+    let addr = format!("127.0.0.1:{port}");
+    let w = walk.to_str().unwrap();
+    let h = huge.to_str().unwrap();
+    let cases: Vec<Vec<&str>> = vec![
+        vec!["--replay", w, "--speed", "1e-300"],
+        vec!["--replay", w, "--speed", "5e-324"],
+        vec!["--replay", h],
+        vec!["--replay", h, "--speed", "1e-300"],
+        vec!["--udp", &addr, "--idle-exit", "1e300"],
+    ];
+    for args in cases {
+        let what = args.join(" ");
+        let mut child = common::mmbm_cmd()
+            .args(["live", "--policy", "fixed:5", "--all", "--stats"])
+            .args(&args)
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        let mut first = String::new();
+        if args[0] == "--replay" {
+            // The first sample is due at once.
+            let mut r = std::io::BufReader::new(child.stdout.take().unwrap());
+            std::io::BufRead::read_line(&mut r, &mut first).unwrap();
+            assert!(first.contains("\"t\":0.0"), "{what}: {first}");
+            child.stdout = None;
+            std::thread::spawn(move || std::io::copy(&mut r, &mut std::io::sink()));
+        }
+        std::thread::sleep(std::time::Duration::from_millis(300));
+        assert!(child.try_wait().unwrap().is_none(), "{what}: ended early");
+        interrupt(&child);
+        let st = wait_for(&mut child, 10.0, &what);
+        let mut err = String::new();
+        std::io::Read::read_to_string(&mut child.stderr.take().unwrap(), &mut err).unwrap();
+        assert_eq!(st.code(), Some(130), "{what}: {err}");
+        assert!(!err.contains("panicked"), "{what}: {err}");
+        let samples = if args[0] == "--replay" { 1 } else { 0 };
+        let stats = match samples {
+            0 => "latency: no samples".to_string(),
+            n => format!("over {n} samples"),
+        };
+        assert!(
+            err.contains(&stats) && err.contains("interrupted"),
+            "{what}: {err}"
+        );
+    }
+}
+
+/// A wait blocked on a silent stdin still ends at Ctrl-C with the statistics.
+#[test]
+fn ctrl_c_on_a_silent_stdin() {
+    let mut child = common::mmbm_cmd()
+        .args(["live", "--policy", "fixed:5", "--stats"])
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut stdin = child.stdin.take().unwrap();
+    stdin.write_all(b"t,wx,wy,wz\n0,0.1,0.2,0.3\n").unwrap();
+    stdin.flush().unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(500));
+    interrupt(&child);
+    let st = wait_for(&mut child, 10.0, "silent stdin");
+    let o = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(st.code(), Some(130), "{err}");
+    assert!(err.contains("over 1 samples"), "{err}");
+    assert_eq!(json_lines(&o).len(), 1);
+    drop(stdin);
+}
+
+#[test]
+fn bad_speed_and_idle_time_exit_2() {
+    for args in [
+        vec!["--replay", "x.csv", "--speed", "nan"],
+        vec!["--replay", "x.csv", "--speed=-1"],
+        vec!["--replay", "x.csv", "--speed", "inf"],
+        vec!["--udp", "127.0.0.1:0", "--idle-exit=-1"],
+        vec!["--udp", "127.0.0.1:0", "--idle-exit", "0"],
+        vec!["--udp", "127.0.0.1:0", "--idle-exit", "nan"],
+    ] {
+        let o = common::mmbm_cmd()
+            .args(["live", "--policy", "fixed:5"])
+            .args(&args)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        assert!(
+            err.contains(args[2].trim_start_matches("--").split('=').next().unwrap()),
+            "{err}"
+        );
+    }
+}
+
+/// Issue 23: one sample whose MMBM is not finite ended the stream (exit 1);
+/// it is reported and skipped like a malformed line (--strict: exit 2).
+#[test]
+fn a_non_finite_sample_is_skipped_like_a_malformed_line() {
+    let input = "t,wx,wy,wz\n0,0,0,0.1\n0,0,0,0.1\n0.01,1.7e308,0,0\n0.02,0,0,0.1\n";
+    let o = live_cli(&["--policy", "fixed:5", "--all"], input.as_bytes());
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    assert!(
+        err.contains("<stdin>:4:") && err.contains("MMBM is inf"),
+        "{err}"
+    );
+    assert!(err.contains("line skipped"), "{err}");
+    let ts: Vec<f64> = json_lines(&o)
+        .iter()
+        .map(|v| v["t"].as_f64().unwrap())
+        .collect();
+    assert_eq!(ts, vec![0.0, 0.02]);
+    let o = live_cli(
+        &["--policy", "fixed:5", "--all", "--strict"],
+        input.as_bytes(),
+    );
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("<stdin>:4:"));
+    assert_eq!(json_lines(&o).len(), 1);
+}
+
+/// Issue 23: a single such datagram stopped the UDP listener.
+#[test]
+fn a_bad_datagram_does_not_stop_the_listener() {
+    let port = {
+        let s = std::net::UdpSocket::bind("127.0.0.1:0").unwrap();
+        s.local_addr().unwrap().port()
+    };
+    let addr = format!("127.0.0.1:{port}");
+    let child = common::mmbm_cmd()
+        .args(["live", "--policy", "fixed:5", "--all", "--idle-exit", "1.5"])
+        .args(["--udp", &addr])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let sock = std::net::UdpSocket::bind("127.0.0.1:0").unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(500));
+    for d in [
+        "t,wx,wy,wz",
+        "0,0,0,0.1",
+        "0.01,1.7e308,0,0",
+        "0.02,0,0,0.1\n0.03,0,0,0.1",
+    ] {
+        sock.send_to(d.as_bytes(), &addr).unwrap();
+    }
+    let o = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    assert!(err.contains("<udp>:3:") && err.contains("skipped"), "{err}");
+    let ts: Vec<f64> = json_lines(&o)
+        .iter()
+        .map(|v| v["t"].as_f64().unwrap())
+        .collect();
+    assert_eq!(ts, vec![0.0, 0.02, 0.03]);
+}
+
+/// Issue 23: `--replay` loaded the whole log before the first decision. It
+/// reads as it plays: a bad line late in the log ends the replay after the
+/// decisions on the samples before it (the whole-log reader wrote none).
+#[test]
+fn a_replay_plays_the_log_as_it_reads_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = dir.path().join("log.csv");
+    let mut text = "t,wx,wy,wz\n".to_string();
+    for k in 0..200 {
+        text.push_str(&format!("{},0.1,0.2,0.3\n", k as f64 * 0.005));
+    }
+    text.push_str("1.0,x,0,0\n");
+    std::fs::write(&log, text).unwrap();
+    let o = common::mmbm_cmd()
+        .args([
+            "live", "--policy", "fixed:5", "--all", "--speed", "0", "--replay",
+        ])
+        .arg(&log)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains(":202:wx"), "{err}");
+    let decided = json_lines(&o)
+        .iter()
+        .filter(|v| v.get("trigger").is_some())
+        .count();
+    assert_eq!(decided, 200);
+}

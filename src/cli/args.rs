@@ -137,10 +137,10 @@ impl CameraArgs {
 /// none (a camera file's or `--rolling-readout`'s readout wins).
 pub fn with_log_readout(
     camera: Camera,
-    log: &mmbm::model::log::ImuLog,
+    readout: Option<mmbm::model::log::LogReadout>,
     gyro: &std::path::Path,
 ) -> Result<Camera> {
-    let (camera, applied) = log.apply_readout(camera)?;
+    let (camera, applied) = mmbm::model::log::LogReadout::apply(readout, camera)?;
     if applied {
         eprintln!(
             "rolling shutter from {}: readout {} s, {:?}",

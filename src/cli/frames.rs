@@ -71,7 +71,7 @@ pub fn run(a: FramesArgs) -> Result<()> {
     mmbm::error::finite("--gap", a.gap)?;
     let frames = read_frames(&a.frames)?;
     let samples = read_log(&a.gyro, a.gyro_opts.options()?)?;
-    let camera = super::args::with_log_readout(camera, &samples, &a.gyro)?;
+    let camera = super::args::with_log_readout(camera, samples.readout(), &a.gyro)?;
     let opts = SeriesOptions {
         scene: Scene {
             camera,

@@ -19,6 +19,8 @@ mod tables;
 mod trigger;
 
 use clap::{Parser, Subcommand};
+use mmbm::trigger::StreamControl;
+use std::time::Duration;
 
 /// Camera motion blur: the MMBM metric, GPU flow fields, a ground-truth blur
 /// renderer, gait simulation and trigger policies.
@@ -76,15 +78,35 @@ enum Command {
     Dataset(dataset::DatasetArgs),
 }
 
+/// How long the Ctrl-C handler waits for a live stream to end by itself.
+const INTERRUPT_GRACE: Duration = Duration::from_millis(500);
+
+/// Removes temporary output files after an interrupt and says so; returns
+/// the exit code (130).
+fn interrupted() -> i32 {
+    let n = mmbm::io::atomic::remove_pending();
+    eprintln!("interrupted; removed {n} temporary file(s)");
+    130
+}
+
 /// Parses arguments, runs, prints errors; returns the exit code.
 pub fn main() -> i32 {
     let cli = Cli::parse();
-    // Ctrl-C (SIGINT): remove temporary output files, exit 130.
-    let _ = ctrlc::set_handler(|| {
-        live::on_interrupt();
-        let n = mmbm::io::atomic::remove_pending();
-        eprintln!("interrupted; removed {n} temporary file(s)");
-        std::process::exit(130);
+    // Ctrl-C (SIGINT): stop a live stream, which ends within its poll
+    // (`live` then prints its statistics and exits 130 itself); otherwise, or
+    // when the stream is blocked on a silent input, print the statistics so
+    // far, remove temporary output files and exit 130 here.
+    let control = StreamControl::default();
+    let handler = control.clone();
+    let _ = ctrlc::set_handler(move || {
+        handler.stop();
+        if handler.wait_ended(INTERRUPT_GRACE) {
+            return;
+        }
+        if let Some(l) = handler.latency() {
+            eprintln!("{}", l.report());
+        }
+        std::process::exit(interrupted());
     });
     let r = match cli.command {
         Command::Eval(a) => eval::run(a),
@@ -101,7 +123,10 @@ pub fn main() -> i32 {
         Command::Blobs(a) => blobs::run(a),
         Command::Experiment(a) => experiment::run(a),
         Command::Demo(a) => demo::run(a),
-        Command::Live(a) => live::run(a),
+        Command::Live(a) => match live::run(a, &control) {
+            Ok(code) => return code,
+            Err(e) => Err(e),
+        },
         Command::Dataset(a) => dataset::run(a),
     };
     match r {

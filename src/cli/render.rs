@@ -174,7 +174,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
     let log = match &a.gyro {
         Some(g) => {
             let log = mmbm::io::gyro::read_log(g, a.gyro_opts.options()?)?;
-            camera = super::args::with_log_readout(camera, &log, g)?;
+            camera = super::args::with_log_readout(camera, log.readout(), g)?;
             Some(log)
         }
         None => None,

@@ -118,7 +118,7 @@ pub fn run(a: TriggerArgs) -> Result<()> {
     }
     let camera = a.camera.camera()?;
     let samples = read_log(&a.gyro, a.gyro_opts.options()?)?;
-    let camera = super::args::with_log_readout(camera, &samples, &a.gyro)?;
+    let camera = super::args::with_log_readout(camera, samples.readout(), &a.gyro)?;
     // A rolling shutter keeps the camera busy for its line readout as well.
     let timing = a
         .timing

@@ -106,6 +106,25 @@ pub struct LogReadout {
     pub direction: Option<Readout>,
 }
 
+impl LogReadout {
+    /// `camera` with `readout` where the camera has none (a global shutter);
+    /// the camera's own readout, when it has one, wins. Returns the camera
+    /// and whether the log's readout was applied.
+    pub fn apply(readout: Option<LogReadout>, mut camera: Camera) -> Result<(Camera, bool)> {
+        match readout {
+            Some(r) if camera.shutter.is_global() => {
+                camera.shutter.readout_s = r.readout_s;
+                if let Some(d) = r.direction {
+                    camera.shutter.direction = d;
+                }
+                camera.validate()?;
+                Ok((camera, true))
+            }
+            _ => Ok((camera, false)),
+        }
+    }
+}
+
 /// A whole gyro log, validated: at least one sample, times finite and
 /// strictly increasing, every value finite. Derefs to its samples.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -177,18 +196,8 @@ impl ImuLog {
     /// `camera` with the log's readout where the camera has none (a global
     /// shutter); the camera's own readout, when it has one, wins. Returns the
     /// camera and whether the log's readout was applied.
-    pub fn apply_readout(&self, mut camera: Camera) -> Result<(Camera, bool)> {
-        match self.readout {
-            Some(r) if camera.shutter.is_global() => {
-                camera.shutter.readout_s = r.readout_s;
-                if let Some(d) = r.direction {
-                    camera.shutter.direction = d;
-                }
-                camera.validate()?;
-                Ok((camera, true))
-            }
-            _ => Ok((camera, false)),
-        }
+    pub fn apply_readout(&self, camera: Camera) -> Result<(Camera, bool)> {
+        LogReadout::apply(self.readout, camera)
     }
 }
 

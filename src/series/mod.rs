@@ -70,6 +70,14 @@ pub fn sample_scene(s: &GyroSample, opts: &SeriesOptions) -> Result<(Twist, Scen
     Ok((tw, scene))
 }
 
+/// The MMBM (mm/s) of one sample under `opts`, with `ev` built for their
+/// camera and method (a live stream's samples, one at a time, and every
+/// sample of a CPU batch). Not checked for finiteness: see [`check_values`].
+pub fn sample_mmbm(s: &GyroSample, opts: &SeriesOptions, ev: &Evaluator) -> Result<f64> {
+    let (tw, scene) = sample_scene(s, opts)?;
+    Ok(ev.mean_speed(&scene.flow_poly(&tw)))
+}
+
 /// Checks that every value of a batch is a finite MMBM (an overflow of huge
 /// rates gives inf or NaN), naming the first bad sample.
 pub fn check_values(batch: &[GyroSample], values: &[f64]) -> Result<()> {
@@ -88,10 +96,7 @@ pub fn eval_batch_cpu(batch: &[GyroSample], opts: &SeriesOptions) -> Result<Vec<
     batch
         .par_iter()
         .with_min_len(1024)
-        .map(|s| {
-            let (tw, scene) = sample_scene(s, opts)?;
-            Ok(ev.mean_speed(&scene.flow_poly(&tw)))
-        })
+        .map(|s| sample_mmbm(s, opts, &ev))
         .collect::<Result<Vec<f64>>>()
         .and_then(|v| check_values(batch, &v).map(|_| v))
 }

@@ -43,9 +43,18 @@
 //! | `gate0:X[:FPS[@PHASE]]` | the same, on the MMBM at the exposure start (the decision sample): the thesis's test |
 //! | `deadline:FPS[:X]` | one frame per fixed-rate slot at the best causal instant (see [`Deadline`]) |
 //! | `P+exp:B[:TMIN]` | any policy `P` with exposure control: each frame's exposure shortened (and gain raised) so the blur the MMBM predicts stays within `B` px (see [`Exposure`]) |
+//!
+//! # Live
+//!
+//! [`Live`] runs one causal policy a sample at a time; [`Stream`] is the loop
+//! of `mmbm live` around it: samples from text lines, UDP datagrams or a
+//! replayed log, one MMBM evaluation per sample for every policy, JSON lines
+//! out, [`Latency`] statistics, stopped through a [`StreamControl`].
 
 mod exposure;
+mod latency;
 mod live;
+mod pace;
 mod parse;
 mod phase;
 mod policy;
@@ -53,10 +62,13 @@ mod predict;
 mod rules;
 mod run;
 mod stats;
+mod stream;
 mod timing;
 
 pub use exposure::Exposure;
+pub use latency::Latency;
 pub use live::{Event, Live};
+pub use pace::check_speed;
 pub use parse::{parse_policy, ExposureControl, Family, PolicySpec, Rate, THESIS_POLICY};
 pub use phase::Phase;
 pub use policy::{Level, LogView, Observation, Policy};
@@ -67,4 +79,5 @@ pub use stats::{
     prediction_error, summary, summary_over, write_frames, ErrorStats, Summary, Table51,
     FRAME_HEADER,
 };
+pub use stream::{Stream, StreamControl, StreamEnd, StreamOptions, StreamOutcome, POLL};
 pub use timing::{exposure_means, CameraTiming, Frame, Integral};
