@@ -2,7 +2,6 @@
 
 mod args;
 mod assess;
-mod bench;
 mod blobs;
 mod dataset;
 mod demo;
@@ -54,8 +53,6 @@ enum Command {
     Tables(tables::TablesArgs),
     /// List GPU adapters and show which one mmbm uses.
     Info,
-    /// Measure throughput: metric methods, GPU flow kernels, trigger policies, renderer.
-    Bench(bench::BenchArgs),
     /// Per-pixel flow field at sensor resolution on the GPU (EXR, optional quiver PNG).
     Flow(flow::FlowArgs),
     /// Render a ground-truth motion-blurred image of a planar target.
@@ -114,7 +111,6 @@ pub fn main() -> i32 {
         Command::Frames(a) => frames::run(a),
         Command::Tables(a) => tables::run(a),
         Command::Info => info::run(),
-        Command::Bench(a) => bench::run(a),
         Command::Flow(a) => flow::run(a),
         Command::Render(a) => render::run(a),
         Command::Simulate(a) => simulate::run(a),

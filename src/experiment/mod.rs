@@ -14,6 +14,7 @@
 pub mod benefit;
 pub mod config;
 pub mod figures;
+mod frames_csv;
 pub mod measure;
 pub mod report;
 pub mod run;

@@ -2,73 +2,14 @@
 //! and `report.md` (findings computed from the data, the thesis's Tables
 //! 5.1, 6.1 and 6.2 recomputed per walk and policy).
 
+pub use super::frames_csv::{frames_csv, FRAMES_HEADER};
+
 use super::config::ExperimentConfig;
 use super::measure::{FrameMeasure, FrameRecord};
 use super::walk::Walk;
 use crate::stats;
 use crate::trigger::{prediction_error, summary_over, PolicySpec};
 use std::fmt::Write as _;
-
-/// Columns of `frames.csv` (the first six are the contract).
-pub const FRAMES_HEADER: &str = "policy,trigger_t,blur_px,jnbm,blobs_found,blobs_ok,walk,exposure_start,exposure_end,\
-mmbm_trigger_mm_s,mmbm_exposure_mm_s,kept,rendered,distance_m,disp_px,cpbd,blur_effect,laplacian_var,\
-blobs_matched,samples_per_pixel,render_ms,pose_err_m,pose_err_deg,quality,seed,blobs_ok_fixed,\
-blur_h_px,blur_v_px,jnbm_2d,cpbd_2d,gain";
-
-fn num(x: f64) -> String {
-    if x.is_finite() {
-        format!("{x}")
-    } else {
-        String::new()
-    }
-}
-
-/// `frames.csv` text; `quality` is the render preset, written for rendered frames.
-pub fn frames_csv(records: &[FrameRecord], quality: &str) -> String {
-    let mut s = String::from(FRAMES_HEADER);
-    s.push('\n');
-    for r in records {
-        let f = &r.frame;
-        let m = r.measure.as_ref();
-        let g = |x: Option<f64>| x.map_or(String::new(), num);
-        let _ = writeln!(
-            s,
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
-            f.policy,
-            f.trigger_t,
-            g(m.map(|m| m.blur_px)),
-            g(m.map(|m| m.jnbm)),
-            m.map_or(String::new(), |m| m.blobs_found.to_string()),
-            m.map_or(String::new(), |m| (m.blobs_ok as u8).to_string()),
-            r.walk,
-            f.exposure_start,
-            f.exposure_end,
-            f.mmbm_trigger_mm_s,
-            f.mmbm_exposure_mm_s,
-            f.kept as u8,
-            m.is_some() as u8,
-            g(m.map(|m| m.distance_m)),
-            g(m.map(|m| m.disp_px)),
-            g(m.map(|m| m.cpbd)),
-            g(m.map(|m| m.blur_effect)),
-            g(m.map(|m| m.laplacian_var)),
-            m.map_or(String::new(), |m| m.blobs_matched.to_string()),
-            m.map_or(String::new(), |m| m.samples_per_pixel.to_string()),
-            g(m.map(|m| m.render_ms)),
-            g(m.map(|m| m.pose_err_m)),
-            g(m.map(|m| m.pose_err_deg)),
-            if m.is_some() { quality } else { "" },
-            r.seed,
-            m.map_or(String::new(), |m| (m.blobs_ok_fixed as u8).to_string()),
-            g(m.map(|m| m.blur_h_px)),
-            g(m.map(|m| m.blur_v_px)),
-            g(m.map(|m| m.jnbm_2d)),
-            g(m.map(|m| m.cpbd_2d)),
-            f.gain,
-        );
-    }
-    s
-}
 
 impl PolicyStats {
     /// Share of rendered frames with all 16 blobs, %; NaN when none was rendered.

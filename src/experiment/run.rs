@@ -122,7 +122,7 @@ pub fn run(cfg: &ExperimentConfig, out: &Path, progress: bool) -> Result<Outcome
     std::fs::create_dir_all(out).map_err(|e| Error::io(out, e))?;
     let written = crate::io::atomic::all_or_nothing(|| {
         let stats = policy_stats(&walks, &records);
-        let csv = frames_csv(&records, &cfg.quality);
+        let csv = frames_csv(&records, &cfg.quality)?;
         write_atomic(&out.join("frames.csv"), |w| {
             w.write_all(csv.as_bytes())
                 .map_err(|e| Error::io(out.join("frames.csv"), e))

@@ -1,9 +1,12 @@
-//! The real camera's cost (printed, never asserted): the metric per sample
-//! through lens distortion, and the renderer's ms per 640x480 frame with each
-//! effect of SPEC 9 alone (the render goal's checker at 1 m, 20 px of blur,
-//! `default` preset), GPU and CPU twin.
+//! The real camera's cost (`cargo bench --bench camera`; printed, never
+//! asserted): the metric per sample through lens distortion, and the
+//! renderer's ms per 640x480 frame with each effect of SPEC 9 alone (the
+//! render goal's checker at 1 m, 20 px of blur, `default` preset), GPU and
+//! CPU twin.
 
-use super::time_per_call;
+mod common;
+
+use common::{time_per_call, twists};
 use mmbm::camera::{Camera, Distortion, Lens, Noise, Readout, Shutter};
 use mmbm::error::Result;
 use mmbm::metric::{Evaluator, Method};
@@ -11,6 +14,7 @@ use mmbm::model::motion::Twist;
 use mmbm::render::{maps, render_frame, Backend, RenderJob, Target, Trajectory};
 use mmbm::Scene;
 use std::hint::black_box;
+use std::process::ExitCode;
 use std::time::Instant;
 
 fn opencv() -> Distortion {
@@ -24,7 +28,7 @@ fn opencv() -> Distortion {
 }
 
 fn metric() -> Result<()> {
-    let polys: Vec<_> = super::twists(4096)
+    let polys: Vec<_> = twists(4096)
         .iter()
         .map(|t| Scene::thesis().flow_poly(t))
         .collect();
@@ -148,8 +152,12 @@ fn render() -> Result<()> {
     Ok(())
 }
 
+fn main() -> ExitCode {
+    common::main(bench)
+}
+
 /// Prints the camera benchmarks.
-pub fn bench() -> Result<()> {
+fn bench() -> Result<()> {
     metric()?;
     render()
 }

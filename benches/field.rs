@@ -1,5 +1,8 @@
-//! `mmbm bench --what gpu`: the flow kernels on the GPU against their CPU
-//! twins on one thread and on all cores. Times are printed, never asserted.
+//! The flow-field kernels (`cargo bench --bench field`): the GPU against
+//! their CPU twins on one thread and on all cores. Times are printed, never
+//! asserted; without a GPU adapter it stops with the adapter error (exit 1).
+
+mod common;
 
 use mmbm::camera::Camera;
 use mmbm::error::{Error, Result};
@@ -7,6 +10,7 @@ use mmbm::field::cpu as flow_cpu;
 use mmbm::field::{FlowRunner, Grid, TwistGpu};
 use mmbm::model::motion::Twist;
 use std::hint::black_box;
+use std::process::ExitCode;
 use std::time::Instant;
 
 /// Seconds per call of `f`: after one warm-up call, repeats until `secs`
@@ -30,7 +34,7 @@ fn pool(threads: usize) -> Result<rayon::ThreadPool> {
 }
 
 /// Deterministic pseudo-random rotations (rad/s), up to about 1 rad/s per axis.
-pub fn bench_twists(n: usize, f: f64) -> Vec<TwistGpu> {
+fn bench_twists(n: usize, f: f64) -> Vec<TwistGpu> {
     let mut s = 0x2545_f491_4f6c_dd1du64;
     let mut r = move || {
         s ^= s << 13;
@@ -43,8 +47,12 @@ pub fn bench_twists(n: usize, f: f64) -> Vec<TwistGpu> {
         .collect()
 }
 
+fn main() -> ExitCode {
+    common::main(run)
+}
+
 /// Runs the benchmark and prints the table.
-pub fn run() -> Result<()> {
+fn run() -> Result<()> {
     let mut gpu = FlowRunner::new()?;
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
     let one = pool(1)?;

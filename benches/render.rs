@@ -1,9 +1,11 @@
-//! Renderer cost (printed, never asserted): ms per 640x480 frame at the
+//! Renderer cost (`cargo bench --bench render`; printed, never asserted): ms per 640x480 frame at the
 //! `default` preset for the two scenes of the render-speed goal (the full-view
 //! `checker:0.02` at 1 m, the blob board at 5 m), at three blur lengths, on
 //! the GPU (whatever adapter is in use, e.g. lavapipe) and the CPU twin (all
 //! threads), with both area integrators; and the equivalent throughput in
 //! pixel-samples (pixels x instants, or x samples for the lattice) per second.
+
+mod common;
 
 use mmbm::camera::Camera;
 use mmbm::error::Result;
@@ -11,6 +13,7 @@ use mmbm::model::motion::Twist;
 use mmbm::render::{
     maps, render_frame, Backend, Integrator, Quality, RenderJob, Target, Trajectory,
 };
+use std::process::ExitCode;
 use std::time::Instant;
 
 /// The goal's motion: w = (0.3, -0.2, 0.5) rad/s, exposure scaled so that the
@@ -40,8 +43,12 @@ fn time(j: &RenderJob, reps: usize) -> Result<(f64, u32)> {
     Ok((best, n))
 }
 
+fn main() -> ExitCode {
+    common::main(bench)
+}
+
 /// Prints the renderer benchmarks.
-pub fn bench() -> Result<()> {
+fn bench() -> Result<()> {
     let gpu = mmbm::gpu::gpu();
     match &gpu {
         Ok(c) => println!("render bench, GPU: {}", c.description),

@@ -1,10 +1,14 @@
-//! Throughput of the trigger policies (printed, never asserted).
+//! Throughput of the trigger policies (`cargo bench --bench trigger`;
+//! printed, never asserted).
+
+mod common;
 
 use mmbm::error::Result;
 use mmbm::metric::{Method, Scene};
 use mmbm::series::mmbm_series;
 use mmbm::sim::{simulate, Gait, GaitConfig};
 use mmbm::trigger::{parse_policy, run, CameraTiming};
+use std::process::ExitCode;
 use std::time::Instant;
 
 /// Policies timed by [`bench`].
@@ -19,10 +23,14 @@ const POLICIES: [&str; 8] = [
     "deadline:5",
 ];
 
+fn main() -> ExitCode {
+    common::main(bench)
+}
+
 /// Prints policy decisions per second (a 10-minute simulated moderate walk at
 /// 600 Hz) and the end-to-end time of a 1-hour 600 Hz log (simulate, MMBM
 /// series with `riemann:8x6`, then `threshold:0.4` and `forecast:0.4`).
-pub fn bench() -> Result<()> {
+fn bench() -> Result<()> {
     let cfg = GaitConfig::preset(Gait::Moderate);
     let timing = CameraTiming::default();
     let scene = Scene::thesis();
