@@ -355,3 +355,70 @@ fn real_logs_at_absurd_rates_are_refused_quickly() {
         assert!(String::from_utf8_lossy(&o.stderr).contains("1000 frames/s"));
     }
 }
+
+/// Issue #23 item 1: a log at t = 1e308 made `trigger --policy fixed:5` (and
+/// gate, gate0) loop forever; nanosecond epoch stamps read as seconds gave
+/// 2000 frames "all kept" with a 0.00 ms exposure. Both are now refused with
+/// a hint at `--time-unit`, quickly, through the CLI and the library alike.
+#[test]
+fn time_bases_too_coarse_for_the_exposure_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("huge.csv"),
+        "t,wx,wy,wz\n1e308,0.1,0,0\n1.0000001e308,0.1,0,0\n1.0000002e308,0.1,0,0\n",
+    )
+    .unwrap();
+    // 2000 samples 1 ms apart, stamped in nanoseconds since the epoch.
+    let mut ns = String::from("t,wx,wy,wz\n");
+    for k in 0..2000u64 {
+        ns += &format!(
+            "{},0.1,0.2,0\n",
+            1_700_000_000_000_000_000u64 + k * 1_000_000
+        );
+    }
+    std::fs::write(dir.path().join("ns.csv"), &ns).unwrap();
+    for policy in [
+        "fixed:5",
+        "gate:0.4",
+        "gate0:0.4",
+        "threshold:0.4",
+        "deadline:5",
+    ] {
+        for log in ["huge.csv", "ns.csv"] {
+            let o = mmbm_in(
+                dir.path(),
+                &["trigger", "--gyro", log, "--policy", policy, "--summary"],
+            );
+            let err = String::from_utf8_lossy(&o.stderr);
+            assert_eq!(o.status.code(), Some(1), "{policy} {log}: {err}");
+            assert!(err.contains("--time-unit"), "{policy} {log}: {err}");
+        }
+    }
+    // The same stamps with their unit: 2 s of log, frames at 5 fps.
+    let o = mmbm_in(
+        dir.path(),
+        &[
+            "trigger",
+            "--gyro",
+            "ns.csv",
+            "--time-unit",
+            "ns",
+            "--policy",
+            "fixed:5",
+            "--summary",
+        ],
+    );
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(out.contains("fixed:5: 10 frames"), "{out}");
+    // live: the first sample is refused (exit 1), not decided with a zero exposure.
+    let o = common::mmbm_cmd()
+        .current_dir(dir.path())
+        .args([
+            "live", "--replay", "ns.csv", "--speed", "0", "--policy", "fixed:5",
+        ])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success() && err.contains("--time-unit"), "{err}");
+}

@@ -96,6 +96,48 @@ pub fn min_interval<T: Timed>(samples: &[T]) -> Option<f64> {
         .reduce(f64::min)
 }
 
+/// An interval a log's times must resolve is at least this many times the
+/// spacing of its time stamps (f64 values near its largest |t|): 0.1 %.
+pub const MIN_STEPS_PER_INTERVAL: f64 = 1000.0;
+
+/// The spacing of f64 time stamps near `t` (s): the resolution of a time base
+/// whose stamps reach `|t|`.
+pub fn time_resolution(t: f64) -> f64 {
+    let a = t.abs();
+    if !a.is_finite() {
+        return f64::INFINITY;
+    }
+    f64::from_bits(a.to_bits() + 1) - a
+}
+
+/// Checks that `interval_s` (an exposure, a frame interval, a delay; `what`
+/// names it) is at least [`MIN_STEPS_PER_INTERVAL`] x the resolution of time
+/// stamps that reach `t_max_abs` (s). Nanosecond epoch stamps read as
+/// seconds (about 1.7e18 s, resolved to 256 s) fail here, with a hint.
+pub fn check_resolution(t_max_abs: f64, interval_s: f64, what: &str) -> Result<()> {
+    let res = time_resolution(t_max_abs);
+    if interval_s > 0.0 && interval_s < MIN_STEPS_PER_INTERVAL * res {
+        return Err(Error::invalid(
+            "time base",
+            format!(
+                "the log's time stamps reach {t_max_abs:e} s, where f64 times are {res:e} s apart: \
+                 too coarse for {what} of {interval_s} s (it needs stamps {MIN_STEPS_PER_INTERVAL} x finer). \
+                 Are the stamps in another unit? Nanoseconds read as seconds are about 1.7e18: \
+                 try --time-unit ns (or us, ms)"
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// The largest |t| of a time column (0 when empty).
+pub fn max_abs_time<T: Timed>(samples: &[T]) -> f64 {
+    match (samples.first(), samples.last()) {
+        (Some(a), Some(b)) => a.time().abs().max(b.time().abs()),
+        _ => 0.0,
+    }
+}
+
 /// A log's own rolling-shutter readout (a `.gcsv` header's
 /// `frame_readout_time` and `frame_readout_direction`).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -393,6 +435,26 @@ mod tests {
         assert_eq!(cam.shutter.direction, Readout::LeftToRight);
         let (again, applied) = log.apply_readout(cam).unwrap();
         assert!(!applied && again == cam);
+    }
+
+    /// Nanosecond epoch stamps read as seconds cannot time a 70 ms exposure;
+    /// the same stamps in seconds can.
+    #[test]
+    fn a_time_base_too_coarse_for_the_exposure_is_refused() {
+        assert_eq!(time_resolution(1.0), f64::EPSILON);
+        assert_eq!(time_resolution(1.7e18), 256.0);
+        let e = check_resolution(1.7e18, 0.07, "the exposure")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("--time-unit ns") && e.contains("the exposure"),
+            "{e}"
+        );
+        assert!(check_resolution(1.7e9, 0.07, "the exposure").is_ok());
+        assert!(check_resolution(1e308, 0.2, "the frame interval").is_err());
+        assert!(check_resolution(f64::MAX, 1.0, "x").is_err());
+        assert!(check_resolution(1e6, 1e-6, "x").is_ok());
+        assert!(check_resolution(1e6, 1e-7, "x").is_err());
     }
 
     /// The running integral's mean is exact for a piecewise-linear series

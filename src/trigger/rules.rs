@@ -34,8 +34,13 @@ impl Schedule {
         if guess.is_finite() && guess > self.k as f64 + 2.0 {
             self.k = (guess as u64).saturating_sub(1);
         }
-        while self.slot(t0, self.k) <= now {
-            self.k += 1;
+        // Bounded: where the times cannot resolve 1/FPS the slot would stop
+        // moving (the runner refuses such a time base; live gets here).
+        for _ in 0..64 {
+            if self.slot(t0, self.k) > now {
+                break;
+            }
+            self.k = self.k.saturating_add(1);
         }
         true
     }
@@ -64,9 +69,10 @@ impl Policy for Fixed {
     fn spec(&self) -> &str {
         &self.spec
     }
-    fn prepare(&mut self, _log: &LogView, _timing: &CameraTiming) -> Result<()> {
+    fn prepare(&mut self, log: &LogView, _timing: &CameraTiming) -> Result<()> {
         self.sched.k = 0;
-        Ok(())
+        let t_max = crate::model::log::max_abs_time(log.t);
+        crate::model::log::check_resolution(t_max, 1.0 / self.sched.fps, "the frame interval")
     }
     fn decide(&mut self, obs: &Observation) -> bool {
         self.sched.due(obs) && obs.camera_free

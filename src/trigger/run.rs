@@ -3,7 +3,7 @@
 use super::policy::{LogView, Observation, Policy};
 use super::timing::{CameraTiming, Frame, Integral};
 use crate::error::{Error, Result};
-use crate::model::log::{check_times, Timed};
+use crate::model::log::{check_resolution, check_times, max_abs_time, Timed};
 
 /// Runs `policy` over a log: `mmbm_mm_s[i]` is the MMBM at the time of
 /// `samples[i]` (gyro samples, or bare times in s: only the times are used).
@@ -31,6 +31,9 @@ pub fn run<S: Timed>(
         return Err(Error::invalid("gyro log", "no samples"));
     }
     check_times(samples, "gyro log")?;
+    let t_max = max_abs_time(samples);
+    check_resolution(t_max, timing.exposure, "the exposure")?;
+    check_resolution(t_max, timing.delay, "the trigger delay")?;
     let t: Vec<f64> = samples.iter().map(Timed::time).collect();
     for i in 0..t.len() {
         let m = mmbm_mm_s[i];
