@@ -351,7 +351,8 @@ fn real_logs_at_absurd_rates_are_refused_quickly() {
             .arg(car)
             .output()
             .unwrap();
-        assert_eq!(o.status.code(), Some(1));
+        // A malformed flag is clap's error: exit 2 (issue #22).
+        assert_eq!(o.status.code(), Some(2));
         assert!(String::from_utf8_lossy(&o.stderr).contains("1000 frames/s"));
     }
 }

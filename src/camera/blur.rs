@@ -2,8 +2,8 @@
 //! (s) become pixels, and back.
 
 /// Blur length over an exposure, px: the MMBM `mmbm_mm_s` (mm/s on the
-/// sensor) times the exposure `exposure_s` (s), over the pixel pitch
-/// `pitch_mm` (mm).
+/// sensor) over the pixel pitch `pitch_mm` (mm), i.e. the speed in px/s,
+/// times the exposure `exposure_s` (s).
 ///
 /// ```
 /// // 0.4 mm/s for 70 ms on 4.65 um pixels: about 6 px.
@@ -11,7 +11,7 @@
 /// assert!((b - 6.0215).abs() < 1e-3);
 /// ```
 pub fn blur_px(mmbm_mm_s: f64, exposure_s: f64, pitch_mm: f64) -> f64 {
-    mmbm_mm_s * exposure_s / pitch_mm
+    mmbm_mm_s / pitch_mm * exposure_s
 }
 
 /// The exposure, s, over which an MMBM of `mmbm_mm_s` (mm/s) blurs

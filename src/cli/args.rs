@@ -88,7 +88,7 @@ pub struct CameraArgs {
     pub rolling_readout: Option<f64>,
     /// Readout direction: top-to-bottom, bottom-to-top, left-to-right, right-to-left.
     #[arg(long, value_name = "DIR")]
-    pub readout_direction: Option<String>,
+    pub readout_direction: Option<mmbm::camera::Readout>,
     /// Sensor noise at this light level (electrons per second of a white pixel),
     /// with the camera file's other noise keys or their defaults.
     #[arg(long, value_name = "E_PER_S")]
@@ -118,8 +118,8 @@ impl CameraArgs {
         if let Some(r) = self.rolling_readout {
             c.shutter.readout_s = r;
         }
-        if let Some(d) = &self.readout_direction {
-            c.shutter.direction = d.parse()?;
+        if let Some(d) = self.readout_direction {
+            c.shutter.direction = d;
         }
         if let Some(phi) = self.light {
             c.noise = Some(mmbm::camera::Noise {

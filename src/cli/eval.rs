@@ -26,7 +26,7 @@ pub struct EvalArgs {
     /// riemann[:NUxNV] (default 8x6), gauss[:N|:NUxNV], exact[:TOL] (default 1e-9), gpu[:WxH].
     /// Limits: 1,048,576 grid points, 1024 Gauss nodes per side.
     #[arg(long, default_value = "riemann:8x6")]
-    pub method: String,
+    pub method: AnyMethod,
     /// Print one JSON object instead of text.
     #[arg(long)]
     pub json: bool,
@@ -39,7 +39,7 @@ pub struct EvalArgs {
 }
 
 pub fn run(a: EvalArgs) -> Result<()> {
-    let method: AnyMethod = a.method.parse()?;
+    let method = a.method;
     let scene = Scene {
         camera: a.camera.camera()?,
         plane: a.scene.plane()?,

@@ -36,7 +36,7 @@ pub struct FramesArgs {
     pub frames: PathBuf,
     /// riemann[:NUxNV], gauss[:N] or exact[:TOL] (gpu is not available here).
     #[arg(long, default_value = "riemann:8x6")]
-    pub method: String,
+    pub method: AnyMethod,
     /// Output CSV (default: stdout).
     #[arg(long, value_name = "FILE")]
     pub out: Option<PathBuf>,
@@ -58,7 +58,7 @@ pub struct FramesArgs {
 }
 
 pub fn run(a: FramesArgs) -> Result<()> {
-    let method = match a.method.parse::<AnyMethod>()? {
+    let method = match a.method {
         AnyMethod::Cpu(m) => m,
         AnyMethod::Gpu { .. } => {
             return Err(Error::invalid(

@@ -7,7 +7,7 @@ use clap::Args;
 use mmbm::error::Result;
 use mmbm::io::gyro::GyroReader;
 use mmbm::series::SeriesOptions;
-use mmbm::trigger::{self, Live, Stream, StreamControl, StreamEnd, StreamOptions};
+use mmbm::trigger::{Live, PolicySpec, Stream, StreamControl, StreamEnd, StreamOptions};
 use mmbm::{Method, Scene};
 use std::path::PathBuf;
 
@@ -38,7 +38,7 @@ Examples:
 pub struct LiveArgs {
     /// Policy (repeat for several; each line's `policy` is the string given).
     #[arg(long, required = true)]
-    pub policy: Vec<String>,
+    pub policy: Vec<PolicySpec>,
     /// Exposure t_e, s.
     #[arg(
         allow_negative_numbers = true,
@@ -52,7 +52,7 @@ pub struct LiveArgs {
     /// CPU metric: riemann[:NUxNV], gauss[:N] or exact[:TOL].
     /// Limits: 1,048,576 grid points, 1024 Gauss nodes per side.
     #[arg(long, default_value = "riemann:8x6")]
-    pub method: String,
+    pub method: Method,
     /// Include the samples' vx,vy,vz (needs depth, --depth or --plane).
     #[arg(long)]
     pub use_velocity: bool,
@@ -88,7 +88,7 @@ pub struct LiveArgs {
 /// `--speed`: 0 or a finite number > 0.
 fn parse_speed(s: &str) -> std::result::Result<f64, String> {
     let x: f64 = s.parse().map_err(|_| format!("'{s}' is not a number"))?;
-    trigger::check_speed(x).map_err(|e| e.to_string())
+    mmbm::trigger::check_speed(x).map_err(|e| e.to_string())
 }
 
 /// `--idle-exit`: a finite number of seconds > 0.
@@ -100,7 +100,7 @@ fn parse_idle(s: &str) -> std::result::Result<f64, String> {
 /// Runs `mmbm live`, stopped through `control` (the Ctrl-C handler's);
 /// returns the exit code: 0, 2 for a `--strict` stop, 130 when interrupted.
 pub fn run(a: LiveArgs, control: &StreamControl) -> Result<i32> {
-    let method: Method = a.method.parse()?;
+    let method = a.method;
     let gyro = a.gyro_opts.options()?;
     // A replayed log is opened first: its own readout (a .gcsv header's)
     // applies when the camera gives none, as in `trigger` and `frames`.
@@ -128,7 +128,7 @@ pub fn run(a: LiveArgs, control: &StreamControl) -> Result<i32> {
     };
     let mut runs = Vec::new();
     for p in &a.policy {
-        runs.push(Live::new(trigger::parse_policy(p)?, timing)?);
+        runs.push(Live::new(p.build(), timing)?);
     }
     let opts = StreamOptions {
         all: a.all,

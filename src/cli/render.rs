@@ -7,7 +7,9 @@ use glam::DVec3;
 use mmbm::error::{Error, Result};
 use mmbm::io::atomic::{all_or_nothing, check_output};
 use mmbm::io::images::{write_exr, write_png_linear_rgb};
-use mmbm::render::{self, Backend, Quality, RenderJob, RenderOutput, Target, Trajectory};
+use mmbm::render::{
+    self, Backend, Integrator, Quality, RenderJob, RenderOutput, Target, Trajectory,
+};
 use mmbm::Twist;
 use std::path::{Path, PathBuf};
 
@@ -100,12 +102,12 @@ pub struct RenderOpts {
     pub psf: Option<String>,
     /// default, fast, or MIN_SAMPLES:SPACING_PX.
     #[arg(long, default_value = "default")]
-    pub quality: String,
+    pub quality: Quality,
     /// Area integration: auto (analytic for checker and blobs, lattice for
     /// images), analytic (closed-form pixel area, one sample per instant) or
     /// lattice (supersampled area and time).
     #[arg(long, default_value = "auto")]
-    pub integrator: String,
+    pub integrator: Integrator,
     /// auto (GPU if any, else CPU), gpu, cpu, or bulk (a hardware GPU, else CPU).
     #[arg(long, default_value = "auto")]
     pub backend: Backend,
@@ -216,10 +218,10 @@ pub fn run(args: RenderArgs) -> Result<()> {
         exposure_s: a.exposure,
         trajectory,
         target,
-        quality: a.quality.parse::<Quality>()?,
+        quality: a.quality,
         backend,
         seed: a.seed,
-        integrator: a.integrator.parse()?,
+        integrator: a.integrator,
         with_maps: a.maps.is_some(),
     };
     let t0 = std::time::Instant::now();

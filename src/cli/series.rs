@@ -14,14 +14,14 @@ pub struct GyroArgs {
     /// Unit of the `t` column: s, ms, us or ns (CSV only: .mcap and .gcsv
     /// logs carry their own).
     #[arg(long, default_value = "s")]
-    pub time_unit: String,
+    pub time_unit: TimeUnit,
     /// Unit of wx, wy, wz: rad or deg (per second; CSV only).
     #[arg(long, default_value = "rad")]
-    pub angle_unit: String,
+    pub angle_unit: AngleUnit,
     /// IMU-to-camera rotation, 9 numbers row-major (applied to w and v; for
     /// a .gcsv log, after its orientation).
-    #[arg(long, value_name = "R11,...,R33", allow_hyphen_values = true)]
-    pub imu_rotation: Option<String>,
+    #[arg(long, value_name = "R11,...,R33", allow_hyphen_values = true, value_parser = rotation)]
+    pub imu_rotation: Option<glam::DMat3>,
     /// Added to every time stamp, s.
     #[arg(
         allow_negative_numbers = true,
@@ -37,15 +37,17 @@ pub struct GyroArgs {
     pub topic: Option<String>,
 }
 
+/// `--imu-rotation`: 9 numbers, a rotation matrix (clap reports a bad one, exit 2).
+fn rotation(s: &str) -> std::result::Result<glam::DMat3, String> {
+    parse_rotation(s).map_err(|e| e.to_string())
+}
+
 impl GyroArgs {
     pub fn options(&self) -> Result<GyroOptions> {
         Ok(GyroOptions {
-            time_unit: self.time_unit.parse::<TimeUnit>()?,
-            angle_unit: self.angle_unit.parse::<AngleUnit>()?,
-            imu_to_camera: match &self.imu_rotation {
-                Some(s) => parse_rotation(s)?,
-                None => glam::DMat3::IDENTITY,
-            },
+            time_unit: self.time_unit,
+            angle_unit: self.angle_unit,
+            imu_to_camera: self.imu_rotation.unwrap_or(glam::DMat3::IDENTITY),
             time_offset: mmbm::error::finite("--time-offset", self.time_offset)?,
             topic: self.topic.clone(),
         })
@@ -66,7 +68,7 @@ pub struct SeriesArgs {
     /// riemann[:NUxNV], gauss[:N], exact[:TOL] or gpu[:WxH].
     /// Limits: 1,048,576 grid points, 1024 Gauss nodes per side.
     #[arg(long, default_value = "riemann:8x6")]
-    pub method: String,
+    pub method: AnyMethod,
     /// Output CSV (default: stdout).
     #[arg(long, value_name = "FILE")]
     pub out: Option<PathBuf>,
@@ -86,7 +88,7 @@ pub struct SeriesArgs {
 }
 
 pub fn run(a: SeriesArgs) -> Result<()> {
-    let method: AnyMethod = a.method.parse()?;
+    let method = a.method;
     let opts = SeriesOptions {
         scene: Scene {
             camera: a.camera.camera()?,

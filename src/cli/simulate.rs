@@ -15,7 +15,7 @@ use std::path::PathBuf;
 pub struct SimulateArgs {
     /// slow (0.085 m/s), moderate (0.17 m/s) or fast (0.53 m/s).
     #[arg(long, default_value = "moderate")]
-    pub gait: String,
+    pub gait: Gait,
     /// Duration, s (at most 1e8 samples in all).
     #[arg(allow_negative_numbers = true, long, default_value_t = 16.0)]
     pub duration: f64,
@@ -37,7 +37,7 @@ pub struct SimulateArgs {
 }
 
 pub fn run(a: SimulateArgs) -> Result<()> {
-    let gait: Gait = a.gait.parse()?;
+    let gait = a.gait;
     let cfg = match &a.config {
         Some(p) => GaitConfig::load(p, gait)?,
         None => GaitConfig::preset(gait),

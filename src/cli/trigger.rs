@@ -6,7 +6,7 @@ use clap::Args;
 use mmbm::error::{Error, Result};
 use mmbm::io::gyro::read_log;
 use mmbm::series::SeriesOptions;
-use mmbm::trigger::{self, Frame};
+use mmbm::trigger::{self, Frame, PolicySpec};
 use mmbm::{Method, Scene};
 use std::io::Write;
 use std::path::PathBuf;
@@ -39,7 +39,7 @@ pub struct TriggerArgs {
     pub gyro: PathBuf,
     /// Policy (repeat for several; each row's `policy` column is the string given).
     #[arg(long, required = true)]
-    pub policy: Vec<String>,
+    pub policy: Vec<PolicySpec>,
     /// Exposure t_e, s (thesis: 0.05, 0.07).
     #[arg(
         allow_negative_numbers = true,
@@ -59,7 +59,7 @@ pub struct TriggerArgs {
     /// MMBM method (CPU): riemann[:NUxNV], gauss[:N], exact[:TOL].
     /// Limits: 1,048,576 grid points, 1024 Gauss nodes per side.
     #[arg(long, default_value = "riemann:8x6")]
-    pub method: String,
+    pub method: Method,
     /// Include the log's vx,vy,vz (needs a depth column, --depth or --plane).
     #[arg(long)]
     pub use_velocity: bool,
@@ -111,10 +111,10 @@ fn summary_text(frames: &[Frame], spec: &str, duration: f64, pitch_mm: f64) -> S
 }
 
 pub fn run(a: TriggerArgs) -> Result<()> {
-    let method: Method = a.method.parse()?;
+    let method = a.method;
     let mut policies = Vec::new();
     for p in &a.policy {
-        policies.push(trigger::parse_policy(p)?);
+        policies.push(p.build());
     }
     let camera = a.camera.camera()?;
     let samples = read_log(&a.gyro, a.gyro_opts.options()?)?;
@@ -139,7 +139,12 @@ pub fn run(a: TriggerArgs) -> Result<()> {
     let mut text = String::new();
     for (p, spec) in policies.iter_mut().zip(&a.policy) {
         let frames = trigger::run(&samples, &m, p.as_mut(), &timing)?;
-        text.push_str(&summary_text(&frames, spec, duration, timing.pitch_mm));
+        text.push_str(&summary_text(
+            &frames,
+            spec.as_str(),
+            duration,
+            timing.pitch_mm,
+        ));
         all.push(frames);
     }
     let write = |w: &mut dyn Write| -> Result<()> {
