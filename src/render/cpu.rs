@@ -1,9 +1,8 @@
 //! CPU twin of `shaders/render.wgsl`: the same samples, homography table,
 //! background box and texture maths in f32, one pixel per task (rayon).
 
-use super::kernel::{
-    concentric, lens_shifts, shifts, GpuHomography, RenderParams, KIND_BLOBS, KIND_CHECKER,
-};
+use super::layout::{GpuHomography, RenderParams, KIND_BLOBS, KIND_CHECKER};
+use super::sampling::{concentric, lens_shifts, shifts};
 use super::texture::MipTexture;
 use glam::Vec3;
 use rayon::prelude::*;

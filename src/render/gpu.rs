@@ -4,7 +4,8 @@
 //! accumulated in place), each submitted and waited for separately, so that no
 //! single dispatch runs long enough to trip a GPU watchdog.
 
-use super::kernel::{with_range, GpuHomography, RenderParams};
+use super::kernel::with_range;
+use super::layout::{GpuHomography, RenderParams};
 use super::texture::MipTexture;
 use crate::error::{Error, Result};
 use crate::gpu::{compute, GpuContext};

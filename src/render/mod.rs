@@ -19,9 +19,12 @@
 
 pub mod cpu;
 pub mod gpu;
+mod homography;
 pub mod kernel;
+mod layout;
 pub mod maps;
 pub mod psf;
+mod sampling;
 pub mod target;
 pub mod texture;
 pub mod trajectory;
@@ -377,7 +380,7 @@ fn render_frame_stream(job: &RenderJob, stream: u64) -> Result<RenderOutput> {
             ),
         ));
     }
-    let lines = kernel::table_lines(cam) as u64 * kernel::table_stride(cam) as u64;
+    let lines = homography::table_lines(cam) as u64 * homography::table_stride(cam) as u64;
     if lines * n as u64 > MAX_TABLE {
         return Err(Error::invalid(
             "render table",
