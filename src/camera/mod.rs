@@ -1,7 +1,7 @@
 //! The camera (SPEC sections 1 and 9): pinhole intrinsics ([`intrinsics`]),
 //! lens distortion ([`distortion`]), rolling shutter ([`shutter`]), sensor
 //! noise ([`noise`]), thin-lens defocus ([`lens`]) and the files that describe
-//! them, Gyroflow lens profiles included ([`file`]). This layer imports
+//! them, Gyroflow lens profiles included ([`mod@file`]). This layer imports
 //! nothing above `error`.
 
 pub mod distortion;
