@@ -1,6 +1,6 @@
 """Reference: the same job as `mmbm series` (thesis camera, 8x6 midpoint grid,
 rotation-only MMBM per gyro sample) done the straightforward way with pandas
-and numpy, for the side-by-side timing in the README.
+and numpy, for the side-by-side timing in docs/performance.md.
 
 usage: python3 bench/series_pandas.py GYRO.csv OUT.csv
 """

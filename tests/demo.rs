@@ -1,6 +1,6 @@
 //! The README's first command, end to end: `mmbm demo` (about 3 minutes on
-//! 2 cores). Its report must lead with the headline, and the README's seed-1
-//! table ("What the demo finds") must be what the demo measures.
+//! 2 cores). Its report must lead with the headline, and the seed-1 table of
+//! `docs/experiment.md` ("What the demo finds") must be what the demo measures.
 
 mod common;
 
@@ -21,7 +21,7 @@ fn num(s: &str) -> f64 {
 }
 
 #[test]
-fn demo_report_matches_the_readme() {
+fn demo_report_matches_the_docs() {
     let d = tempfile::tempdir().unwrap();
     let out = d.path().join("report");
     let o = common::mmbm_cmd()
@@ -62,9 +62,9 @@ fn demo_report_matches_the_readme() {
         .filter(|r| r.len() == header6.len())
         .map(|r| (r[1], r))
         .collect();
-    let readme =
-        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/README.md")).unwrap();
-    let section = &readme[readme.find("#### What the demo finds").unwrap()..];
+    let doc = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/docs/experiment.md"))
+        .unwrap();
+    let section = &doc[doc.find("## What the demo finds").unwrap()..];
     let start = section.find("| policy |").unwrap();
     let section = &section[start..start + section[start..].find("\n\n").unwrap()];
     let quoted = rows(section, "| ");
@@ -72,11 +72,11 @@ fn demo_report_matches_the_readme() {
     assert_eq!(quoted.len(), 13, "{section}");
     for r in quoted.iter().skip(1) {
         let got = &t6[r[0]];
-        let cmp = |readme_cell: &str, name: &str, tol: f64| {
-            let (a, b) = (num(readme_cell), num(got[col(name)]));
+        let cmp = |doc_cell: &str, name: &str, tol: f64| {
+            let (a, b) = (num(doc_cell), num(got[col(name)]));
             assert!(
                 (a - b).abs() <= tol,
-                "{}: README {a} vs demo {b} ({name})",
+                "{}: docs/experiment.md {a} vs demo {b} ({name})",
                 r[0]
             );
         };

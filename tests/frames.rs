@@ -312,11 +312,12 @@ fn cli_frames_select_and_errors() {
     assert!(!ok && err.contains(":4:exposure_s"), "{err}");
 }
 
-/// The README's table of the running log's sharpest and blurriest frames is
+/// The table of the running log's sharpest and blurriest frames in
+/// `docs/cli.md` is
 /// what `mmbm frames` computes (frames, order and every printed digit), as is
 /// the sentence before it (frames inside the log, median blur).
 #[test]
-fn readme_frames_table_is_current() {
+fn docs_frames_table_is_current() {
     let Some((samples, frames)) = shared_frames("running_phone") else {
         return;
     };
@@ -357,18 +358,20 @@ fn readme_frames_table_is_current() {
         0,
         "| frame | t_start (s) | exposure MMBM (mm/s) | blur (px) | MMBM at start (mm/s) |".into(),
     );
-    let readme =
-        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/README.md")).unwrap();
-    let start = readme
+    let doc = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/docs/cli.md")).unwrap();
+    let start = doc
         .find("<!-- frames-table")
-        .expect("README frames table");
-    let end = readme.find("<!-- /frames-table -->").unwrap();
-    let table: Vec<&str> = readme[start..end]
+        .expect("docs/cli.md frames table");
+    let end = doc.find("<!-- /frames-table -->").unwrap();
+    let table: Vec<&str> = doc[start..end]
         .lines()
         .skip(1)
         .filter(|l| !l.is_empty())
         .collect();
-    assert_eq!(table, expect, "README table vs computed");
+    assert_eq!(table, expect, "docs/cli.md table vs computed");
     let sentence = format!("{n} frames inside the log, median blur {median:.2} px");
-    assert!(readme.contains(&sentence), "README should say: {sentence}");
+    assert!(
+        doc.contains(&sentence),
+        "docs/cli.md should say: {sentence}"
+    );
 }

@@ -27,11 +27,11 @@ fn calibration(g: Gait, seed: u64) -> (f64, f64, f64, f64) {
 
 #[test]
 fn calibration_figures() {
-    // The README quotes these figures (seed 7); they must be what the
+    // docs/trigger.md quotes these figures (seed 7); they must be what the
     // simulator gives, to the digits printed there.
-    let readme =
-        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/README.md")).unwrap();
-    let text = readme.split_whitespace().collect::<Vec<_>>().join(" ");
+    let doc =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/docs/trigger.md")).unwrap();
+    let text = doc.split_whitespace().collect::<Vec<_>>().join(" ");
     let (slow, moderate, fast) = (
         calibration(Gait::Slow, 7),
         calibration(Gait::Moderate, 7),
@@ -57,7 +57,10 @@ fn calibration_figures() {
         fast.0,
         100.0 * fast.1
     );
-    assert!(text.contains(&quoted), "README does not say: {quoted}");
+    assert!(
+        text.contains(&quoted),
+        "docs/trigger.md does not say: {quoted}"
+    );
 }
 
 #[test]

@@ -191,7 +191,7 @@ def series(
     """MMBM (mm/s) of every sample of a log: ``t`` (s, increasing, shape
     (N,)), ``omega`` (N, 3) rad/s, optional ``velocity`` (N, 3) m/s with a
     per-sample ``depth`` (N,) m or a ``plane``. The same as ``mmbm series``.
-    Arrays from ``telemetry_parser`` work as they are (see the README)."""
+    Arrays from ``telemetry_parser`` work as they are (see docs/python.md)."""
     tt, w = _log(t, omega)
     v = None if velocity is None else _rows3(velocity, "velocity")
     if v is not None and v.shape[0] != tt.shape[0]:

@@ -2,7 +2,7 @@
 //! lens distortion ([`distortion`]), rolling shutter ([`shutter`]), sensor
 //! noise ([`noise`]), thin-lens defocus ([`lens`]), blur in px of an MMBM over
 //! an exposure ([`blur`]) and the files that describe
-//! them, Gyroflow lens profiles included ([`file`]). This layer imports
+//! them, Gyroflow lens profiles included ([`mod@file`]). This layer imports
 //! nothing above `error`.
 
 pub mod blur;

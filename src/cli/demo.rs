@@ -28,7 +28,7 @@ pub struct DemoArgs {
     /// Simulation seed.
     #[arg(long, default_value_t = 1, conflicts_with = "full")]
     pub seed: u64,
-    /// Run seeds 1 to 5 and pool them (the README's multi-seed numbers).
+    /// Run seeds 1 to 5 and pool them (the multi-seed numbers of docs/experiment.md).
     #[arg(long)]
     pub full: bool,
     /// No progress bar.

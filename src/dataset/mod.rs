@@ -7,7 +7,7 @@
 //! - [`config`]: what items are drawn from (TOML, `--print-config`).
 //! - [`item`]: one item's parameters (drawn from the configuration and the
 //!   item's seed only) and files.
-//! - [`run`]: making a shard (resumable), merging shard manifests, verifying
+//! - [`mod@run`]: making a shard (resumable), merging shard manifests, verifying
 //!   a directory against its manifest.
 
 pub mod config;

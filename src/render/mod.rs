@@ -14,7 +14,7 @@
 //!
 //! The GPU kernel is `shaders/render.wgsl` ([`gpu`]); its CPU twin ([`cpu`]) is
 //! used when no adapter exists (announced once on stderr). [`maps`] gives the
-//! per-pixel blur ground truth (path length, displacement, speed), [`psf`] the
+//! per-pixel blur ground truth (path length, displacement, speed), [`mod@psf`] the
 //! point-spread function at a pixel.
 
 pub mod cpu;

@@ -80,7 +80,7 @@ impl CameraTiming {
 /// One triggered frame.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Frame {
-    /// The policy string exactly as given to [`parse_policy`].
+    /// The policy string exactly as given to [`parse_policy`](crate::trigger::parse_policy).
     pub policy: String,
     /// Index of the gyro sample the decision was made on.
     pub index: usize,
