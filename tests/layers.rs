@@ -14,6 +14,7 @@ use std::path::{Path, PathBuf};
 const LAYERS: &[(&str, u32)] = &[
     ("error", 0),
     ("stats", 0),
+    ("diagnostics", 0),
     ("camera", 1),
     ("model", 1),
     ("io", 1),

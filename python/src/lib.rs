@@ -574,6 +574,8 @@ fn read_exr<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bound<'py, PyDict>>
 /// The native module.
 #[pymodule]
 fn _mmbm(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    // The library's warnings (gaps in a log, the CPU twin standing in) on stderr.
+    mmbm::diagnostics::log_to_stderr();
     m.add_function(wrap_pyfunction!(camera_from_file, m)?)?;
     m.add_function(wrap_pyfunction!(camera_thesis, m)?)?;
     m.add_function(wrap_pyfunction!(camera_check, m)?)?;

@@ -88,6 +88,7 @@ fn interrupted() -> i32 {
 
 /// Parses arguments, runs, prints errors; returns the exit code.
 pub fn main() -> i32 {
+    mmbm::diagnostics::log_to_stderr();
     let cli = Cli::parse();
     // Ctrl-C (SIGINT): stop a live stream, which ends within its poll
     // (`live` then prints its statistics and exits 130 itself); otherwise, or

@@ -75,7 +75,7 @@ impl Backend {
                 }
                 Ok(ctx) => {
                     if !announced.swap(true, Ordering::Relaxed) {
-                        eprintln!(
+                        log::info!(
                             "{what}: {} is a software adapter; using the CPU {twin} (faster there, bounded memory)",
                             ctx.description
                         );
@@ -91,7 +91,7 @@ impl Backend {
                 ),
                 Err(e) => {
                     if !announced.swap(true, Ordering::Relaxed) {
-                        eprintln!("{what}: {e}; using the CPU {twin}");
+                        log::warn!("{what}: {e}; using the CPU {twin}");
                     }
                     Ok(Resolved::Cpu(None))
                 }

@@ -311,7 +311,7 @@ impl GyroReader {
     /// Prints [`GyroReader::warnings`] on stderr, one `warning: ...` line each.
     pub fn print_warnings(&self) {
         for w in &self.warnings {
-            eprintln!("warning: {w}");
+            log::warn!("warning: {w}");
         }
     }
 

@@ -370,7 +370,7 @@ impl Stream {
             Ok(None) => Ok(None),
             Err(e) if self.opts.strict => Ok(Some(StreamEnd::Strict(e))),
             Err(e) => {
-                eprintln!("{e}; line skipped");
+                log::warn!("{e}; line skipped");
                 Ok(None)
             }
         }
@@ -385,9 +385,10 @@ impl Stream {
         out: &mut dyn Write,
     ) -> Result<Option<StreamEnd>> {
         if s.t <= self.last_t {
-            eprintln!(
+            log::warn!(
                 "{at}: time {} s does not follow {} s; sample dropped",
-                s.t, self.last_t
+                s.t,
+                self.last_t
             );
             return Ok(None);
         }
@@ -400,7 +401,7 @@ impl Stream {
                 if self.opts.strict {
                     return Ok(Some(StreamEnd::Strict(e)));
                 }
-                eprintln!("{e}; {} skipped", at.unit());
+                log::warn!("{e}; {} skipped", at.unit());
                 return Ok(None);
             }
         };
