@@ -3,12 +3,12 @@
 //! montage of frames.
 
 use super::config::ExperimentConfig;
-use super::measure::{half, FrameRecord};
+use super::measure::FrameRecord;
 use super::walk::Walk;
 use crate::error::Result;
 use crate::gpu::Backend;
 use crate::io::atomic::write_atomic_path;
-use crate::io::images::{linear_to_srgb8, save_rgb8};
+use crate::io::images::{half, linear_to_srgb8, save_rgb8};
 use crate::metric::Scene;
 use crate::plot::{ensure_font, plot_error};
 use crate::trigger::Family;

@@ -2,10 +2,11 @@
 //! extraction), and the report's prose.
 
 use super::config::ExperimentConfig;
+use super::crop::{pattern_crop, pitch_px};
 use super::walk::Walk;
 use crate::camera::Camera;
 use crate::error::{Error, Result};
-use crate::io::images::linear_to_srgb8;
+use crate::io::images::to_rgb8;
 use crate::render::{self, Backend, Quality, RenderJob, Target, Trajectory};
 use crate::trigger::Frame;
 use std::time::Instant;
@@ -71,71 +72,6 @@ pub struct FrameRecord {
     pub frame: Frame,
     /// Measurements on the rendered frame.
     pub measure: Option<FrameMeasure>,
-}
-
-/// Linear RGB (interleaved) to an 8-bit sRGB image.
-pub fn to_rgb8(width: u32, height: u32, rgb: &[f32]) -> Result<image::RgbImage> {
-    let bytes: Vec<u8> = rgb.iter().map(|&x| linear_to_srgb8(x)).collect();
-    image::RgbImage::from_raw(width, height, bytes).ok_or_else(|| {
-        Error::invalid(
-            "frame",
-            format!("{} values are not a {width}x{height} RGB image", rgb.len()),
-        )
-    })
-}
-
-/// 2x2 box downsampling of linear RGB (for the montage).
-pub fn half(width: u32, height: u32, rgb: &[f32]) -> Vec<f32> {
-    let (w2, h2) = ((width / 2) as usize, (height / 2) as usize);
-    let w = width as usize;
-    let mut out = vec![0.0; w2 * h2 * 3];
-    for y in 0..h2 {
-        for x in 0..w2 {
-            for c in 0..3 {
-                let at = |xx: usize, yy: usize| rgb[(yy * w + xx) * 3 + c];
-                out[(y * w2 + x) * 3 + c] = 0.25
-                    * (at(2 * x, 2 * y)
-                        + at(2 * x + 1, 2 * y)
-                        + at(2 * x, 2 * y + 1)
-                        + at(2 * x + 1, 2 * y + 1));
-            }
-        }
-    }
-    out
-}
-
-/// The region of the pattern (the bounding box of the expected blob centres,
-/// grown by one blob pitch on each side, at least 128 x 128 so that JNBM has
-/// whole 64 x 64 blocks), cropped from the frame; the whole frame when no
-/// centres are known.
-pub fn pattern_crop(img: &image::RgbImage, expected: &[(f64, f64)]) -> image::RgbImage {
-    if expected.is_empty() {
-        return img.clone();
-    }
-    let p = pitch_px(expected);
-    let (mut x0, mut y0, mut x1, mut y1) = (
-        f64::INFINITY,
-        f64::INFINITY,
-        f64::NEG_INFINITY,
-        f64::NEG_INFINITY,
-    );
-    for &(x, y) in expected {
-        x0 = x0.min(x - p);
-        y0 = y0.min(y - p);
-        x1 = x1.max(x + p);
-        y1 = y1.max(y + p);
-    }
-    let (w, h) = (img.width() as f64, img.height() as f64);
-    let grow = |a: f64, b: f64, lim: f64| {
-        let (c, half) = ((a + b) / 2.0, ((b - a) / 2.0).max(64.0));
-        let lo = (c - half).clamp(0.0, (lim - 2.0 * half).max(0.0));
-        (lo.floor() as u32, (2.0 * half).min(lim).ceil() as u32)
-    };
-    let (cx, cw) = grow(x0, x1, w);
-    let (cy, ch) = grow(y0, y1, h);
-    let cw = cw.min(img.width() - cx);
-    let ch = ch.min(img.height() - cy);
-    image::imageops::crop_imm(img, cx, cy, cw, ch).to_image()
 }
 
 /// Image blur metrics of one frame (NaN where a metric is undefined).
@@ -235,21 +171,6 @@ pub fn blob_ok_fixed(img: &image::RgbImage, expected: &[(f64, f64)]) -> bool {
     crate::board::blobs::extract(img, &params)
         .and_then(|b| crate::board::blobs::evaluate(&b, expected, pitch_px(expected)))
         .is_ok_and(|r| r.ok)
-}
-
-/// Blob pitch (px): the smallest distance between two expected centres.
-fn pitch_px(c: &[(f64, f64)]) -> f64 {
-    let mut best = f64::INFINITY;
-    for (i, a) in c.iter().enumerate() {
-        for b in &c[i + 1..] {
-            best = best.min(((a.0 - b.0).powi(2) + (a.1 - b.1).powi(2)).sqrt());
-        }
-    }
-    if best.is_finite() {
-        best
-    } else {
-        1.0
-    }
 }
 
 /// Mean and 99th percentile ([`crate::stats::percentile`]) of the per-value

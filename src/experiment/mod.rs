@@ -13,6 +13,7 @@
 
 pub mod benefit;
 pub mod config;
+mod crop;
 pub mod figures;
 mod frames_csv;
 pub mod measure;

@@ -161,9 +161,49 @@ pub fn read_rgb8(path: &Path) -> Result<image::RgbImage> {
         .to_rgb8())
 }
 
+/// Linear RGB (interleaved) to an 8-bit sRGB image.
+pub fn to_rgb8(width: u32, height: u32, rgb: &[f32]) -> Result<image::RgbImage> {
+    let bytes: Vec<u8> = rgb.iter().map(|&x| linear_to_srgb8(x)).collect();
+    image::RgbImage::from_raw(width, height, bytes).ok_or_else(|| {
+        Error::invalid(
+            "frame",
+            format!("{} values are not a {width}x{height} RGB image", rgb.len()),
+        )
+    })
+}
+
+/// 2x2 box downsampling of linear RGB (for the montage).
+pub fn half(width: u32, height: u32, rgb: &[f32]) -> Vec<f32> {
+    let (w2, h2) = ((width / 2) as usize, (height / 2) as usize);
+    let w = width as usize;
+    let mut out = vec![0.0; w2 * h2 * 3];
+    for y in 0..h2 {
+        for x in 0..w2 {
+            for c in 0..3 {
+                let at = |xx: usize, yy: usize| rgb[(yy * w + xx) * 3 + c];
+                out[(y * w2 + x) * 3 + c] = 0.25
+                    * (at(2 * x, 2 * y)
+                        + at(2 * x + 1, 2 * y)
+                        + at(2 * x, 2 * y + 1)
+                        + at(2 * x + 1, 2 * y + 1));
+            }
+        }
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn half_averages_2x2_and_to_rgb8_checks_the_size() {
+        // 2x2 RGB: one white pixel of four: a quarter.
+        let rgb = [1.0, 1.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0];
+        assert_eq!(half(2, 2, &rgb), vec![0.25; 3]);
+        assert!(to_rgb8(2, 2, &rgb).is_ok());
+        assert!(to_rgb8(3, 2, &rgb).is_err());
+    }
 
     #[test]
     fn exr_round_trip_and_srgb() {
