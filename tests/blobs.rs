@@ -224,3 +224,46 @@ fn cli_blobs() {
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("/nonexistent/x.png"));
 }
+
+/// `mmbm blobs --target` takes `render --target`'s names: a half-size board
+/// drawn at 3 m is found with `blobs:0.5` and with its alias `blobs-half`, and
+/// not with the full board's centres; a bad board name is clap's error.
+#[test]
+fn blobs_target_takes_the_render_names() {
+    let dir = tempfile::tempdir().unwrap();
+    let img = dir.path().join("half.png");
+    draw(&cam(), &Board::half(), 3.0, (0.0, 0.0), 1, 0.0)
+        .save(&img)
+        .unwrap();
+    let run = |target: &str| {
+        let out = common::mmbm_cmd()
+            .arg("blobs")
+            .arg(&img)
+            .args([
+                "--target",
+                target,
+                "--distance",
+                "3",
+                "--sensor",
+                "320x240",
+                "--json",
+            ])
+            .output()
+            .unwrap();
+        (
+            out.status.code(),
+            String::from_utf8_lossy(&out.stdout).into_owned(),
+        )
+    };
+    for t in ["blobs:0.5", "blobs-half"] {
+        let (code, out) = run(t);
+        assert_eq!(code, Some(0), "{t}");
+        let j: serde_json::Value = serde_json::from_str(&out).unwrap();
+        assert!(j["result"]["ok"].as_bool().unwrap(), "{t}: {j}");
+    }
+    let (code, out) = run("blobs");
+    assert_eq!(code, Some(0));
+    let j: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert!(!j["result"]["ok"].as_bool().unwrap(), "{j}");
+    assert_eq!(run("blobs:-1").0, Some(2));
+}

@@ -1,19 +1,26 @@
 //! `mmbm blobs`: extract the 16 red blobs of the thesis target from an image.
 
 use super::args::CameraArgs;
-use clap::{Args, ValueEnum};
+use clap::Args;
 use mmbm::board::blobs::{components, evaluate, red_mask, Blob, BlobParams, BlobResult};
 use mmbm::board::{board_centres_px, Board};
 use mmbm::error::{Error, Result};
 use std::path::{Path, PathBuf};
 
-/// Which board the expected centres come from.
-#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Target {
-    /// Thesis board: 4x4 red 10 cm squares, 2 cm gaps (pitch 12 cm).
-    Blobs,
-    /// Half-size board of thesis Table 6.2: 5 cm squares, 1 cm gaps.
-    BlobsHalf,
+/// Which board the expected centres come from: the same names as
+/// `render --target` (`blobs`, `blobs:SCALE`), plus `blobs-half` (= `blobs:0.5`).
+fn parse_board(s: &str) -> std::result::Result<Board, String> {
+    match s {
+        "blobs" => Ok(Board::thesis()),
+        "blobs-half" => Ok(Board::half()),
+        _ => match s.strip_prefix("blobs:").map(str::parse::<f64>) {
+            Some(Ok(k)) if k.is_finite() && k > 0.0 => Ok(Board::thesis().scaled(k)),
+            _ => Err(format!(
+                "'{s}': expected blobs (the thesis board: 4x4 red 10 cm squares, 2 cm gaps), \
+                 blobs:SCALE (every length times SCALE > 0) or blobs-half (= blobs:0.5, thesis Table 6.2)"
+            )),
+        },
+    }
 }
 
 /// Extract the red blobs of the thesis target (and check them against the truth).
@@ -36,9 +43,10 @@ pub struct BlobsArgs {
     /// Expected centres: JSON {"centres_px": [[x,y],...], "pitch_px": P}.
     #[arg(long, value_name = "FILE", conflicts_with_all = ["distance", "target"])]
     pub expected: Option<PathBuf>,
-    /// Board whose projected centres are expected (with --distance).
-    #[arg(long, value_enum, requires = "distance")]
-    pub target: Option<Target>,
+    /// Board whose projected centres are expected (with --distance): blobs
+    /// (default), blobs:SCALE as in `render --target`, or blobs-half (= blobs:0.5).
+    #[arg(long, value_name = "BOARD", value_parser = parse_board, requires = "distance")]
+    pub target: Option<Board>,
     /// Distance of the fronto-parallel board on the optical axis, m.
     #[arg(allow_negative_numbers = true, long, value_name = "M")]
     pub distance: Option<f64>,
@@ -97,10 +105,7 @@ pub fn run(a: BlobsArgs) -> Result<()> {
                 ),
             ));
         }
-        let board = match a.target.unwrap_or(Target::Blobs) {
-            Target::Blobs => Board::thesis(),
-            Target::BlobsHalf => Board::half(),
-        };
+        let board = a.target.unwrap_or_else(Board::thesis);
         Some(board_centres_px(&cam, &board, d)?)
     } else {
         None

@@ -85,8 +85,9 @@ fn num(spec: &str, s: &str, what: &str) -> Result<f64> {
 }
 
 impl Target {
-    /// Parses `checker:S` (S in m), `blobs` / `blobs:SCALE`, or
-    /// `image:PATH:WIDTH_M` (the texture is loaded now; errors name the file).
+    /// Parses `checker:S` (S in m), `blobs` / `blobs:SCALE` (`blobs-half` is
+    /// `blobs:0.5`, the name `mmbm blobs` also takes), or `image:PATH:WIDTH_M`
+    /// (the texture is loaded now; errors name the file).
     pub fn parse(spec: &str, distance: f64) -> Result<Self> {
         let (name, rest) = spec.split_once(':').unwrap_or((spec, ""));
         let kind = match name.trim() {
@@ -94,6 +95,7 @@ impl Target {
                 size: num(spec, rest, "square size (m)")?,
             },
             "blobs" if rest.is_empty() => TargetKind::Blobs { scale: 1.0 },
+            "blobs-half" if rest.is_empty() => TargetKind::Blobs { scale: 0.5 },
             "blobs" => TargetKind::Blobs {
                 scale: num(spec, rest, "scale")?,
             },
@@ -272,6 +274,11 @@ mod tests {
         assert_eq!(t.kind, TargetKind::Checker { size: 0.05 });
         assert_eq!(
             Target::parse("blobs:0.5", 2.0).unwrap().kind,
+            TargetKind::Blobs { scale: 0.5 }
+        );
+        // `blobs-half` (the name `mmbm blobs` takes too) is `blobs:0.5`.
+        assert_eq!(
+            Target::parse("blobs-half", 2.0).unwrap().kind,
             TargetKind::Blobs { scale: 0.5 }
         );
         assert!(Target::parse("checker:-1", 2.0).is_err());
