@@ -44,6 +44,10 @@ PathLike = Union[str, "os.PathLike[str]"]
 ArrayLike = Any
 
 
+# The thesis camera, from its one definition in the library (``Camera::thesis``).
+_THESIS = _mmbm.camera_thesis()
+
+
 @dataclass(frozen=True)
 class Camera:
     """A camera (the keys of mmbm's camera files, SPEC sections 1 and 9).
@@ -59,11 +63,11 @@ class Camera:
     (``{"f_number": 2.0, "focus_m": 1.5}``).
     """
 
-    focal_mm: float = 4.2548
-    pitch_x_mm: float = 0.00465
-    pitch_y_mm: float = 0.00465
-    width: int = 640
-    height: int = 480
+    focal_mm: float = _THESIS[0]
+    pitch_x_mm: float = _THESIS[1]
+    pitch_y_mm: float = _THESIS[2]
+    width: int = _THESIS[3]
+    height: int = _THESIS[4]
     cx: Optional[float] = None
     cy: Optional[float] = None
     skew: float = 0.0
