@@ -278,6 +278,16 @@ impl Scene {
 
 /// Computes MMBM with a CPU method. Validates inputs first. (The GPU field
 /// is `crate::field::mmbm_gpu`.)
+///
+/// ```
+/// use mmbm::{mmbm, Camera, Method, Scene, Twist};
+/// let scene = Scene { camera: Camera::thesis(), plane: None };
+/// // Pitching at 1 rad/s: every point moves at least f = 4.2548 mm/s on the sensor.
+/// let m = mmbm(&scene, &Twist::rotation(1.0, 0.0, 0.0), Method::Exact { tol: 1e-9 })?;
+/// assert!(m.mm_s > 4.2548 && m.mm_s < 5.0);
+/// assert!(m.error_estimate.unwrap() < 1e-6);
+/// # Ok::<(), mmbm::Error>(())
+/// ```
 pub fn mmbm(scene: &Scene, tw: &Twist, method: Method) -> Result<Mmbm> {
     scene.validate_for(tw)?;
     let poly = scene.flow_poly(tw);

@@ -179,6 +179,16 @@ pub struct ImuLog {
 
 impl ImuLog {
     /// Validates `samples` (the one place a whole log is checked).
+    ///
+    /// ```
+    /// use glam::DVec3;
+    /// use mmbm::model::log::{GyroSample, ImuLog};
+    /// let s = |t| GyroSample { t, omega: DVec3::new(0.1, 0.0, 0.0), velocity: None, depth: None };
+    /// let log = ImuLog::new(vec![s(0.0), s(0.005), s(0.01)])?;
+    /// assert_eq!(log.median_interval(), Some(0.005));
+    /// assert!(ImuLog::new(vec![s(0.0), s(0.0)]).is_err()); // time must increase
+    /// # Ok::<(), mmbm::Error>(())
+    /// ```
     pub fn new(samples: Vec<GyroSample>) -> Result<Self> {
         if samples.is_empty() {
             return Err(Error::invalid("gyro log", "no samples"));

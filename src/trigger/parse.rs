@@ -175,6 +175,17 @@ pub struct PolicySpec {
 
 impl PolicySpec {
     /// Parses a policy string (grammar in the module docs of [`crate::trigger`]).
+    ///
+    /// ```
+    /// use mmbm::trigger::{Family, PolicySpec};
+    /// let p = PolicySpec::parse("deadline:5+exp:3:0.02")?;
+    /// assert_eq!(p.family, Family::Deadline);
+    /// assert_eq!(p.rate.map(|r| r.fps), Some(5.0));
+    /// assert_eq!(p.exposure.map(|e| e.budget_px), Some(3.0));
+    /// assert!(p.is_causal() && !p.is_baseline());
+    /// assert!(PolicySpec::parse("fixed:5").unwrap().is_baseline());
+    /// # Ok::<(), mmbm::Error>(())
+    /// ```
     pub fn parse(spec: &str) -> Result<Self> {
         if let Some((base, modifier)) = spec.split_once('+') {
             let bad = |msg: &str| {
