@@ -290,9 +290,18 @@ fn outputs_never_replace_what_they_point_at() {
     assert!(m.file_type().is_fifo(), "the FIFO was replaced");
 }
 
+/// SIGINT, and SIGTERM and SIGHUP (what `timeout`, systemd and SLURM send;
+/// issue #23 item 7) alike: the temporary output is removed, exit 130.
 #[cfg(unix)]
 #[test]
 fn an_interrupt_removes_temporary_files() {
+    for sig in ["INT", "TERM", "HUP"] {
+        interrupt_removes_temporary_files(sig);
+    }
+}
+
+#[cfg(unix)]
+fn interrupt_removes_temporary_files(sig: &str) {
     let d = tempfile::tempdir().unwrap();
     let mut child = common::mmbm_cmd()
         .args(["series", "--gyro", "-", "--out", "o.csv"])
@@ -325,15 +334,18 @@ fn an_interrupt_removes_temporary_files() {
         leftovers(d.path(), &[])
     );
     let st = Command::new("sh")
-        .args(["-c", &format!("kill -INT {}", child.id())])
+        .args(["-c", &format!("kill -{sig} {}", child.id())])
         .status()
         .unwrap();
     assert!(st.success());
     let o = child.wait_with_output().unwrap();
     drop(stdin);
-    assert_eq!(o.status.code(), Some(130));
-    assert!(String::from_utf8_lossy(&o.stderr).contains("interrupted"));
-    assert_eq!(leftovers(d.path(), &[]), Vec::<String>::new());
+    assert_eq!(o.status.code(), Some(130), "SIG{sig}");
+    assert!(
+        String::from_utf8_lossy(&o.stderr).contains("interrupted"),
+        "SIG{sig}"
+    );
+    assert_eq!(leftovers(d.path(), &[]), Vec::<String>::new(), "SIG{sig}");
 }
 
 #[test]
