@@ -259,3 +259,55 @@ fn scheduler_environments_pick_the_shard() {
     assert_eq!(o.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&o.stderr).contains("--shard-count"));
 }
+
+/// Issue #23 item 7: SIGTERM (and SIGINT, SIGHUP) during `dataset` removes
+/// the item being made (`.partial-*`) and says so, exit 130; a rerun resumes.
+#[cfg(unix)]
+#[test]
+fn a_terminated_run_leaves_no_partial_item() {
+    for sig in ["TERM", "INT", "HUP"] {
+        let mut cfg = small(50);
+        cfg.resolution = [160, 120];
+        let d = tempfile::tempdir().unwrap();
+        let toml = d.path().join("ds.toml");
+        std::fs::write(&toml, cfg.to_toml().unwrap()).unwrap();
+        let out = d.path().join("out");
+        let child = common::mmbm_cmd()
+            .args(["dataset", "--quiet", "--config"])
+            .arg(&toml)
+            .arg("--out")
+            .arg(&out)
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        let partials = || -> Vec<String> {
+            std::fs::read_dir(&out)
+                .map(|r| {
+                    r.filter_map(|e| e.ok())
+                        .map(|e| e.file_name().to_string_lossy().into_owned())
+                        .filter(|n| n.starts_with(".partial-"))
+                        .collect()
+                })
+                .unwrap_or_default()
+        };
+        let mut seen = false;
+        for _ in 0..1000 {
+            std::thread::sleep(std::time::Duration::from_millis(10));
+            if !partials().is_empty() {
+                seen = true;
+                break;
+            }
+        }
+        assert!(seen, "SIG{sig}: no item was being made");
+        let st = std::process::Command::new("kill")
+            .args([format!("-{sig}"), child.id().to_string()])
+            .status()
+            .unwrap();
+        assert!(st.success());
+        let o = child.wait_with_output().unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(130), "SIG{sig}: {err}");
+        assert!(partials().is_empty(), "SIG{sig}: {:?}", partials());
+        assert!(!err.contains("removed 0 temporary"), "SIG{sig}: {err}");
+    }
+}

@@ -9,7 +9,7 @@
 use super::config::DatasetConfig;
 use super::item::{make, plan, ItemMeasures, ItemParams, Sources, FILES};
 use crate::error::{Error, Result};
-use crate::io::atomic::write_atomic;
+use crate::io::atomic::{write_atomic, PendingDir};
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
@@ -128,7 +128,8 @@ fn ensure_item(cfg: &DatasetConfig, src: &Sources, out: &Path, i: u64) -> Result
         // Left by a killed run of this item (items are made by one shard only).
         std::fs::remove_dir_all(&partial).map_err(|e| Error::io(&partial, e))?;
     }
-    std::fs::create_dir_all(&partial).map_err(|e| Error::io(&partial, e))?;
+    // Registered: an interrupt (SIGINT, SIGTERM, SIGHUP) removes it.
+    let _guard = PendingDir::create(&partial)?;
     let result = (|| {
         let params = plan(cfg, src, i)?;
         let measures = make(&params, src, &partial)?;

@@ -108,20 +108,66 @@ fn pending(f: impl FnOnce(&mut HashSet<PathBuf>)) {
     }
 }
 
-/// Removes every temporary output file this process still has on disk
-/// (called on interrupt); returns how many were removed.
-pub fn remove_pending() -> usize {
-    let paths: Vec<PathBuf> = match PENDING.lock() {
+/// Temporary directories (a dataset item being made) not yet renamed or removed.
+static PENDING_DIRS: Mutex<Option<HashSet<PathBuf>>> = Mutex::new(None);
+
+fn taken(set: &Mutex<Option<HashSet<PathBuf>>>) -> Vec<PathBuf> {
+    match set.lock() {
         Ok(mut g) => g
             .take()
             .map(|s| s.into_iter().collect())
             .unwrap_or_default(),
         Err(_) => Vec::new(),
-    };
-    paths
+    }
+}
+
+/// Removes every temporary output file and directory this process still has
+/// on disk (called on interrupt: SIGINT, SIGTERM, SIGHUP); returns how many
+/// were removed.
+pub fn remove_pending() -> usize {
+    let files = taken(&PENDING)
         .iter()
         .filter(|p| std::fs::remove_file(p).is_ok())
-        .count()
+        .count();
+    let dirs = taken(&PENDING_DIRS)
+        .iter()
+        .filter(|p| std::fs::remove_dir_all(p).is_ok())
+        .count();
+    files + dirs
+}
+
+/// A temporary directory, created now and registered for [`remove_pending`]
+/// until the guard drops (after the directory was renamed into place, or
+/// removed).
+pub struct PendingDir(PathBuf);
+
+impl PendingDir {
+    /// Registers `path`, then creates it (and its parents): an interrupt at
+    /// any moment finds it registered.
+    pub fn create(path: &Path) -> Result<Self> {
+        if let Ok(mut g) = PENDING_DIRS.lock() {
+            g.get_or_insert_with(HashSet::new)
+                .insert(path.to_path_buf());
+        }
+        let guard = PendingDir(path.to_path_buf());
+        std::fs::create_dir_all(path).map_err(|e| Error::io(path, e))?;
+        Ok(guard)
+    }
+
+    /// The directory.
+    pub fn path(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl Drop for PendingDir {
+    fn drop(&mut self) {
+        if let Ok(mut g) = PENDING_DIRS.lock() {
+            if let Some(s) = g.as_mut() {
+                s.remove(&self.0);
+            }
+        }
+    }
 }
 
 /// A temporary file registered in [`PENDING`] for its lifetime.
