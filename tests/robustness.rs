@@ -165,11 +165,19 @@ const BAD: &[(&str, &[&str])] = &[
 fn bad_inputs_are_clear_errors_that_leave_nothing() {
     let d = tempfile::tempdir().unwrap();
     files(d.path());
-    let before = leftovers(d.path(), &[]);
+    let failures = unclear_errors(d.path(), BAD);
+    assert!(failures.is_empty(), "\n{}", failures.join("\n"));
+}
+
+/// Runs every case of `table` in `dir` and returns how each one that is not
+/// a clear error leaving nothing behind fails (exit code, panic, words,
+/// stderr size, leftovers).
+fn unclear_errors(dir: &Path, table: &[(&str, &[&str])]) -> Vec<String> {
+    let before = leftovers(dir, &[]);
     let mut failures = Vec::new();
-    for (args, words) in BAD {
+    for (args, words) in table {
         let argv: Vec<&str> = args.split_whitespace().collect();
-        let o = mmbm_in(d.path(), &argv);
+        let o = mmbm_in(dir, &argv);
         let err = String::from_utf8_lossy(&o.stderr);
         let mut why = Vec::new();
         if !matches!(o.status.code(), Some(1 | 2)) {
@@ -189,23 +197,23 @@ fn bad_inputs_are_clear_errors_that_leave_nothing() {
                 err.len()
             ));
         }
-        let left = leftovers(d.path(), &before);
+        let left = leftovers(dir, &before);
         if !left.is_empty() {
             why.push(format!("left {left:?}"));
             for n in left {
-                let _ = std::fs::remove_file(d.path().join(&n));
-                let _ = std::fs::remove_dir_all(d.path().join(&n));
+                let _ = std::fs::remove_file(dir.join(&n));
+                let _ = std::fs::remove_dir_all(dir.join(&n));
             }
         }
         if !why.is_empty() {
             failures.push(format!(
                 "mmbm {args}: {}\n    {}",
                 why.join("; "),
-                err.trim()
+                err.chars().take(2000).collect::<String>().trim()
             ));
         }
     }
-    assert!(failures.is_empty(), "\n{}", failures.join("\n"));
+    failures
 }
 
 #[test]
@@ -434,4 +442,161 @@ fn time_bases_too_coarse_for_the_exposure_are_refused() {
         .unwrap();
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(!o.status.success() && err.contains("--time-unit"), "{err}");
+}
+
+/// A small render every output case shares (CPU, 32 x 24: seconds at most);
+/// `R` at the start of a case below stands for it.
+const RENDER: &str = "render --omega 0.1,0,0 --exposure 0.05 --target checker:0.02 --distance 1 \
+                      --resolution 32x24 --backend cpu";
+
+/// Issue 23, items 5, 7 and 8: results that are not finite numbers, two
+/// outputs on one path, outputs that cannot be written, and error messages
+/// that would echo whole inputs: clear errors, before any work, bounded.
+/// Each case: the arguments, then ` | ` and each word the error must say.
+const ROUND_3: &[&str] = &[
+    // Results and cameras that are not finite numbers.
+    "eval --omega 1,1,1 --pitch 1e-308 --exposure 0.05 | pixel pitch | between",
+    "eval --omega 1,1,1 --exposure 1e308 --json | blur | not a finite number",
+    "eval --omega 1,1,1 --camera tiny_focal.json | tiny_focal.json | focal length | 1e-300",
+    "series --gyro good.csv --exposure 1e308 --out o.csv | t = 0 s | blur | not a finite",
+    // Two outputs on one path (a name, a hard link, a symlink), before any work.
+    "R --out x.png --sharp x.png | --out x.png | --sharp x.png | one file",
+    "R --out x.exr --maps ./x.exr | --out | --maps | one file",
+    "R --out x.png --psf 5,5:x.png | --psf | one file",
+    "R --out old.png --sharp hard.png | old.png | hard.png | one file",
+    "flow --omega 1,1,1 --out f.exr --quiver q.png | --quiver q.png | one file",
+    // An experiment's output place, checked before rendering.
+    "experiment --config small.toml --out afile --quiet | afile | not a directory",
+    // What an error echoes is bounded and printable.
+    "series --gyro wide.csv | wide.csv:1 | wz | bytes in all",
+    "series --gyro nul.csv | nul.csv:1 | \\x00",
+    "series --gyro nogx.gcsv | nogx.gcsv | gx | bytes in all",
+    "eval --omega 1,1,1 --camera long_line.toml | long_line.toml | line 1 | bytes in all",
+    "dataset --config tex.toml --out data --quiet | caf\\xe9.png | not valid UTF-8",
+];
+
+#[cfg(unix)]
+#[test]
+fn non_finite_results_shared_outputs_and_huge_echoes_are_clear_errors() {
+    use std::os::unix::ffi::OsStrExt;
+    let d = tempfile::tempdir().unwrap();
+    files(d.path());
+    let w = |name: &str, text: &str| std::fs::write(d.path().join(name), text).unwrap();
+    let profile = |extra: &str| {
+        format!(
+            "{{\"calib_dimension\": {{\"w\": 640, \"h\": 480}}, \"fisheye_params\": \
+             {{\"camera_matrix\": [[500, 0, 320], [0, 500, 240], [0, 0, 1]]}}{extra}}}"
+        )
+    };
+    w("tiny_focal.json", &profile(", \"focal_length\": 1e-300"));
+    w("real_focal.json", &profile(", \"focal_length\": 2.5"));
+    w("profile.json", &profile(""));
+    let cols: Vec<String> = (0..200_000).map(|i| format!("c{i}")).collect();
+    w(
+        "wide.csv",
+        &format!("t,wx,wy,{}\n0,1,2,3\n", cols.join(",")),
+    );
+    w("nul.csv", &"\0".repeat(1000));
+    let gcsv = "GYROFLOW IMU LOG\nversion,1.3\ntscale,0.001\ngscale,1\nt,";
+    w("nogx.gcsv", &format!("{gcsv}{}\n0,1,2,3\n", cols.join(",")));
+    w(
+        "long_line.toml",
+        &format!("focal_mm = 4{}\n", "x".repeat(3_000_000)),
+    );
+    w(
+        "small.toml",
+        "duration_s = 3.0\npolicies = [\"fixed:5\"]\nresolution = [32, 24]\nquality = \"fast\"\n\
+         max_frames_per_policy = 1\nsweep_exposures_s = [0.05]\nsweep_frames = 1\n",
+    );
+    w("afile", "not a directory");
+    // A texture whose name is not UTF-8 (a readable PNG all the same).
+    std::fs::create_dir(d.path().join("tex")).unwrap();
+    let odd = std::ffi::OsStr::from_bytes(b"caf\xe9.png");
+    std::fs::write(d.path().join("tex").join(odd), one_red_pixel_png()).unwrap();
+    w(
+        "tex.toml",
+        "textures = \"tex\"\ncount = 1\nmotion = [\"sim:slow\"]\n",
+    );
+    // One file under two names: a hard link, and a dangling symlink to a new one.
+    w("old.png", "old");
+    std::fs::hard_link(d.path().join("old.png"), d.path().join("hard.png")).unwrap();
+    std::os::unix::fs::symlink("f.exr", d.path().join("q.png")).unwrap();
+    let cases: Vec<(String, Vec<&str>)> = ROUND_3
+        .iter()
+        .map(|c| {
+            let mut parts = c.split(" | ");
+            let args = parts.next().unwrap();
+            let args = args
+                .strip_prefix("R ")
+                .map_or(args.to_string(), |r| format!("{RENDER} {r}"));
+            (args, parts.collect())
+        })
+        .collect();
+    let table: Vec<(&str, &[&str])> = cases
+        .iter()
+        .map(|(a, w)| (a.as_str(), w.as_slice()))
+        .collect();
+    let failures = unclear_errors(d.path(), &table);
+    assert!(failures.is_empty(), "\n{}", failures.join("\n"));
+    assert_eq!(std::fs::read(d.path().join("old.png")).unwrap(), b"old");
+    // A profile without a focal length in mm, or with a real one, has its
+    // answer, the same in px/s (they do not depend on the pitch); a finite
+    // blur is printed as before.
+    let eval = |args: &[&str]| -> serde_json::Value {
+        let argv = [&["eval", "--omega", "1,1,1", "--json"], args].concat();
+        serde_json::from_slice(&common::mmbm_ok_in(d.path(), &argv).stdout).unwrap()
+    };
+    let px_s = |camera: &str| eval(&["--camera", camera])["mmbm_px_s"].as_f64().unwrap();
+    let (nominal, real) = (px_s("profile.json"), px_s("real_focal.json"));
+    assert!(
+        nominal > 100.0 && (nominal - real).abs() < 1e-9 * nominal,
+        "{nominal} {real}"
+    );
+    let v = eval(&["--exposure", "0.05"]);
+    assert!(v["blur_px"].as_f64().is_some_and(f64::is_finite), "{v}");
+}
+
+/// `demo --out` at a place it cannot write fails at once, not after
+/// minutes of rendering (each run is killed after 60 s: a failure).
+#[cfg(unix)]
+#[test]
+fn demo_checks_its_output_place_first() {
+    let d = tempfile::tempdir().unwrap();
+    std::fs::write(d.path().join("afile"), "x").unwrap();
+    let ro = d.path().join("ro");
+    std::fs::create_dir(&ro).unwrap();
+    use std::os::unix::fs::PermissionsExt;
+    std::fs::set_permissions(&ro, std::fs::Permissions::from_mode(0o555)).unwrap();
+    // /proc takes no new files, even for root; a mode-555 directory only
+    // stops other users (root writes there: that case is skipped).
+    let mut outs = vec![("/proc/mmbm-report".to_string(), "cannot write")];
+    outs.push(("afile".into(), "not a directory"));
+    if std::fs::write(ro.join("probe"), "x").is_ok() {
+        common::skip("running as root: a read-only directory is writable");
+    } else {
+        outs.push(("ro/report".into(), "Permission denied"));
+    }
+    for (out, word) in outs {
+        let mut child = common::mmbm_cmd()
+            .args(["demo", "--quiet", "--out", &out])
+            .current_dir(d.path())
+            .stdin(Stdio::null())
+            .stdout(Stdio::null())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        let t0 = std::time::Instant::now();
+        while child.try_wait().unwrap().is_none() {
+            if t0.elapsed().as_secs() > 60 {
+                let _ = child.kill();
+                panic!("demo --out {out}: still running after 60 s (outputs not checked first)");
+            }
+            std::thread::sleep(std::time::Duration::from_millis(50));
+        }
+        let o = child.wait_with_output().unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "demo --out {out}: {err}");
+        assert!(err.contains(word), "demo --out {out}: {err}");
+    }
+    let _ = std::fs::set_permissions(&ro, std::fs::Permissions::from_mode(0o755));
 }

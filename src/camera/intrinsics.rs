@@ -48,6 +48,12 @@ pub struct Camera {
     pub lens: Option<Lens>,
 }
 
+/// The range a focal length or pixel pitch must lie in, mm (1 nm to 1 km):
+/// every physical camera, with the derived quantities (focal length in
+/// pixels, sensor size and area in mm, the flow's powers of the sensor
+/// coordinates) far from overflow and underflow.
+pub const LENGTH_RANGE_MM: [f64; 2] = [1e-6, 1e6];
+
 impl Default for Camera {
     fn default() -> Self {
         Self::thesis()
@@ -138,11 +144,28 @@ impl Camera {
         }
     }
 
-    /// Rejects zero/negative/NaN focal length or pitch, an empty sensor, a non-finite principal point.
+    /// Rejects zero/negative/NaN focal length or pitch, lengths outside
+    /// [`LENGTH_RANGE_MM`] (their squares and ratios, the sensor's area and
+    /// the focal length in pixels, must stay far from the float range), an
+    /// empty sensor, a non-finite principal point.
     pub fn validate(&self) -> Result<()> {
-        positive("focal length (mm)", self.focal_mm)?;
-        positive("pixel pitch x (mm)", self.pitch_x_mm)?;
-        positive("pixel pitch y (mm)", self.pitch_y_mm)?;
+        for (what, x) in [
+            ("focal length (mm)", self.focal_mm),
+            ("pixel pitch x (mm)", self.pitch_x_mm),
+            ("pixel pitch y (mm)", self.pitch_y_mm),
+        ] {
+            positive(what, x)?;
+            let [lo, hi] = LENGTH_RANGE_MM;
+            if !(lo..=hi).contains(&x) {
+                return Err(Error::invalid(
+                    what,
+                    format!(
+                        "must be between {lo:e} and {hi:e} mm, got {x:e} (the sensor's \
+                         geometry in mm and pixels would not be representable)"
+                    ),
+                ));
+            }
+        }
         finite("principal point cx", self.cx)?;
         finite("principal point cy", self.cy)?;
         finite("skew", self.skew)?;

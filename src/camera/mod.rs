@@ -13,7 +13,7 @@ pub mod lens;
 pub mod noise;
 pub mod shutter;
 
-pub use blur::{blur_px, exposure_for_blur};
+pub use blur::{blur_px, checked_blur_px, checked_px_s, exposure_for_blur};
 pub use distortion::Distortion;
 pub use intrinsics::{Camera, SensorRect};
 pub use lens::Lens;

@@ -82,6 +82,10 @@ fn read_expected(path: &Path) -> Result<(Vec<(f64, f64)>, f64)> {
 }
 
 pub fn run(a: BlobsArgs) -> Result<()> {
+    // The output's place, checked before any work.
+    if let Some(p) = &a.mask {
+        mmbm::io::atomic::check_output(p)?;
+    }
     let img = mmbm::io::images::read_rgb8(&a.image)?;
     let params = BlobParams {
         threshold: a.threshold,

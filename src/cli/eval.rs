@@ -3,7 +3,7 @@
 use super::args::{parse_vec3, CameraArgs, SceneArgs};
 use clap::Args;
 use glam::DVec3;
-use mmbm::camera::blur_px;
+use mmbm::camera::checked_blur_px;
 use mmbm::error::Result;
 use mmbm::{AnyMethod, Scene, Twist};
 
@@ -55,6 +55,12 @@ pub fn run(a: EvalArgs) -> Result<()> {
         }
         AnyMethod::Cpu(method) => mmbm::mmbm(&scene, &tw, method)?,
     };
+    // Checked before anything is printed: a blur that is not a finite
+    // number is an error, not "inf" or a JSON null.
+    let blur = match a.exposure {
+        Some(te) => Some((te, checked_blur_px(m.mm_s, te, scene.camera.pitch_x_mm)?)),
+        None => None,
+    };
     if a.json {
         let mut o = serde_json::json!({
             "mmbm_mm_s": m.mm_s,
@@ -65,9 +71,9 @@ pub fn run(a: EvalArgs) -> Result<()> {
         if let Some(e) = m.error_estimate {
             o["error_estimate"] = serde_json::json!(e);
         }
-        if let Some(te) = a.exposure {
+        if let Some((te, b)) = blur {
             o["exposure_s"] = serde_json::json!(te);
-            o["blur_px"] = serde_json::json!(blur_px(m.mm_s, te, scene.camera.pitch_x_mm));
+            o["blur_px"] = serde_json::json!(b);
         }
         println!("{o}");
     } else {
@@ -76,11 +82,8 @@ pub fn run(a: EvalArgs) -> Result<()> {
             print!(", error estimate {e:.2e} mm/s");
         }
         println!(")");
-        if let Some(te) = a.exposure {
-            println!(
-                "blur over {te} s: {:.4} px",
-                blur_px(m.mm_s, te, scene.camera.pitch_x_mm)
-            );
+        if let Some((te, b)) = blur {
+            println!("blur over {te} s: {b:.4} px");
         }
     }
     Ok(())

@@ -49,11 +49,12 @@ pub fn run(a: FlowArgs) -> Result<()> {
     positive("--exposure (s)", a.exposure)?;
     // Every output checked before any work.
     super::args::check_ext(&a.out, &["exr"], "--out")?;
-    mmbm::io::atomic::check_output(&a.out)?;
+    let mut outputs = vec![("--out", a.out.as_path())];
     if let Some(q) = &a.quiver {
         super::args::check_ext(q, &["png"], "--quiver")?;
-        mmbm::io::atomic::check_output(q)?;
+        outputs.push(("--quiver", q.as_path()));
     }
+    mmbm::io::atomic::check_outputs(&outputs)?;
     let scene = Scene {
         camera: a.camera.camera()?,
         plane: a.scene.plane()?,

@@ -58,6 +58,10 @@ pub struct FramesArgs {
 }
 
 pub fn run(a: FramesArgs) -> Result<()> {
+    // The output's place, checked before any work.
+    if let Some(p) = &a.out {
+        mmbm::io::atomic::check_output(p)?;
+    }
     let method = match a.method {
         AnyMethod::Cpu(m) => m,
         AnyMethod::Gpu { .. } => {

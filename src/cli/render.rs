@@ -5,7 +5,7 @@ use super::series::GyroArgs;
 use clap::Args;
 use glam::DVec3;
 use mmbm::error::{Error, Result};
-use mmbm::io::atomic::{all_or_nothing, check_output};
+use mmbm::io::atomic::{all_or_nothing, check_outputs};
 use mmbm::io::images::{write_exr, write_png_linear_rgb};
 use mmbm::render::{
     self, Backend, Integrator, Quality, RenderJob, RenderOutput, Target, Trajectory,
@@ -145,16 +145,17 @@ fn write_image(p: &Path, o: &RenderOutput) -> Result<()> {
 pub fn run(args: RenderArgs) -> Result<()> {
     let a = *args.opts;
     // Validate every output name and place before any work, so nothing is
-    // half-written; the files then appear all together or not at all.
+    // half-written (and no two outputs share a file); the files then appear
+    // all together or not at all.
     check_ext(&a.out, &["exr", "png"], "--out")?;
-    check_output(&a.out)?;
+    let mut outputs: Vec<(&str, &Path)> = vec![("--out", &a.out)];
     if let Some(p) = &a.maps {
         check_ext(p, &["exr"], "--maps")?;
-        check_output(p)?;
+        outputs.push(("--maps", p));
     }
     if let Some(p) = &a.sharp {
         check_ext(p, &["exr", "png"], "--sharp")?;
-        check_output(p)?;
+        outputs.push(("--sharp", p));
     }
     let psf = match &a.psf {
         Some(s) => {
@@ -164,11 +165,14 @@ pub fn run(args: RenderArgs) -> Result<()> {
             let [x, y] = pair(xy, "--psf")?;
             let file = PathBuf::from(file);
             check_ext(&file, &["exr", "png"], "--psf")?;
-            check_output(&file)?;
             Some((x, y, file))
         }
         None => None,
     };
+    if let Some((_, _, file)) = &psf {
+        outputs.push(("--psf", file));
+    }
+    check_outputs(&outputs)?;
     let mut camera = a.camera.camera()?;
     if let Some((w, h)) = a.resolution {
         camera = camera.with_resolution(w, h);

@@ -37,6 +37,10 @@ pub struct SimulateArgs {
 }
 
 pub fn run(a: SimulateArgs) -> Result<()> {
+    // The output's place, checked before any work.
+    if let Some(p) = &a.out {
+        mmbm::io::atomic::check_output(p)?;
+    }
     let gait = a.gait;
     let cfg = match &a.config {
         Some(p) => GaitConfig::load(p, gait)?,

@@ -21,6 +21,10 @@ pub struct TablesArgs {
 }
 
 pub fn run(a: TablesArgs) -> Result<()> {
+    // The output's place, checked before any work.
+    if let Some(p) = &a.plot {
+        mmbm::io::atomic::check_output(p)?;
+    }
     let ts = tables::all_tables()?;
     let grid = tables::grid_error()?;
     if a.json {

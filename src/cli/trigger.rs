@@ -111,6 +111,10 @@ fn summary_text(frames: &[Frame], spec: &str, duration: f64, pitch_mm: f64) -> S
 }
 
 pub fn run(a: TriggerArgs) -> Result<()> {
+    // The output's place, checked before any work.
+    if let Some(p) = &a.out {
+        mmbm::io::atomic::check_output(p)?;
+    }
     let method = a.method;
     let mut policies = Vec::new();
     for p in &a.policy {

@@ -79,10 +79,23 @@ impl Sources {
         let mut textures = Vec::new();
         for e in rd {
             let e = e.map_err(|e| Error::io(dir, e))?;
-            let name = e.file_name().to_string_lossy().into_owned();
-            let ext = name.rsplit('.').next().unwrap_or("").to_ascii_lowercase();
+            let file_name = e.file_name();
+            let lossy = file_name.to_string_lossy();
+            let ext = lossy.rsplit('.').next().unwrap_or("").to_ascii_lowercase();
             if ["png", "jpg", "jpeg"].contains(&ext.as_str()) {
-                let p = dir.join(&name);
+                let p = dir.join(&file_name);
+                // Items and manifests name their texture as text: a name
+                // that is not UTF-8 is refused as it is (not read as another).
+                let name = file_name.to_str().map(str::to_string).ok_or_else(|| {
+                    Error::invalid(
+                        "texture",
+                        format!(
+                            "{}: the file name is not valid UTF-8 (items and manifests name \
+                             their texture as text); rename the file",
+                            crate::error::show_path(&p)
+                        ),
+                    )
+                })?;
                 image::image_dimensions(&p).map_err(|e| Error::Image {
                     path: p.clone(),
                     message: format!("not a readable image: {e}"),

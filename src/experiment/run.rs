@@ -30,6 +30,8 @@ pub fn frames_to_render(frames: &[Frame], max: usize) -> Vec<usize> {
 /// Runs the experiment and writes `frames.csv`, `report.md` and the figures into `out`.
 pub fn run(cfg: &ExperimentConfig, out: &Path, progress: bool) -> Result<Outcome> {
     cfg.validate()?;
+    // The outputs' place is checked before minutes of rendering.
+    crate::io::atomic::check_output_dir(out)?;
     let t_start = Instant::now();
     let quality = Quality::from_str(&cfg.quality)?;
     let scene = Scene {

@@ -52,13 +52,13 @@ impl FlowField {
     }
 }
 
-fn to_mmbm(scene: &Scene, mean_mm_s: f64, grid: &Grid) -> Mmbm {
-    Mmbm {
+fn to_mmbm(scene: &Scene, mean_mm_s: f64, grid: &Grid) -> Result<Mmbm> {
+    Ok(Mmbm {
         mm_s: mean_mm_s,
-        px_s: mean_mm_s / scene.camera.pitch_x_mm,
+        px_s: crate::camera::checked_px_s(mean_mm_s, scene.camera.pitch_x_mm)?,
         error_estimate: None,
         evaluations: grid.len() as u64,
-    }
+    })
 }
 
 static ANNOUNCED: AtomicBool = AtomicBool::new(false);
@@ -110,7 +110,7 @@ pub fn flow_field(
         height: grid.height,
         u: field.iter().map(|x| x[0]).collect(),
         v: field.iter().map(|x| x[1]).collect(),
-        mmbm: to_mmbm(scene, mean, &grid),
+        mmbm: to_mmbm(scene, mean, &grid)?,
     })
 }
 
@@ -135,5 +135,5 @@ pub fn mmbm_gpu(scene: &Scene, tw: &Twist, w: u32, h: u32) -> Result<Mmbm> {
             format!("MMBM is {mean}: the flow overflows f32 on the GPU"),
         ));
     }
-    Ok(to_mmbm(scene, mean, &grid))
+    to_mmbm(scene, mean, &grid)
 }

@@ -15,7 +15,7 @@
 //! all of them succeeded. Temporary files still on disk when the process is
 //! interrupted are removed by [`remove_pending`] (the CLI calls it on Ctrl-C).
 
-use crate::error::{Error, Result};
+use crate::error::{show_path, Error, Result};
 use std::cell::RefCell;
 use std::collections::HashSet;
 use std::io::Write;
@@ -90,6 +90,117 @@ impl Destination {
 /// existing non-directory, or a new file in an existing directory.
 pub fn check_output(path: &Path) -> Result<()> {
     Destination::of(path).map(|_| ())
+}
+
+/// Checks, before any work, every output of one command: each as
+/// [`check_output`], and no two on one destination (one would silently
+/// replace the other). `outputs` pairs each path with the flag that gave it,
+/// for the message. Several outputs may go to `/dev/null`.
+pub fn check_outputs(outputs: &[(&str, &Path)]) -> Result<()> {
+    let mut seen: Vec<(&str, &Path, Identity)> = Vec::new();
+    for &(flag, path) in outputs {
+        let Some(id) = Identity::of(&Destination::of(path)?) else {
+            continue;
+        };
+        if let Some((f0, p0, _)) = seen.iter().find(|s| s.2 == id) {
+            return Err(Error::invalid(
+                "outputs",
+                format!(
+                    "{f0} {} and {flag} {} are one file: one output would replace the other; \
+                     give each output its own path",
+                    show_path(p0),
+                    show_path(path)
+                ),
+            ));
+        }
+        seen.push((flag, path, id));
+    }
+    Ok(())
+}
+
+/// What two output paths must not share.
+#[derive(Debug, PartialEq, Eq)]
+enum Identity {
+    Stdout,
+    /// An existing file (device and inode: hard links and `a/../b` included).
+    #[cfg(unix)]
+    Inode(u64, u64),
+    /// A file still to be created: its directory's canonical path and its name.
+    Path(PathBuf),
+}
+
+impl Identity {
+    /// `None` for `/dev/null`, which takes any number of outputs.
+    fn of(d: &Destination) -> Option<Self> {
+        let p = match d {
+            Destination::Stdout => return Some(Identity::Stdout),
+            Destination::InPlace(p) if p == Path::new("/dev/null") => return None,
+            Destination::File(p) | Destination::InPlace(p) => p,
+        };
+        #[cfg(unix)]
+        if let Ok(m) = std::fs::metadata(p) {
+            use std::os::unix::fs::MetadataExt;
+            return Some(Identity::Inode(m.dev(), m.ino()));
+        }
+        let dir = parent_dir(p);
+        let dir = std::fs::canonicalize(dir).unwrap_or_else(|_| dir.to_path_buf());
+        Some(Identity::Path(match p.file_name() {
+            Some(n) => dir.join(n),
+            None => dir,
+        }))
+    }
+}
+
+/// Checks, before any work, that the directory `path` can take outputs: an
+/// existing directory or one that can be created (its nearest existing
+/// ancestor is a directory), which this process can write in (a probe file
+/// is created there and removed at once).
+pub fn check_output_dir(path: &Path) -> Result<()> {
+    let not_found = |dir: &Path| {
+        Error::io(
+            path,
+            std::io::Error::new(
+                std::io::ErrorKind::NotFound,
+                format!("no existing directory above '{}'", show_path(dir)),
+            ),
+        )
+    };
+    let mut dir = path;
+    loop {
+        match std::fs::metadata(dir) {
+            Ok(m) if m.is_dir() => break,
+            Ok(_) => {
+                return Err(Error::io(
+                    path,
+                    std::io::Error::other(format!(
+                        "'{}' exists and is not a directory",
+                        show_path(dir)
+                    )),
+                ))
+            }
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+                let up = parent_dir(dir);
+                if up == dir {
+                    return Err(not_found(dir));
+                }
+                dir = up;
+            }
+            Err(e) => return Err(Error::io(dir, e)),
+        }
+    }
+    tempfile::Builder::new()
+        .prefix(".mmbm-probe-")
+        .tempfile_in(dir)
+        .map(drop)
+        .map_err(|e| {
+            Error::io(
+                path,
+                std::io::Error::new(
+                    e.kind(),
+                    format!("cannot write in '{}': {e}", show_path(dir)),
+                ),
+            )
+        })
 }
 
 fn parent_dir(path: &Path) -> &Path {

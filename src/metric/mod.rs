@@ -338,7 +338,7 @@ pub fn mmbm_poly(cam: &Camera, poly: &FlowPoly, method: Method) -> Result<Mmbm> 
     }
     Ok(Mmbm {
         mm_s,
-        px_s: mm_s / cam.pitch_x_mm,
+        px_s: crate::camera::checked_px_s(mm_s, cam.pitch_x_mm)?,
         error_estimate: err,
         evaluations: evals,
     })

@@ -189,6 +189,13 @@ pub fn frame_mmbm(
                 "the exposure MMBM is not finite (rates near the float range?)",
             ));
         }
+        // The blur in px must be a number too (what `blur_px` then gives).
+        crate::camera::checked_blur_px(exposure, f.exposure_s, cam.pitch_x_mm).map_err(|e| {
+            Error::invalid(
+                format!("frame {k} (t_start = {} s)", f.t_start),
+                e.to_string(),
+            )
+        })?;
         r.exposure_mm_s = Some(exposure);
         r.start_mm_s = Some(start);
         out.push(r);

@@ -183,7 +183,14 @@ pub fn run<W: Write>(
             }
             let vals = eval(&batch)?;
             for (s, m) in batch.iter().zip(&vals) {
-                for (i, x) in [a.format(s.t), b.format(*m), c.format(m / pitch_mm)]
+                let at =
+                    |e: Error| Error::invalid(format!("sample at t = {} s", s.t), e.to_string());
+                let px = crate::camera::checked_px_s(*m, pitch_mm).map_err(at)?;
+                let blur = exposure_s
+                    .map(|te| crate::camera::checked_blur_px(*m, te, pitch_mm))
+                    .transpose()
+                    .map_err(at)?;
+                for (i, x) in [a.format(s.t), b.format(*m), c.format(px)]
                     .iter()
                     .enumerate()
                 {
@@ -192,13 +199,9 @@ pub fn run<W: Write>(
                     }
                     out.write_all(x.as_bytes()).map_err(werr)?;
                 }
-                if let Some(te) = exposure_s {
+                if let Some(blur) = blur {
                     out.write_all(b",").map_err(werr)?;
-                    out.write_all(
-                        d.format(crate::camera::blur_px(*m, te, pitch_mm))
-                            .as_bytes(),
-                    )
-                    .map_err(werr)?;
+                    out.write_all(d.format(blur).as_bytes()).map_err(werr)?;
                 }
                 out.write_all(b"\n").map_err(werr)?;
             }
