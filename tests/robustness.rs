@@ -423,3 +423,139 @@ fn time_bases_too_coarse_for_the_exposure_are_refused() {
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(!o.status.success() && err.contains("--time-unit"), "{err}");
 }
+
+/// Issue #23 item 3: `/dev/zero` as a gyro log (CLI, experiment config,
+/// dataset config, the library function Python's `read_gyro` calls) aborted
+/// on a 4 GiB allocation; one endless line on stdin grew without bound; a
+/// FIFO named `f.png` among a dataset's textures blocked forever. Now only
+/// regular files and pipes are read, every line is capped at
+/// `MAX_LINE_BYTES`, and image headers are checked before decoding.
+#[cfg(unix)]
+#[test]
+fn endless_and_gigantic_inputs_are_refused_quickly() {
+    use mmbm::io::gyro::{read_log, GyroOptions};
+    use mmbm::io::input::{MAX_IMAGE_PIXELS, MAX_LINE_BYTES};
+    let d = tempfile::tempdir().unwrap();
+    let p = d.path();
+    files(p);
+    // /dev/zero behind every name a log may have, through every door.
+    for (name, link) in [
+        ("z.csv", true),
+        ("z.gcsv", true),
+        ("z.mcap", true),
+        ("/dev/zero", false),
+    ] {
+        if link {
+            std::os::unix::fs::symlink("/dev/zero", p.join(name)).unwrap();
+        }
+        let o = common::mmbm_within(p, &["series", "--gyro", name, "--out", "o.csv"], vec![], 20);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "{name}: {err}");
+        assert!(
+            err.contains(name) && err.contains("character device"),
+            "{name}: {err}"
+        );
+        let e = read_log(&p.join(name), GyroOptions::default())
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("character device"), "{name}: {e}");
+    }
+    std::fs::write(p.join("e.toml"), "gyro = \"/dev/zero\"\n").unwrap();
+    let o = common::mmbm_within(
+        p,
+        &["experiment", "--config", "e.toml", "--out", "rep"],
+        vec![],
+        20,
+    );
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        o.status.code() == Some(1) && err.contains("/dev/zero"),
+        "{err}"
+    );
+    // One line a byte over the cap on stdin (`series` streams).
+    let mut long = b"t,wx,wy,wz\n0,1,2,".to_vec();
+    long.resize(11 + MAX_LINE_BYTES + 1, b'3');
+    long.push(b'\n');
+    let o = common::mmbm_within(
+        p,
+        &["series", "--gyro", "-", "--out", "o.csv"],
+        long.clone(),
+        20,
+    );
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("<stdin>:2") && err.contains(&format!("longer than {MAX_LINE_BYTES} bytes")),
+        "{err}"
+    );
+    // The same line to `live` is a malformed line, skipped: the stream goes on.
+    let mut live = long.clone();
+    live.extend_from_slice(b"0.01,0.1,0.2,0.3\n");
+    let o = common::mmbm_within(
+        p,
+        &["live", "--policy", "fixed:5", "--exposure", "0.05"],
+        live,
+        20,
+    );
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    assert!(
+        err.contains("longer than") && err.contains("line skipped"),
+        "{err}"
+    );
+    // A .gcsv header that never reaches its column line.
+    let mut gcsv = b"GYROFLOW IMU LOG\n".to_vec();
+    gcsv.resize(gcsv.len() + mmbm::io::input::MAX_HEADER_BYTES + 2, b'\n');
+    std::fs::write(p.join("endless.gcsv"), &gcsv).unwrap();
+    let o = common::mmbm_within(
+        p,
+        &["series", "--gyro", "endless.gcsv", "--out", "o.csv"],
+        vec![],
+        20,
+    );
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        o.status.code() == Some(1) && err.contains("header"),
+        "{err}"
+    );
+    // A decompression bomb: the header claims more pixels than the cap.
+    let side = (MAX_IMAGE_PIXELS as f64).sqrt() as u32 + 1;
+    std::fs::write(p.join("bomb.png"), common::png_header(side, side)).unwrap();
+    for cmd in ["blobs", "assess"] {
+        let o = common::mmbm_within(p, &[cmd, "bomb.png"], vec![], 20);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "{cmd}: {err}");
+        assert!(
+            err.contains("bomb.png") && err.contains(&format!("{side} x {side}")),
+            "{cmd}: {err}"
+        );
+    }
+    // A dataset: a FIFO named f.png among the textures is not a texture; a
+    // log at /dev/zero is refused.
+    let tex = p.join("tex");
+    std::fs::create_dir(&tex).unwrap();
+    std::fs::write(tex.join("a.png"), one_red_pixel_png()).unwrap();
+    assert!(Command::new("mkfifo")
+        .arg(tex.join("f.png"))
+        .status()
+        .unwrap()
+        .success());
+    let cfg = |motion: &str| mmbm::dataset::DatasetConfig {
+        textures: tex.clone(),
+        motion: vec![motion.into()],
+        count: 1,
+        ..Default::default()
+    };
+    let (tx, rx) = std::sync::mpsc::channel();
+    let (ok, zero) = (cfg("sim:slow"), cfg("log:/dev/zero"));
+    std::thread::spawn(move || {
+        let a = mmbm::dataset::Sources::open(&ok).map(|s| s.textures);
+        let b = mmbm::dataset::Sources::open(&zero).map(|_| ());
+        let _ = tx.send((a, b.map_err(|e| e.to_string())));
+    });
+    let (a, b) = rx
+        .recv_timeout(std::time::Duration::from_secs(20))
+        .expect("Sources::open blocked on a FIFO texture");
+    assert_eq!(a.unwrap(), ["a.png"]);
+    assert!(b.unwrap_err().contains("character device"));
+}

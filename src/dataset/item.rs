@@ -7,6 +7,7 @@ use crate::error::{Error, Result};
 use crate::field::flow_field;
 use crate::io::gyro::{read_log, GyroOptions, GyroSample};
 use crate::io::images::write_exr;
+use crate::io::input::{image_dimensions, is_regular_file};
 use crate::metric::{mmbm, Method, Scene};
 use crate::model::log::ImuLog;
 use crate::model::motion::{Plane, Twist};
@@ -81,11 +82,16 @@ impl Sources {
             let e = e.map_err(|e| Error::io(dir, e))?;
             let name = e.file_name().to_string_lossy().into_owned();
             let ext = name.rsplit('.').next().unwrap_or("").to_ascii_lowercase();
-            if ["png", "jpg", "jpeg"].contains(&ext.as_str()) {
-                let p = dir.join(&name);
-                image::image_dimensions(&p).map_err(|e| Error::Image {
-                    path: p.clone(),
-                    message: format!("not a readable image: {e}"),
+            let p = dir.join(&name);
+            // Only regular files are textures (a pipe named f.png would
+            // block the read; a folder or a device is not an image).
+            if ["png", "jpg", "jpeg"].contains(&ext.as_str()) && is_regular_file(&p) {
+                image_dimensions(&p).map_err(|e| match e {
+                    Error::Image { path, message } => Error::Image {
+                        path,
+                        message: format!("not a readable image: {message}"),
+                    },
+                    e => e,
                 })?;
                 textures.push(name);
             }

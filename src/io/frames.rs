@@ -19,7 +19,8 @@ pub struct VideoFrame {
 
 /// Reads a frame table.
 pub fn read_frames(path: &Path) -> Result<Vec<VideoFrame>> {
-    let file = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
+    use super::input::{open_stream, LineCap, MAX_LINE_BYTES};
+    let file = LineCap::new(open_stream(path)?, path, MAX_LINE_BYTES);
     let mut rd = csv::ReaderBuilder::new()
         .comment(Some(b'#'))
         .trim(csv::Trim::All)

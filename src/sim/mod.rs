@@ -268,7 +268,7 @@ impl GaitConfig {
 
     /// Loads a TOML file over the preset `base` (see [`GaitConfig::from_toml_str`]).
     pub fn load(path: &Path, base: Gait) -> Result<Self> {
-        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+        let text = crate::io::input::read_text(path)?;
         Self::from_toml_str(&text, base, path)
     }
 
