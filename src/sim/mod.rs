@@ -56,7 +56,7 @@
 
 mod gen;
 
-pub use gen::{simulate, write_log, LOG_HEADER};
+pub use gen::{samples, simulate, write_log, write_samples, Samples, LOG_HEADER, MAX_SAMPLES};
 
 /// Highest step rate of a gait, steps/s (legged gaits take a few).
 pub const MAX_STEP_HZ: f64 = 100.0;
