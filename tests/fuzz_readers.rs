@@ -288,3 +288,72 @@ fn simulate_streams_its_log() {
         "{err}"
     );
 }
+
+/// Issue #23 item 3: every line reader holds a line of `MAX_LINE_BYTES` (not
+/// counting its `\n`) and refuses one byte more, naming the file and line;
+/// an image whose header claims more than `MAX_IMAGE_PIXELS` is refused
+/// before decoding.
+#[test]
+fn line_and_image_caps_at_their_boundary() {
+    use mmbm::io::input::{MAX_IMAGE_PIXELS, MAX_LINE_BYTES};
+    let d = tempfile::tempdir().unwrap();
+    // A line of exactly `len` bytes: a number field padded with zeros.
+    let line = |prefix: &str, len: usize| {
+        let mut s = prefix.to_string();
+        s.push('1');
+        s.push_str(&"0".repeat(len - prefix.len() - 1));
+        s
+    };
+    let cases = [
+        ("a.csv", "t,wx,wy,wz\n", "0,1,2,", "\n1,1,2,3\n", 2),
+        (
+            "a.gcsv",
+            "GYROFLOW IMU LOG\ntscale,1\ngscale,1\nt,gx,gy,gz\n",
+            "0,1,2,",
+            "\n1,1,2,3\n",
+            5,
+        ),
+        (
+            "h.gcsv",
+            "GYROFLOW IMU LOG\n",
+            "note,",
+            "\ntscale,1\ngscale,1\nt,gx,gy,gz\n0,1,2,3\n1,1,2,3\n",
+            2,
+        ),
+    ];
+    for (name, head, prefix, tail, no) in cases {
+        for (len, over) in [(MAX_LINE_BYTES, false), (MAX_LINE_BYTES + 1, true)] {
+            let text = format!("{head}{}{tail}", line(prefix, len));
+            let p = write(d.path(), name, text.as_bytes());
+            let r = read_log(&p, GyroOptions::default()).map(|_| ());
+            let e = r.err().map(|e| e.to_string()).unwrap_or_default();
+            let refused = e.contains("longer than");
+            assert_eq!(refused, over, "{name}, a line of {len} bytes: {e}");
+            if over {
+                assert!(e.contains(&format!("{name}:{no}")), "{e}");
+            }
+        }
+    }
+    // The frame table.
+    for (len, over) in [(MAX_LINE_BYTES, false), (MAX_LINE_BYTES + 1, true)] {
+        let text = format!("t_start,exposure_s\n{}\n", line("0,", len));
+        let p = write(d.path(), "frames.csv", text.as_bytes());
+        let e = mmbm::io::frames::read_frames(&p)
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default();
+        assert_eq!(e.contains("longer than"), over, "{e}");
+    }
+    // Images: read, and listed as a dataset texture.
+    let side = (MAX_IMAGE_PIXELS as f64).sqrt() as u32;
+    for (w, h, over) in [
+        (side, side, false),
+        (side, side + 1, true),
+        (4 * side, 4 * side, true),
+    ] {
+        let p = write(d.path(), "big.png", &common::png_header(w, h));
+        let e = mmbm::io::images::read_rgb8(&p).unwrap_err().to_string();
+        assert_eq!(e.contains("the header declares"), over, "{w}x{h}: {e}");
+        assert!(e.contains("big.png"), "{e}");
+    }
+}

@@ -24,7 +24,7 @@ pub const MAX_LINE_BYTES: usize = 4 << 20;
 
 /// Longest `.gcsv` header (the magic line, `key,value` lines and comments
 /// before the column line, together), bytes.
-pub const MAX_HEADER_BYTES: usize = 4 << 20;
+pub const MAX_HEADER_BYTES: usize = 16 << 20;
 
 /// Most pixels (width x height) an input image may declare to be decoded
 /// (16384 x 16384).
@@ -133,7 +133,7 @@ pub enum Line {
 }
 
 /// Reads one line into `buf` (cleared first) holding at most `cap` bytes of
-/// it: a longer line is read to its end in bounded memory and reported as
+/// it (not counting its `\n`): a longer line is read to its end in bounded memory and reported as
 /// [`Line::TooLong`].
 pub fn read_line(src: &mut dyn BufRead, buf: &mut Vec<u8>, cap: usize) -> std::io::Result<Line> {
     buf.clear();
@@ -157,7 +157,8 @@ pub fn read_line(src: &mut dyn BufRead, buf: &mut Vec<u8>, cap: usize) -> std::i
         };
         let room = (cap + 1).saturating_sub(buf.len()).min(n);
         buf.extend_from_slice(&chunk[..room]);
-        total = total.saturating_add(n);
+        // The line's length does not count its `\n` (as for [`LineCap`]).
+        total = total.saturating_add(n - usize::from(end));
         src.consume(n);
         if end {
             return Ok(if total > cap {
@@ -274,7 +275,7 @@ mod tests {
 
     #[test]
     fn lines_over_the_cap() {
-        let text = b"ab\ncdefg\n\nxy";
+        let text = b"abc\ncdefg\n\nxy";
         let mut src: &[u8] = text;
         let mut buf = Vec::new();
         let mut got = Vec::new();
@@ -288,7 +289,7 @@ mod tests {
         assert_eq!(
             got,
             [
-                (Line::Read, "ab\n".to_string()),
+                (Line::Read, "abc\n".to_string()),
                 (Line::TooLong, "cde".to_string()),
                 (Line::Read, "\n".to_string()),
                 (Line::Read, "xy".to_string()),
