@@ -193,3 +193,167 @@ fn exr_mutations() {
         })
         .unwrap();
 }
+
+/// Issue #23 item 4: sizes and values the CLI refused but other doors (Python)
+/// passed to the library: a 65535 x 65535 flow field aborted on 34 GB, a
+/// negative or NaN exposure or readout of a video frame panicked and a NaN
+/// start time gave numbers, a negative resolution was an `OverflowError`
+/// naming nothing. Each is now refused by the library function every door calls.
+#[test]
+fn library_doors_refuse_what_the_cli_refuses() {
+    use mmbm::field::{flow_field, MAX_FIELD_PIXELS};
+    use mmbm::io::frames::VideoFrame;
+    use mmbm::metric::Scene;
+    use mmbm::model::motion::Twist;
+    let mut camera = Camera::thesis();
+    (camera.width, camera.height) = (65535, 65535);
+    let scene = Scene {
+        camera,
+        plane: None,
+    };
+    let tw = Twist::new(glam::DVec3::new(0.1, 0.2, 0.3), glam::DVec3::ZERO);
+    let e = flow_field(
+        &scene,
+        &tw,
+        0,
+        0,
+        mmbm::gpu::Backend::Cpu { threads: Some(1) },
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("65535x65535") && e.contains(&MAX_FIELD_PIXELS.to_string()),
+        "{e}"
+    );
+    // Python's resolution: integers checked by the library.
+    let e = Camera::size_from(-1, 5).unwrap_err().to_string();
+    assert!(e.contains("resolution") && e.contains("-1x5"), "{e}");
+    assert!(Camera::size_from(1 << 33, 5).is_err());
+    assert_eq!(Camera::size_from(640, 480).unwrap(), (640, 480));
+    // Video frames with bad values, as Python passes them.
+    let samples: Vec<_> = (0..200)
+        .map(|k| mmbm::io::gyro::GyroSample {
+            t: k as f64 * 0.005,
+            omega: glam::DVec3::new(0.1, 0.2, 0.3),
+            velocity: None,
+            depth: None,
+        })
+        .collect();
+    let opts = mmbm::series::SeriesOptions {
+        scene: Scene {
+            camera: Camera::thesis(),
+            plane: None,
+        },
+        method: Default::default(),
+        use_velocity: false,
+    };
+    let frame = |t_start: f64, exposure_s: f64, readout_s: Option<f64>| VideoFrame {
+        t_start,
+        exposure_s,
+        readout_s,
+    };
+    let good = frame(0.1, 0.02, Some(0.01));
+    let run = |f: VideoFrame| mmbm::series::frames::frame_mmbm(&samples, &opts, &[good, f]);
+    assert!(run(good).is_ok());
+    for (f, column) in [
+        (frame(0.1, -0.5, None), "exposure_s"),
+        (frame(0.1, f64::NAN, None), "exposure_s"),
+        (frame(0.1, 0.02, Some(-0.5)), "readout_s"),
+        (frame(0.1, 0.02, Some(f64::NAN)), "readout_s"),
+        (frame(f64::NAN, 0.02, None), "t_start"),
+    ] {
+        let e = run(f).unwrap_err().to_string();
+        assert!(e.contains("frame 1") && e.contains(column), "{f:?}: {e}");
+    }
+}
+
+/// Issue #23 item 4: `simulate` wrote its log from one allocation of every
+/// sample (8 GB at its cap of 1e8 samples, even into /dev/null); it streams
+/// now, so 3e6 samples (240 MB held at once before) run in 150 MB of address
+/// space.
+#[cfg(unix)]
+#[test]
+fn simulate_streams_its_log() {
+    let o = std::process::Command::new("sh")
+        .arg("-c")
+        .arg(format!(
+            "ulimit -v 150000 && exec '{}' simulate --duration 30 --rate 100000 --out /dev/null",
+            env!("CARGO_BIN_EXE_mmbm")
+        ))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        o.status.success() && err.contains("3000000 samples"),
+        "{err}"
+    );
+}
+
+/// Issue #23 item 3: every line reader holds a line of `MAX_LINE_BYTES` (not
+/// counting its `\n`) and refuses one byte more, naming the file and line;
+/// an image whose header claims more than `MAX_IMAGE_PIXELS` is refused
+/// before decoding.
+#[test]
+fn line_and_image_caps_at_their_boundary() {
+    use mmbm::io::input::{MAX_IMAGE_PIXELS, MAX_LINE_BYTES};
+    let d = tempfile::tempdir().unwrap();
+    // A line of exactly `len` bytes: a number field padded with zeros.
+    let line = |prefix: &str, len: usize| {
+        let mut s = prefix.to_string();
+        s.push('1');
+        s.push_str(&"0".repeat(len - prefix.len() - 1));
+        s
+    };
+    let cases = [
+        ("a.csv", "t,wx,wy,wz\n", "0,1,2,", "\n1,1,2,3\n", 2),
+        (
+            "a.gcsv",
+            "GYROFLOW IMU LOG\ntscale,1\ngscale,1\nt,gx,gy,gz\n",
+            "0,1,2,",
+            "\n1,1,2,3\n",
+            5,
+        ),
+        (
+            "h.gcsv",
+            "GYROFLOW IMU LOG\n",
+            "note,",
+            "\ntscale,1\ngscale,1\nt,gx,gy,gz\n0,1,2,3\n1,1,2,3\n",
+            2,
+        ),
+    ];
+    for (name, head, prefix, tail, no) in cases {
+        for (len, over) in [(MAX_LINE_BYTES, false), (MAX_LINE_BYTES + 1, true)] {
+            let text = format!("{head}{}{tail}", line(prefix, len));
+            let p = write(d.path(), name, text.as_bytes());
+            let r = read_log(&p, GyroOptions::default()).map(|_| ());
+            let e = r.err().map(|e| e.to_string()).unwrap_or_default();
+            let refused = e.contains("longer than");
+            assert_eq!(refused, over, "{name}, a line of {len} bytes: {e}");
+            if over {
+                assert!(e.contains(&format!("{name}:{no}")), "{e}");
+            }
+        }
+    }
+    // The frame table.
+    for (len, over) in [(MAX_LINE_BYTES, false), (MAX_LINE_BYTES + 1, true)] {
+        let text = format!("t_start,exposure_s\n{}\n", line("0,", len));
+        let p = write(d.path(), "frames.csv", text.as_bytes());
+        let e = mmbm::io::frames::read_frames(&p)
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default();
+        assert_eq!(e.contains("longer than"), over, "{e}");
+    }
+    // Images: read, and listed as a dataset texture.
+    let side = (MAX_IMAGE_PIXELS as f64).sqrt() as u32;
+    for (w, h, over) in [
+        (side, side, false),
+        (side, side + 1, true),
+        (4 * side, 4 * side, true),
+    ] {
+        let p = write(d.path(), "big.png", &common::png_header(w, h));
+        let e = mmbm::io::images::read_rgb8(&p).unwrap_err().to_string();
+        assert_eq!(e.contains("the header declares"), over, "{w}x{h}: {e}");
+        assert!(e.contains("big.png"), "{e}");
+    }
+}

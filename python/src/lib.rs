@@ -20,8 +20,10 @@ use pyo3::types::PyDict;
 use std::path::PathBuf;
 
 /// The camera as the Python half passes it: the pinhole intrinsics and the
-/// real-camera parts of SPEC 9 as a JSON object ([`Extras`]).
-type CamTuple = (f64, f64, f64, u32, u32, f64, f64, f64, String);
+/// real-camera parts of SPEC 9 as a JSON object ([`Extras`]). The sides are
+/// taken as `i64` and checked by the library ([`Camera::size_from`]), so a
+/// negative one is a `ValueError` that names the resolution.
+type CamTuple = (f64, f64, f64, i64, i64, f64, f64, f64, String);
 
 /// The camera file's real-camera keys (rolling shutter, distortion, noise, lens).
 #[derive(serde::Serialize, serde::Deserialize, Default)]
@@ -43,6 +45,7 @@ fn err(e: mmbm::Error) -> PyErr {
 
 fn camera(c: CamTuple) -> PyResult<Camera> {
     let (focal_mm, pitch_x_mm, pitch_y_mm, width, height, cx, cy, skew, extras) = c;
+    let (width, height) = Camera::size_from(width, height).map_err(err)?;
     let x: Extras = if extras.is_empty() {
         Extras::default()
     } else {
@@ -74,8 +77,8 @@ fn cam_tuple(c: &Camera) -> CamTuple {
         c.focal_mm,
         c.pitch_x_mm,
         c.pitch_y_mm,
-        c.width,
-        c.height,
+        c.width as i64,
+        c.height as i64,
         c.cx,
         c.cy,
         c.skew,

@@ -207,6 +207,11 @@ def test_frames_equal_cli(tmp_path):
         assert got["start_mmbm_mm_s"][k] == float(o["start_mmbm_mm_s"])
 
 
+# A 1 s log at 200 Hz for the frame cases.
+T = np.arange(200) * 0.005
+W = np.tile([0.1, 0.2, 0.3], (200, 1))
+
+
 @pytest.mark.parametrize(
     "call, exc, words",
     [
@@ -225,6 +230,15 @@ def test_frames_equal_cli(tmp_path):
         (lambda: mmbm.render(omega=[0, 0, 0], target="image:/nonexistent.png:1"), OSError, "nonexistent"),
         (lambda: mmbm.simulate("moonwalk"), ValueError, "moonwalk"),
         (lambda: mmbm.read_exr("/nonexistent.exr"), OSError, "nonexistent"),
+        # Issue 23 items 3 and 4: the library's checks, through Python.
+        (lambda: mmbm.read_gyro("/dev/zero"), OSError, "character device"),
+        (lambda: mmbm.flow_field([0.1, 0, 0], camera=mmbm.Camera(width=65535, height=65535)), ValueError, "67108864"),
+        (lambda: mmbm.render(omega=[0.1, 0, 0], resolution=(-1, 5)), ValueError, "resolution"),
+        (lambda: mmbm.frames(T, W, [0.1], [-0.5]), ValueError, "exposure_s"),
+        (lambda: mmbm.frames(T, W, [0.1], [float("nan")]), ValueError, "exposure_s"),
+        (lambda: mmbm.frames(T, W, [0.1], [0.02], [-0.5]), ValueError, "readout_s"),
+        (lambda: mmbm.frames(T, W, [0.1], [0.02], [float("nan")]), ValueError, "readout_s"),
+        (lambda: mmbm.frames(T, W, [float("nan")], [0.02]), ValueError, "t_start"),
     ],
 )
 def test_bad_inputs_raise(call, exc, words):

@@ -72,13 +72,7 @@ pub fn to_grey(img: &DynamicImage) -> GrayImage {
 /// Reads a PNG/JPEG (format guessed from the content) as a grey image,
 /// naming the file in errors.
 pub fn load_grey(path: &Path) -> Result<GrayImage> {
-    let r = image::ImageReader::open(path).map_err(|e| Error::io(path, e))?;
-    let r = r.with_guessed_format().map_err(|e| Error::io(path, e))?;
-    let img = r.decode().map_err(|e| Error::Image {
-        path: path.into(),
-        message: e.to_string(),
-    })?;
-    Ok(to_grey(&img))
+    Ok(to_grey(&crate::io::images::decode(path)?))
 }
 
 /// The metrics of one image.

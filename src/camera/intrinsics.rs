@@ -144,6 +144,22 @@ impl Camera {
         }
     }
 
+    /// A sensor size from integers as another door gives them (Python): each
+    /// side must fit the camera's `u32` (a zero side is then refused by
+    /// [`Camera::validate`]).
+    pub fn size_from(width: i64, height: i64) -> Result<(u32, u32)> {
+        match (u32::try_from(width), u32::try_from(height)) {
+            (Ok(w), Ok(h)) => Ok((w, h)),
+            _ => Err(Error::invalid(
+                "resolution",
+                format!(
+                    "{width}x{height}: width and height must be whole numbers of pixels from 1 to {}",
+                    u32::MAX
+                ),
+            )),
+        }
+    }
+
     /// Rejects zero/negative/NaN focal length or pitch, lengths outside
     /// [`LENGTH_RANGE_MM`] (their squares and ratios, the sensor's area and
     /// the focal length in pixels, must stay far from the float range), an

@@ -73,7 +73,7 @@ struct Expected {
 }
 
 fn read_expected(path: &Path) -> Result<(Vec<(f64, f64)>, f64)> {
-    let s = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+    let s = mmbm::io::input::read_text(path)?;
     let e: Expected = serde_json::from_str(&s).map_err(|e| Error::Config {
         path: path.into(),
         message: e.to_string(),

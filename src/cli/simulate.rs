@@ -51,12 +51,12 @@ pub fn run(a: SimulateArgs) -> Result<()> {
         print!("{}", cfg.to_toml()?);
         return Ok(());
     }
-    let samples = sim::simulate(&cfg, a.duration, a.rate, a.seed)?;
+    // Streamed: constant memory up to the cap (1e8 samples).
+    let samples = sim::samples(&cfg, a.duration, a.rate, a.seed)?;
     if let Some(out) = &a.out {
-        sim::write_log(out, &samples)?;
+        let n = sim::write_samples(out, samples)?;
         eprintln!(
-            "{} samples ({} s at {} Hz, gait {gait}, seed {}) -> {}",
-            samples.len(),
+            "{n} samples ({} s at {} Hz, gait {gait}, seed {}) -> {}",
             a.duration,
             a.rate,
             a.seed,

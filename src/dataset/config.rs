@@ -63,7 +63,7 @@ impl DatasetConfig {
     /// Loads a TOML file; missing keys take the defaults. Errors name the
     /// file and the key.
     pub fn load(path: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+        let text = crate::io::input::read_text(path)?;
         let cfg: DatasetConfig = toml::from_str(&text).map_err(|e| {
             Error::invalid(
                 path.display().to_string(),

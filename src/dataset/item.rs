@@ -7,6 +7,7 @@ use crate::error::{Error, Result};
 use crate::field::flow_field;
 use crate::io::gyro::{read_log, GyroOptions, GyroSample};
 use crate::io::images::write_exr;
+use crate::io::input::{image_dimensions, is_regular_file};
 use crate::metric::{mmbm, Method, Scene};
 use crate::model::log::ImuLog;
 use crate::model::motion::{Plane, Twist};
@@ -82,8 +83,10 @@ impl Sources {
             let file_name = e.file_name();
             let lossy = file_name.to_string_lossy();
             let ext = lossy.rsplit('.').next().unwrap_or("").to_ascii_lowercase();
-            if ["png", "jpg", "jpeg"].contains(&ext.as_str()) {
-                let p = dir.join(&file_name);
+            let p = dir.join(&file_name);
+            // Only regular files are textures (a pipe named f.png would
+            // block the read; a folder or a device is not an image).
+            if ["png", "jpg", "jpeg"].contains(&ext.as_str()) && is_regular_file(&p) {
                 // Items and manifests name their texture as text: a name
                 // that is not UTF-8 is refused as it is (not read as another).
                 let name = file_name.to_str().map(str::to_string).ok_or_else(|| {
@@ -96,9 +99,12 @@ impl Sources {
                         ),
                     )
                 })?;
-                image::image_dimensions(&p).map_err(|e| Error::Image {
-                    path: p.clone(),
-                    message: format!("not a readable image: {e}"),
+                image_dimensions(&p).map_err(|e| match e {
+                    Error::Image { path, message } => Error::Image {
+                        path,
+                        message: format!("not a readable image: {message}"),
+                    },
+                    e => e,
                 })?;
                 textures.push(name);
             }

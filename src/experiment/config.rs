@@ -171,7 +171,7 @@ impl ExperimentConfig {
 
     /// Loads a TOML file; missing fields take the defaults.
     pub fn load(path: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+        let text = crate::io::input::read_text(path)?;
         let cfg: Self = toml::from_str(&text).map_err(|e| Error::Config {
             path: path.into(),
             message: e.to_string(),

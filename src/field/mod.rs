@@ -63,10 +63,14 @@ fn to_mmbm(scene: &Scene, mean_mm_s: f64, grid: &Grid) -> Result<Mmbm> {
 
 static ANNOUNCED: AtomicBool = AtomicBool::new(false);
 
+/// Most cells of a flow field [`flow_field`] returns (8192 x 8192; about 12
+/// bytes each: u, v and the speed), for every door (CLI, dataset, Python).
+pub const MAX_FIELD_PIXELS: u64 = 1 << 26;
+
 /// The flow field (px/s) of `tw` on a `w x h` grid of cell centres (`0 x 0`:
 /// every pixel centre of the sensor) and its mean speed, on `backend` (the
 /// GPU kernel `flow_tiles` or its CPU twin). Validates the scene (a plane is
-/// needed when `tw` translates).
+/// needed when `tw` translates) and the size (at most [`MAX_FIELD_PIXELS`]).
 pub fn flow_field(
     scene: &Scene,
     tw: &Twist,
@@ -76,6 +80,15 @@ pub fn flow_field(
 ) -> Result<FlowField> {
     scene.validate_for(tw)?;
     let grid = Grid::new(&scene.camera, w, h)?;
+    if grid.len() as u64 > MAX_FIELD_PIXELS {
+        return Err(Error::invalid(
+            "flow field",
+            format!(
+                "{}x{} cells: a flow field has at most {MAX_FIELD_PIXELS} (use a smaller sensor or grid)",
+                grid.width, grid.height
+            ),
+        ));
+    }
     let g = TwistGpu::new(scene.camera.focal_mm, tw, scene.plane.as_ref());
     let (mean, field) = match backend.resolve("flow field", "twin", &ANNOUNCED)? {
         Resolved::Gpu(_) => {

@@ -17,9 +17,31 @@ pub struct VideoFrame {
     pub readout_s: Option<f64>,
 }
 
+impl VideoFrame {
+    /// Checks the values (every door: a table, Python): `t_start` finite,
+    /// `exposure_s` finite and > 0, `readout_s` finite and >= 0. An error is
+    /// `(column, message)`.
+    pub fn check(&self) -> std::result::Result<(), (&'static str, String)> {
+        if !self.t_start.is_finite() {
+            return Err(("t_start", format!("must be finite, got {}", self.t_start)));
+        }
+        if !(self.exposure_s.is_finite() && self.exposure_s > 0.0) {
+            return Err((
+                "exposure_s",
+                format!("must be > 0 s, got {}", self.exposure_s),
+            ));
+        }
+        if self.readout_s.is_some_and(|r| !(r.is_finite() && r >= 0.0)) {
+            return Err(("readout_s", "must be >= 0 s".into()));
+        }
+        Ok(())
+    }
+}
+
 /// Reads a frame table.
 pub fn read_frames(path: &Path) -> Result<Vec<VideoFrame>> {
-    let file = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
+    use super::input::{open_stream, LineCap, MAX_LINE_BYTES};
+    let file = LineCap::new(open_stream(path)?, path, MAX_LINE_BYTES);
     let mut rd = csv::ReaderBuilder::new()
         .comment(Some(b'#'))
         .trim(csv::Trim::All)
@@ -73,16 +95,9 @@ pub fn read_frames(path: &Path) -> Result<Vec<VideoFrame>> {
             exposure_s: field(ie, "exposure_s")?,
             readout_s: ir.map(|i| field(i, "readout_s")).transpose()?,
         };
-        if frame.exposure_s <= 0.0 {
-            return Err(parse_err(
-                line,
-                "exposure_s",
-                format!("must be > 0 s, got {}", frame.exposure_s),
-            ));
-        }
-        if frame.readout_s.is_some_and(|r| r < 0.0) {
-            return Err(parse_err(line, "readout_s", "must be >= 0 s".into()));
-        }
+        frame
+            .check()
+            .map_err(|(column, message)| parse_err(line, column, message))?;
         out.push(frame);
     }
     Ok(out)

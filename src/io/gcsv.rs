@@ -37,6 +37,7 @@
 //! CSV are line numbers in the `.gcsv` file; a bad row is reported by the
 //! stream itself, naming the file, its line and the `.gcsv` column.
 
+use super::input::{line_too_long, open_stream, read_line, Line, MAX_HEADER_BYTES, MAX_LINE_BYTES};
 use crate::error::{quote, Error, Result};
 use glam::{DMat3, DVec3};
 use std::fs::File;
@@ -181,6 +182,10 @@ pub fn is_gcsv(path: &Path) -> bool {
     {
         return true;
     }
+    // Only a regular file is sniffed (reading a pipe would consume it).
+    if !super::input::is_regular_file(path) {
+        return false;
+    }
     let mut head = Vec::with_capacity(64);
     let read = File::open(path).and_then(|f| f.take(64).read_to_end(&mut head));
     if read.is_err() {
@@ -198,12 +203,13 @@ struct Columns {
     g: [usize; 3],
 }
 
-/// Reads one line (without its `\n` / `\r\n`) into `buf`; false at end of file.
-fn next_line<R: BufRead>(src: &mut R, buf: &mut Vec<u8>, path: &Path) -> Result<bool> {
-    buf.clear();
-    let n = src.read_until(b'\n', buf).map_err(|e| Error::io(path, e))?;
-    if n == 0 {
-        return Ok(false);
+/// Reads line number `line` (without its `\n` / `\r\n`) into `buf`; false
+/// at end of file. A line over [`MAX_LINE_BYTES`] is an error.
+fn next_line<R: BufRead>(src: &mut R, buf: &mut Vec<u8>, path: &Path, line: u64) -> Result<bool> {
+    match read_line(src, buf, MAX_LINE_BYTES).map_err(|e| Error::io(path, e))? {
+        Line::Eof => return Ok(false),
+        Line::TooLong => return Err(line_too_long(path, line, MAX_LINE_BYTES)),
+        Line::Read => {}
     }
     if buf.last() == Some(&b'\n') {
         buf.pop();
@@ -232,7 +238,7 @@ fn utf8<'a>(bytes: &'a [u8], path: &Path, line: u64) -> Result<&'a str> {
 /// the columns and the number of lines read (the column line's number).
 fn read_head<R: BufRead>(src: &mut R, path: &Path) -> Result<(GcsvHeader, Columns, u64)> {
     let mut buf = Vec::new();
-    if !next_line(src, &mut buf, path)? || !is_magic(&buf) {
+    if !next_line(src, &mut buf, path, 1)? || !is_magic(&buf) {
         return Err(parse_err(
             path,
             1,
@@ -246,8 +252,17 @@ fn read_head<R: BufRead>(src: &mut R, path: &Path) -> Result<(GcsvHeader, Column
     let mut line = 1u64;
     // (key, value, line)
     let mut fields: Vec<(String, String, u64)> = Vec::new();
+    let mut head_bytes = buf.len();
     let columns = loop {
-        if !next_line(src, &mut buf, path)? {
+        if head_bytes > MAX_HEADER_BYTES {
+            return Err(parse_err(
+                path,
+                line,
+                "-",
+                format!("the header (before the column line) is longer than {MAX_HEADER_BYTES} bytes, the most read"),
+            ));
+        }
+        if !next_line(src, &mut buf, path, line + 1)? {
             return Err(parse_err(
                 path,
                 line,
@@ -256,6 +271,7 @@ fn read_head<R: BufRead>(src: &mut R, path: &Path) -> Result<(GcsvHeader, Column
             ));
         }
         line += 1;
+        head_bytes += buf.len() + 1;
         let text = utf8(&buf, path, line)?.trim();
         if text.is_empty() || text.starts_with('#') {
             continue;
@@ -396,7 +412,7 @@ fn read_head<R: BufRead>(src: &mut R, path: &Path) -> Result<(GcsvHeader, Column
 
 /// Reads the header of the `.gcsv` file at `path` (up to its column line).
 pub fn read_header(path: &Path) -> Result<GcsvHeader> {
-    let mut src = BufReader::new(File::open(path).map_err(|e| Error::io(path, e))?);
+    let mut src = BufReader::new(open_stream(path)?);
     read_head(&mut src, path).map(|(h, _, _)| h)
 }
 
@@ -425,8 +441,7 @@ pub struct CsvStream {
 impl CsvStream {
     /// Opens `path` and reads its header (errors name the file, line and key).
     pub fn open(path: &Path) -> Result<Self> {
-        let mut src =
-            BufReader::with_capacity(1 << 16, File::open(path).map_err(|e| Error::io(path, e))?);
+        let mut src = BufReader::with_capacity(1 << 16, open_stream(path)?);
         let (header, cols, line) = read_head(&mut src, path)?;
         let axes = camera_axes(
             &parse_orientation(&header.orientation)
@@ -457,7 +472,7 @@ impl CsvStream {
 
     /// Converts the next line into `out`.
     fn convert_line(&mut self) -> Result<bool> {
-        if !next_line(&mut self.src, &mut self.buf, &self.path)? {
+        if !next_line(&mut self.src, &mut self.buf, &self.path, self.line + 1)? {
             return Ok(false);
         }
         self.line += 1;
@@ -596,69 +611,4 @@ pub fn to_csv(path: &Path) -> Result<String> {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn orientations() {
-        let g = DVec3::new(1.0, 2.0, 3.0);
-        assert_eq!(orientation_matrix("XYZ").unwrap(), DMat3::IDENTITY);
-        assert_eq!(
-            orientation_matrix("YxZ").unwrap() * g,
-            DVec3::new(2.0, -1.0, 3.0)
-        );
-        assert_eq!(
-            orientation_matrix("zXy").unwrap() * g,
-            DVec3::new(-3.0, 1.0, -2.0)
-        );
-        assert_eq!(
-            camera_matrix("XYZ").unwrap() * g,
-            DVec3::new(-2.0, -1.0, -3.0)
-        );
-        assert_eq!(
-            camera_matrix("YxZ").unwrap() * g,
-            DVec3::new(1.0, -2.0, -3.0)
-        );
-        for o in ["XXZ", "xyzw", "XY", "", "XYA", "xYx", "ÄYZ"] {
-            let e = orientation_matrix(o).unwrap_err().to_string();
-            assert!(e.contains("orientation"), "{o}: {e}");
-        }
-        // Every valid orientation: the signed-axis map is the matrix.
-        for p in ["XYZ", "XZY", "YXZ", "YZX", "ZXY", "ZYX"] {
-            for signs in 0..8u8 {
-                let o: String = p
-                    .chars()
-                    .enumerate()
-                    .map(|(i, c)| {
-                        if signs >> i & 1 == 1 {
-                            c.to_ascii_lowercase()
-                        } else {
-                            c
-                        }
-                    })
-                    .collect();
-                let axes = camera_axes(&parse_orientation(&o).unwrap());
-                let m = camera_matrix(&o).unwrap();
-                assert_eq!(axes_matrix(&axes), m, "{o}");
-                assert!(
-                    (m.determinant().abs() - 1.0).abs() < 1e-15,
-                    "{o}: a signed permutation"
-                );
-            }
-        }
-        assert_eq!(GYROFLOW_TO_CAMERA.determinant(), 1.0);
-    }
-
-    #[test]
-    fn magic_lines() {
-        assert!(is_magic(b"GYROFLOW IMU LOG"));
-        assert!(is_magic(b"\xEF\xBB\xBFCAMERA IMU LOG \r"));
-        assert!(!is_magic(b"GYROFLOW IMU LOGS"));
-        assert!(!is_magic(b"t,wx,wy,wz"));
-        assert!(ReadoutDirection::from_gyroflow("4").is_none());
-        assert_eq!(
-            ReadoutDirection::from_gyroflow("90"),
-            Some(ReadoutDirection::RightToLeft)
-        );
-    }
-}
+mod tests;

@@ -12,7 +12,6 @@ pub use crate::model::log::GyroSample;
 use crate::model::log::{is_gap, ImuLog, LogReadout};
 use glam::{DMat3, DVec3};
 use serde::{Deserialize, Serialize};
-use std::fs::File;
 use std::io::{BufReader, Read};
 use std::path::{Path, PathBuf};
 use std::str::FromStr;
@@ -189,8 +188,11 @@ impl GyroReader {
     /// checks the header.
     pub fn open(path: &Path, opts: GyroOptions) -> Result<Self> {
         let mut readout = None;
+        use super::input::{open_stream, LineCap, MAX_LINE_BYTES};
         let (file, path): (Box<dyn Read + Send>, &Path) = if path.as_os_str() == "-" {
-            (Box::new(std::io::stdin()), Path::new("<stdin>"))
+            let name = Path::new("<stdin>");
+            let stdin = LineCap::new(std::io::stdin(), name, MAX_LINE_BYTES);
+            (Box::new(stdin), name)
         } else if super::mcap::is_mcap(path) {
             if opts.time_unit != TimeUnit::S || opts.angle_unit != AngleUnit::Rad {
                 return Err(Error::invalid(
@@ -221,10 +223,8 @@ impl GyroReader {
             });
             (Box::new(stream), path)
         } else {
-            (
-                Box::new(File::open(path).map_err(|e| Error::io(path, e))?),
-                path,
-            )
+            let file = LineCap::new(open_stream(path)?, path, MAX_LINE_BYTES);
+            (Box::new(file), path)
         };
         let mut reader = csv::ReaderBuilder::new()
             .comment(Some(b'#'))

@@ -53,8 +53,9 @@ pub type ExrChannels = Vec<(String, Vec<f32>)>;
 /// Reads every f32 (or f16, converted) channel of the first layer of an EXR:
 /// `(width, height, [(name, values)])`.
 pub fn read_exr(path: &Path) -> Result<(usize, usize, ExrChannels)> {
-    // A missing or unreadable file is an I/O error (as for every input).
-    std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
+    // A missing or unreadable file is an I/O error (as for every input), and
+    // only a regular file is read (never a device or a pipe).
+    super::input::open_file(path)?;
     // The header first: a file that claims more samples than any mmbm output
     // has is refused before anything is allocated for it.
     let meta = exr::meta::MetaData::read_from_file(path, false).map_err(|e| Error::Image {
@@ -149,16 +150,29 @@ pub fn write_png_linear_rgb(path: &Path, width: u32, height: u32, rgb: &[f32]) -
     save_rgb8(path, &img)
 }
 
-/// Reads any PNG/JPEG as RGB8, naming the file in errors.
+/// Decodes any PNG/JPEG (format guessed from the content), naming the
+/// file in errors: a regular file whose header declares at most
+/// [`super::input::MAX_IMAGE_PIXELS`] (checked before decoding).
+pub fn decode(path: &Path) -> Result<image::DynamicImage> {
+    let (w, h) = super::input::image_dimensions(path)?;
+    let file = super::input::open_file(path)?;
+    let mut r = image::ImageReader::new(std::io::BufReader::new(file))
+        .with_guessed_format()
+        .map_err(|e| Error::io(path, e))?;
+    // The decoder holds to the size its header declared (and was checked).
+    let mut limits = image::Limits::default();
+    limits.max_image_width = Some(w);
+    limits.max_image_height = Some(h);
+    r.limits(limits);
+    r.decode().map_err(|e| Error::Image {
+        path: path.into(),
+        message: e.to_string(),
+    })
+}
+
+/// Reads any PNG/JPEG as RGB8 ([`decode`]).
 pub fn read_rgb8(path: &Path) -> Result<image::RgbImage> {
-    let r = image::ImageReader::open(path).map_err(|e| Error::io(path, e))?;
-    let r = r.with_guessed_format().map_err(|e| Error::io(path, e))?;
-    Ok(r.decode()
-        .map_err(|e| Error::Image {
-            path: path.into(),
-            message: e.to_string(),
-        })?
-        .to_rgb8())
+    Ok(decode(path)?.to_rgb8())
 }
 
 /// Linear RGB (interleaved) to an 8-bit sRGB image.

@@ -43,6 +43,10 @@ pub fn is_mcap(path: &Path) -> bool {
     {
         return true;
     }
+    // Only a regular file is sniffed (reading a pipe would consume it).
+    if !super::input::is_regular_file(path) {
+        return false;
+    }
     let mut head = [0u8; 8];
     std::fs::File::open(path)
         .and_then(|mut f| std::io::Read::read_exact(&mut f, &mut head))
@@ -52,7 +56,10 @@ pub fn is_mcap(path: &Path) -> bool {
 /// Reads the IMU messages of `topic` (None: the only IMU topic) from the
 /// MCAP file at `path`, in file order.
 pub fn read_imu(path: &Path, topic: Option<&str>) -> Result<Vec<ImuMessage>> {
-    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    // A whole-file read: a regular file only (never a device or a pipe).
+    let mut bytes = Vec::new();
+    std::io::Read::read_to_end(&mut super::input::open_file(path)?, &mut bytes)
+        .map_err(|e| Error::io(path, e))?;
     let bad = |what: String| Error::invalid(path.display().to_string(), what);
     // Which topics carry IMU messages (read from the messages themselves:
     // the summary section is optional).

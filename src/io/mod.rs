@@ -2,12 +2,15 @@
 //! files ([`images`]: EXR, sRGB PNG, textures) and gyro log readers
 //! ([`gyro`]: CSV, ROS 2 MCAP through [`mcap`] and Gyroflow `.gcsv` through
 //! [`gcsv`]; [`lines`]: one line at a time, for live streams); video frame
-//! tables ([`frames`]). This layer imports nothing above `error`.
+//! tables ([`frames`]); [`input`]: the kind and size checks every reader
+//! shares (regular files and pipes only, capped lines, headers and image
+//! sizes). This layer imports nothing above `error`.
 
 pub mod atomic;
 pub mod frames;
 pub mod gcsv;
 pub mod gyro;
 pub mod images;
+pub mod input;
 pub mod lines;
 pub mod mcap;

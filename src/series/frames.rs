@@ -87,6 +87,7 @@ fn line_groups(cam: &Camera, method: Method) -> Result<Vec<(f64, GridRule)>> {
 /// A frame's readout is its own (`readout_s` of the table) or else the
 /// camera's. Frames whose window `[t_start, t_start + t_r + t_e]` is not
 /// inside the log get `None` values; their indices are returned as well.
+/// Every frame is checked first ([`VideoFrame::check`]).
 pub fn frame_mmbm(
     samples: &[GyroSample],
     opts: &SeriesOptions,
@@ -107,6 +108,8 @@ pub fn frame_mmbm(
     let mut out = Vec::with_capacity(frames.len());
     let mut outside = Vec::new();
     for (k, f) in frames.iter().enumerate() {
+        f.check()
+            .map_err(|(column, message)| Error::invalid(format!("frame {k}: {column}"), message))?;
         let readout = f.readout_s.unwrap_or(cam.shutter.readout_s);
         if readout > 0.0 && groups.is_none() {
             return Err(Error::invalid(

@@ -14,7 +14,7 @@ use std::path::Path;
 pub const LOG_HEADER: &str = "t,wx,wy,wz,vx,vy,vz";
 
 /// Most samples one call may produce (about 46 hours at 600 Hz).
-const MAX_SAMPLES: f64 = 1e8;
+pub const MAX_SAMPLES: f64 = 1e8;
 
 /// One step (stance of one tripod).
 #[derive(Debug, Clone, Copy)]
@@ -109,13 +109,23 @@ impl Transient {
 /// with random seed `seed`. Sample `i` is at `t = i / rate_hz` s, for
 /// `i < round(duration_s * rate_hz)`. Every sample carries the linear velocity
 /// (m/s) and no depth. Deterministic per (config, rate, seed); a longer
-/// duration extends a shorter one sample for sample.
+/// duration extends a shorter one sample for sample. ([`samples`] yields the
+/// same samples one at a time, in constant memory.)
 pub fn simulate(
     cfg: &GaitConfig,
     duration_s: f64,
     rate_hz: f64,
     seed: u64,
 ) -> Result<Vec<GyroSample>> {
+    let it = samples(cfg, duration_s, rate_hz, seed)?;
+    let mut out = Vec::with_capacity(it.len());
+    out.extend(it);
+    Ok(out)
+}
+
+/// The samples of [`simulate`], generated one at a time (constant memory);
+/// the same checks (at most [`MAX_SAMPLES`]).
+pub fn samples(cfg: &GaitConfig, duration_s: f64, rate_hz: f64, seed: u64) -> Result<Samples> {
     cfg.validate()?;
     crate::error::positive("duration", duration_s)?;
     crate::error::positive("rate", rate_hz)?;
@@ -132,19 +142,49 @@ pub fn simulate(
             format!("{duration_s} s at {rate_hz} Hz is more than {MAX_SAMPLES:e} samples"),
         ));
     }
-    let n = n_f as usize;
-    let mut steps = Steps::new(cfg, seed);
-    let mut noise_rng = StdRng::seed_from_u64(seed ^ 0x9E37_79B9_7F4A_7C15);
     let noise =
         Normal::new(0.0, cfg.noise_std).map_err(|e| Error::invalid("noise_std", e.to_string()))?;
-    let tr = Transient::new(cfg.touchdown_decay_s, cfg.touchdown_freq_hz);
-    let sign = |j: usize, side: f64| if cfg.alternate[j] { side } else { 1.0 };
-    let bias = DVec3::from_array(cfg.bias);
-    let mut out = Vec::with_capacity(n);
-    let mut k = 0;
-    for i in 0..n {
-        let t = i as f64 / rate_hz;
-        k = steps.locate(t, k);
+    Ok(Samples {
+        steps: Steps::new(cfg, seed),
+        noise_rng: StdRng::seed_from_u64(seed ^ 0x9E37_79B9_7F4A_7C15),
+        noise,
+        tr: Transient::new(cfg.touchdown_decay_s, cfg.touchdown_freq_hz),
+        cfg: cfg.clone(),
+        rate_hz,
+        n: n_f as usize,
+        i: 0,
+        k: 0,
+    })
+}
+
+/// The iterator of [`samples`].
+pub struct Samples {
+    cfg: GaitConfig,
+    steps: Steps,
+    noise_rng: StdRng,
+    noise: Normal<f64>,
+    tr: Transient,
+    rate_hz: f64,
+    n: usize,
+    i: usize,
+    k: usize,
+}
+
+impl Iterator for Samples {
+    type Item = GyroSample;
+
+    fn next(&mut self) -> Option<GyroSample> {
+        if self.i >= self.n {
+            return None;
+        }
+        let (cfg, tr) = (&self.cfg, &self.tr);
+        let sign = |j: usize, side: f64| if cfg.alternate[j] { side } else { 1.0 };
+        let bias = DVec3::from_array(cfg.bias);
+        let t = self.i as f64 / self.rate_hz;
+        self.i += 1;
+        let steps = &mut self.steps;
+        self.k = steps.locate(t, self.k);
+        let k = self.k;
         let s = steps.steps[k];
         let period = steps.steps[k + 1].start - s.start;
         let p = (t - s.start) / period;
@@ -166,23 +206,29 @@ pub fn simulate(
         let mut omega = DVec3::from_array(w) + bias;
         if cfg.noise_std > 0.0 {
             omega += DVec3::new(
-                noise.sample(&mut noise_rng),
-                noise.sample(&mut noise_rng),
-                noise.sample(&mut noise_rng),
+                self.noise.sample(&mut self.noise_rng),
+                self.noise.sample(&mut self.noise_rng),
+                self.noise.sample(&mut self.noise_rng),
             );
         }
         let ph = TAU * p;
         let vz = cfg.speed_m_s * (1.0 + cfg.surge * ph.cos());
         let vy = -cfg.bob_m * TAU / period * ph.sin();
-        out.push(GyroSample {
+        Some(GyroSample {
             t,
             omega,
             velocity: Some(DVec3::new(0.0, vy, vz)),
             depth: None,
-        });
+        })
     }
-    Ok(out)
+
+    fn size_hint(&self) -> (usize, Option<usize>) {
+        let left = self.n - self.i;
+        (left, Some(left))
+    }
 }
+
+impl ExactSizeIterator for Samples {}
 
 /// Writes samples as a gyro CSV (SPEC section 5) atomically: header
 /// `t,wx,wy,wz` plus `,vx,vy,vz` when every sample has a velocity and
@@ -204,6 +250,24 @@ pub fn write_log(path: &Path, samples: &[GyroSample]) -> Result<()> {
             "some samples have a depth and some do not",
         ));
     }
+    write_rows(path, with_v, with_d, samples.iter().copied())
+}
+
+/// Writes the samples of [`samples`] as [`write_log`] writes them, one at a
+/// time (constant memory, whatever the duration). Returns how many.
+pub fn write_samples(path: &Path, samples: Samples) -> Result<u64> {
+    let n = samples.len() as u64;
+    write_rows(path, true, false, samples)?;
+    Ok(n)
+}
+
+/// The CSV of [`write_log`]: the header, then one line per sample.
+fn write_rows(
+    path: &Path,
+    with_v: bool,
+    with_d: bool,
+    samples: impl Iterator<Item = GyroSample>,
+) -> Result<()> {
     crate::io::atomic::write_atomic(path, |w| {
         let e = |e: std::io::Error| Error::io(path, e);
         let mut header = String::from("t,wx,wy,wz");

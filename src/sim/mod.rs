@@ -56,7 +56,7 @@
 
 mod gen;
 
-pub use gen::{simulate, write_log, LOG_HEADER};
+pub use gen::{samples, simulate, write_log, write_samples, Samples, LOG_HEADER, MAX_SAMPLES};
 
 /// Highest step rate of a gait, steps/s (legged gaits take a few).
 pub const MAX_STEP_HZ: f64 = 100.0;
@@ -268,7 +268,7 @@ impl GaitConfig {
 
     /// Loads a TOML file over the preset `base` (see [`GaitConfig::from_toml_str`]).
     pub fn load(path: &Path, base: Gait) -> Result<Self> {
-        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+        let text = crate::io::input::read_text(path)?;
         Self::from_toml_str(&text, base, path)
     }
 

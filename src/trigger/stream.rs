@@ -26,11 +26,13 @@ use super::live::{Event, Live};
 use super::pace::{self, Pacer};
 use crate::error::{Error, Result};
 use crate::io::gyro::{GyroOptions, GyroSample};
+use crate::io::input::{line_too_long, read_line, Line, MAX_LINE_BYTES};
 use crate::io::lines::LineParser;
 use crate::metric::Evaluator;
 use crate::series::{check_values, sample_mmbm, SeriesOptions};
 use std::io::{BufRead, Write};
 use std::net::UdpSocket;
+use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
@@ -242,12 +244,20 @@ impl Stream {
             if self.control.is_stopped() {
                 return Ok(self.outcome(StreamEnd::Stopped));
             }
-            raw.clear();
-            let n = input
-                .read_until(b'\n', &mut raw)
-                .map_err(|e| Error::io(source, e))?;
-            if n == 0 {
-                return Ok(self.outcome(StreamEnd::Eof));
+            // A line over the cap is read to its end in bounded memory and
+            // is a malformed line.
+            match read_line(input, &mut raw, MAX_LINE_BYTES).map_err(|e| Error::io(source, e))? {
+                Line::Eof => return Ok(self.outcome(StreamEnd::Eof)),
+                Line::TooLong => {
+                    line_no += 1;
+                    let e = line_too_long(Path::new(source), line_no, MAX_LINE_BYTES);
+                    if self.opts.strict {
+                        return Ok(self.outcome(StreamEnd::Strict(e)));
+                    }
+                    eprintln!("{e}; line skipped");
+                    continue;
+                }
+                Line::Read => {}
             }
             let text = String::from_utf8_lossy(&raw);
             if let Some(end) = self.line(&mut parser, &text, &mut line_no, source, out)? {

@@ -1,0 +1,310 @@
+//! Bounded input, the one place where the kind and the size of what is read
+//! are checked, for every reader (gyro CSV, `.gcsv`, MCAP, frame tables,
+//! line streams, images, configuration files):
+//!
+//! - [`open_file`] opens only a regular file (a whole-file reader: MCAP,
+//!   images, EXR); [`open_stream`] also a pipe (a FIFO, a process
+//!   substitution): a character device such as `/dev/zero`, a directory or a
+//!   socket is refused before anything is read.
+//! - [`LineCap`] (a byte stream for a CSV reader) and [`read_line`] (one line
+//!   of a [`BufRead`]) refuse a line longer than [`MAX_LINE_BYTES`];
+//!   [`MAX_HEADER_BYTES`] bounds a `.gcsv` header (every line before its
+//!   column line together).
+//! - [`check_image_size`] refuses an image whose header claims more than
+//!   [`MAX_IMAGE_PIXELS`] before it is decoded; [`read_text`] reads a
+//!   configuration file of at most [`MAX_TEXT_BYTES`].
+
+use crate::error::{Error, Result};
+use std::fs::File;
+use std::io::{BufRead, Read};
+use std::path::{Path, PathBuf};
+
+/// Longest line of any text input (a log row, a header line, a live line), bytes.
+pub const MAX_LINE_BYTES: usize = 4 << 20;
+
+/// Longest `.gcsv` header (the magic line, `key,value` lines and comments
+/// before the column line, together), bytes.
+pub const MAX_HEADER_BYTES: usize = 16 << 20;
+
+/// Most pixels (width x height) an input image may declare to be decoded
+/// (16384 x 16384).
+pub const MAX_IMAGE_PIXELS: u64 = 1 << 28;
+
+/// Largest configuration file (TOML, JSON) read whole, bytes.
+pub const MAX_TEXT_BYTES: u64 = 64 << 20;
+
+fn refused(path: &Path, message: String) -> Error {
+    Error::io(
+        path,
+        std::io::Error::new(std::io::ErrorKind::InvalidInput, message),
+    )
+}
+
+/// What a file type is, in words.
+fn kind(ft: std::fs::FileType) -> &'static str {
+    use std::os::unix::fs::FileTypeExt;
+    if ft.is_dir() {
+        "a directory"
+    } else if ft.is_char_device() {
+        "a character device"
+    } else if ft.is_block_device() {
+        "a block device"
+    } else if ft.is_socket() {
+        "a socket"
+    } else if ft.is_fifo() {
+        "a pipe"
+    } else {
+        "not a regular file"
+    }
+}
+
+/// Checks the kind of what `path` names (links followed): a regular file,
+/// or a pipe when `pipe` is allowed.
+fn check_kind(path: &Path, pipe: bool) -> Result<()> {
+    use std::os::unix::fs::FileTypeExt;
+    let ft = std::fs::metadata(path)
+        .map_err(|e| Error::io(path, e))?
+        .file_type();
+    if ft.is_file() || (pipe && ft.is_fifo()) {
+        return Ok(());
+    }
+    let want = if pipe {
+        "a regular file or a pipe"
+    } else {
+        "a regular file"
+    };
+    Err(refused(path, format!("is {}: expected {want}", kind(ft))))
+}
+
+/// True when `path` names a regular file (links followed).
+pub fn is_regular_file(path: &Path) -> bool {
+    std::fs::metadata(path).is_ok_and(|m| m.is_file())
+}
+
+/// Opens a regular file for reading (anything else is refused unopened).
+pub fn open_file(path: &Path) -> Result<File> {
+    check_kind(path, false)?;
+    File::open(path).map_err(|e| Error::io(path, e))
+}
+
+/// Opens a regular file or a pipe for reading, as a stream.
+pub fn open_stream(path: &Path) -> Result<File> {
+    check_kind(path, true)?;
+    File::open(path).map_err(|e| Error::io(path, e))
+}
+
+/// Reads a whole text file (a configuration) of at most [`MAX_TEXT_BYTES`]
+/// from a regular file or a pipe.
+pub fn read_text(path: &Path) -> Result<String> {
+    let mut s = String::new();
+    open_stream(path)?
+        .take(MAX_TEXT_BYTES + 1)
+        .read_to_string(&mut s)
+        .map_err(|e| Error::io(path, e))?;
+    if s.len() as u64 > MAX_TEXT_BYTES {
+        return Err(refused(
+            path,
+            format!("longer than {MAX_TEXT_BYTES} bytes, the most read"),
+        ));
+    }
+    Ok(s)
+}
+
+/// The error for line `line` of `path` longer than `cap` bytes.
+pub fn line_too_long(path: &Path, line: u64, cap: usize) -> Error {
+    Error::Parse {
+        path: path.into(),
+        line,
+        column: "-".into(),
+        message: format!("the line is longer than {cap} bytes, the most read"),
+    }
+}
+
+/// How one line was read by [`read_line`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Line {
+    /// A line (its `\n` kept, if it had one) is in the buffer.
+    Read,
+    /// The line was longer than the cap: the buffer holds its first `cap`
+    /// bytes, the rest was read and dropped (up to its `\n`).
+    TooLong,
+    /// End of input.
+    Eof,
+}
+
+/// Reads one line into `buf` (cleared first) holding at most `cap` bytes of
+/// it (not counting its `\n`): a longer line is read to its end in bounded memory and reported as
+/// [`Line::TooLong`].
+pub fn read_line(src: &mut dyn BufRead, buf: &mut Vec<u8>, cap: usize) -> std::io::Result<Line> {
+    buf.clear();
+    let mut total = 0usize;
+    loop {
+        let chunk = match src.fill_buf() {
+            Ok(c) => c,
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
+            Err(e) => return Err(e),
+        };
+        if chunk.is_empty() {
+            return Ok(match (total, total > cap) {
+                (0, _) => Line::Eof,
+                (_, true) => Line::TooLong,
+                _ => Line::Read,
+            });
+        }
+        let (n, end) = match chunk.iter().position(|&b| b == b'\n') {
+            Some(i) => (i + 1, true),
+            None => (chunk.len(), false),
+        };
+        let room = (cap + 1).saturating_sub(buf.len()).min(n);
+        buf.extend_from_slice(&chunk[..room]);
+        // The line's length does not count its `\n` (as for [`LineCap`]).
+        total = total.saturating_add(n - usize::from(end));
+        src.consume(n);
+        if end {
+            return Ok(if total > cap {
+                buf.truncate(cap);
+                Line::TooLong
+            } else {
+                Line::Read
+            });
+        }
+        if total > cap {
+            buf.truncate(cap);
+        }
+    }
+}
+
+/// A byte stream (for a CSV reader) that ends with an error at a line
+/// longer than `cap` bytes. A line break inside a quoted CSV field does not
+/// end the line (quotes are counted, except on `#` comment lines), so a
+/// record cannot grow past the cap either. The error is an I/O error that
+/// carries an [`Error`] naming the file and the line (see
+/// [`super::gcsv::unwrap_error`]).
+pub struct LineCap<R> {
+    inner: R,
+    path: PathBuf,
+    cap: usize,
+    run: usize,
+    line: u64,
+    quoted: bool,
+    comment: bool,
+    start: bool,
+}
+
+impl<R: Read> LineCap<R> {
+    /// `inner`, named `path` in errors, with lines of at most `cap` bytes.
+    pub fn new(inner: R, path: &Path, cap: usize) -> Self {
+        LineCap {
+            inner,
+            path: path.into(),
+            cap,
+            run: 0,
+            line: 1,
+            quoted: false,
+            comment: false,
+            start: true,
+        }
+    }
+}
+
+impl<R: Read> Read for LineCap<R> {
+    fn read(&mut self, dst: &mut [u8]) -> std::io::Result<usize> {
+        let n = self.inner.read(dst)?;
+        for &b in &dst[..n] {
+            if b == b'\n' && !self.quoted {
+                self.run = 0;
+                self.line += 1;
+                self.comment = false;
+                self.start = true;
+                continue;
+            }
+            if b == b'\n' {
+                self.line += 1;
+            }
+            if self.start && b == b'#' && !self.quoted {
+                self.comment = true;
+            }
+            self.start = false;
+            if b == b'"' && !self.comment {
+                self.quoted = !self.quoted;
+            }
+            self.run += 1;
+            if self.run > self.cap {
+                return Err(std::io::Error::other(line_too_long(
+                    &self.path, self.line, self.cap,
+                )));
+            }
+        }
+        Ok(n)
+    }
+}
+
+/// Refuses an image of `width` x `height` over [`MAX_IMAGE_PIXELS`].
+pub fn check_image_size(path: &Path, width: u64, height: u64) -> Result<()> {
+    let pixels = width as u128 * height as u128;
+    if pixels > MAX_IMAGE_PIXELS as u128 {
+        return Err(Error::Image {
+            path: path.into(),
+            message: format!(
+                "the header declares {width} x {height} pixels, more than the {MAX_IMAGE_PIXELS} mmbm decodes"
+            ),
+        });
+    }
+    Ok(())
+}
+
+/// The width and height an image file's header declares (a regular file,
+/// format guessed from its content), checked against [`MAX_IMAGE_PIXELS`]
+/// without decoding it.
+pub fn image_dimensions(path: &Path) -> Result<(u32, u32)> {
+    let file = open_file(path)?;
+    let r = image::ImageReader::new(std::io::BufReader::new(file))
+        .with_guessed_format()
+        .map_err(|e| Error::io(path, e))?;
+    let (w, h) = r.into_dimensions().map_err(|e| Error::Image {
+        path: path.into(),
+        message: e.to_string(),
+    })?;
+    check_image_size(path, w as u64, h as u64)?;
+    Ok((w, h))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lines_over_the_cap() {
+        let text = b"abc\ncdefg\n\nxy";
+        let mut src: &[u8] = text;
+        let mut buf = Vec::new();
+        let mut got = Vec::new();
+        loop {
+            let r = read_line(&mut src, &mut buf, 3).unwrap();
+            if r == Line::Eof {
+                break;
+            }
+            got.push((r, String::from_utf8(buf.clone()).unwrap()));
+        }
+        assert_eq!(
+            got,
+            [
+                (Line::Read, "abc\n".to_string()),
+                (Line::TooLong, "cde".to_string()),
+                (Line::Read, "\n".to_string()),
+                (Line::Read, "xy".to_string()),
+            ]
+        );
+        let read = |s: &'static [u8]| {
+            let mut out = Vec::new();
+            LineCap::new(s, Path::new("x"), 4)
+                .read_to_end(&mut out)
+                .map(|_| out)
+        };
+        assert!(read(b"abcd\nabcd\n# \"x\nabcd").is_ok());
+        assert!(read(b"abcd\nabcde\n").is_err());
+        // A quoted field spanning lines is one record.
+        assert!(read(b"\"a\nb\nc\"\n").is_err());
+        assert!(read(b"\"a\"\nb\n").is_ok());
+    }
+}
