@@ -230,10 +230,10 @@ def frames(
     if readout_s is not None:
         rs = np.ascontiguousarray(np.broadcast_to(np.asarray(readout_s, dtype=np.float64), ts.shape))
     cam = camera or Camera()
-    e, s0 = _mmbm.frames(cam._tuple(), tt, w, np.ascontiguousarray(ts), es, rs, method)
+    e, blur, s0 = _mmbm.frames(cam._tuple(), tt, w, np.ascontiguousarray(ts), es, rs, method)
     return {
         "exposure_mmbm_mm_s": e,
-        "blur_px": e * es / cam.pitch_x_mm,
+        "blur_px": blur,
         "start_mmbm_mm_s": s0,
     }
 

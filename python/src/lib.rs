@@ -185,8 +185,9 @@ fn log_samples(t: &[f64], w: &[DVec3], v: Option<&[DVec3]>, d: Option<&[f64]>) -
 }
 
 /// Exposure MMBM (mm/s, each line over its own rolling-shutter window) and
-/// the MMBM at the start of every video frame; NaN where a frame's window
-/// leaves the log. Returns `(exposure_mm_s, start_mm_s)`.
+/// the MMBM at the start of every video frame, and the blur in px
+/// (`FrameMmbm::blur_px`); NaN where a frame's window leaves the log.
+/// Returns `(exposure_mm_s, blur_px, start_mm_s)`.
 #[pyfunction]
 #[pyo3(signature = (cam, t, omega, t_start, exposure_s, readout_s, method))]
 #[allow(clippy::too_many_arguments, clippy::type_complexity)]
@@ -202,6 +203,7 @@ fn frames<'py>(
 ) -> PyResult<(
     Bound<'py, numpy::PyArray1<f64>>,
     Bound<'py, numpy::PyArray1<f64>>,
+    Bound<'py, numpy::PyArray1<f64>>,
 )> {
     let samples = log_samples(t.as_slice()?, &rows3(&omega)?, None, None);
     let (ts, es) = (t_start.as_slice()?, exposure_s.as_slice()?);
@@ -213,9 +215,10 @@ fn frames<'py>(
             readout_s: rs.map(|r| r[k]),
         })
         .collect();
+    let cam = camera(cam)?;
     let opts = mmbm::series::SeriesOptions {
         scene: Scene {
-            camera: camera(cam)?,
+            camera: cam,
             plane: None,
         },
         method: method.parse().map_err(err)?,
@@ -228,12 +231,17 @@ fn frames<'py>(
         .iter()
         .map(|r| r.exposure_mm_s.unwrap_or(f64::NAN))
         .collect();
+    let blur: Vec<f64> = rows
+        .iter()
+        .map(|r| r.blur_px(&cam).unwrap_or(f64::NAN))
+        .collect();
     let s0: Vec<f64> = rows
         .iter()
         .map(|r| r.start_mm_s.unwrap_or(f64::NAN))
         .collect();
     Ok((
         Array1::from(e).into_pyarray(py),
+        Array1::from(blur).into_pyarray(py),
         Array1::from(s0).into_pyarray(py),
     ))
 }
