@@ -16,7 +16,7 @@
 use super::measure::FrameRecord;
 use super::walk::Walk;
 use crate::stats::percentile;
-use crate::trigger::{Family, PolicySpec};
+use crate::trigger::{Family, PolicySpec, DEFAULT_HORIZON_S};
 use rand::{Rng, SeedableRng};
 
 /// Block length, s.
@@ -305,7 +305,7 @@ pub fn headline_md(hs: &[Headline], policies: &[PolicySpec]) -> String {
                     && o.policy.family == family
                     && o.policy.threshold == h.policy.threshold
                     && o.policy.exposure.is_none()
-                    && (family != Family::Oracle || o.policy.horizon == Some(0.2))
+                    && (family != Family::Oracle || o.policy.horizon == Some(DEFAULT_HORIZON_S))
             })
         };
         if let (Some(t), Some(o)) = (find(Family::Threshold), find(Family::Oracle)) {

@@ -69,7 +69,9 @@ pub use exposure::Exposure;
 pub use latency::Latency;
 pub use live::{Event, Live};
 pub use pace::check_speed;
-pub use parse::{parse_policy, ExposureControl, Family, PolicySpec, Rate, THESIS_POLICY};
+pub use parse::{
+    parse_policy, ExposureControl, Family, PolicySpec, Rate, DEFAULT_HORIZON_S, THESIS_POLICY,
+};
 pub use phase::Phase;
 pub use policy::{Level, LogView, Observation, Policy};
 pub use predict::{Forecast, Oracle};

@@ -145,6 +145,19 @@ pub struct Rate {
     pub phase: f64,
 }
 
+/// A gate's schedule when its string gives none: 5 fps from the log's start.
+const DEFAULT_GATE_RATE: Rate = Rate {
+    fps: 5.0,
+    phase: 0.0,
+};
+/// `adaptive`'s target frame rate when its string gives none.
+const DEFAULT_ADAPTIVE_RATE: Rate = Rate {
+    fps: 2.5,
+    phase: 0.0,
+};
+/// The forecast horizon of `oracle`, `forecast` and `phase` when their string gives none, s.
+pub const DEFAULT_HORIZON_S: f64 = 0.2;
+
 /// Exposure control (`+exp:B[:TMIN]`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ExposureControl {
@@ -238,20 +251,16 @@ impl PolicySpec {
             horizon: None,
             exposure: None,
         };
-        let default_gate = Rate {
-            fps: 5.0,
-            phase: 0.0,
-        };
         match (family, args) {
             (Family::Fixed, [r]) => out.rate = Some(rate(r)?),
             (Family::Threshold, [x]) => out.threshold = Some(level(x)?),
             (Family::Adaptive, []) => {
                 out.threshold = Some(Level::Abs(0.4));
-                out.rate = Some(fps_only("2.5", "target frame rate")?);
+                out.rate = Some(DEFAULT_ADAPTIVE_RATE);
             }
             (Family::Adaptive, [x]) => {
                 out.threshold = Some(level(x)?);
-                out.rate = Some(fps_only("2.5", "target frame rate")?);
+                out.rate = Some(DEFAULT_ADAPTIVE_RATE);
             }
             (Family::Adaptive, [x, f]) => {
                 out.threshold = Some(level(x)?);
@@ -259,7 +268,7 @@ impl PolicySpec {
             }
             (Family::Oracle | Family::Forecast | Family::Phase, [x]) => {
                 out.threshold = Some(level(x)?);
-                out.horizon = Some(0.2);
+                out.horizon = Some(DEFAULT_HORIZON_S);
             }
             (Family::Oracle | Family::Forecast | Family::Phase, [x, h]) => {
                 out.threshold = Some(level(x)?);
@@ -267,7 +276,7 @@ impl PolicySpec {
             }
             (Family::Gate | Family::Gate0, [x]) => {
                 out.threshold = Some(level(x)?);
-                out.rate = Some(default_gate);
+                out.rate = Some(DEFAULT_GATE_RATE);
             }
             (Family::Gate | Family::Gate0, [x, r]) => {
                 out.threshold = Some(level(x)?);
@@ -331,11 +340,8 @@ impl PolicySpec {
     fn build_base(&self) -> Box<dyn Policy> {
         let spec = self.base.as_str();
         let level = self.threshold.unwrap_or(Level::Abs(0.0));
-        let rate = self.rate.unwrap_or(Rate {
-            fps: 5.0,
-            phase: 0.0,
-        });
-        let h = self.horizon.unwrap_or(0.2);
+        let rate = self.rate.unwrap_or(DEFAULT_GATE_RATE);
+        let h = self.horizon.unwrap_or(DEFAULT_HORIZON_S);
         match self.family {
             Family::Fixed => Box::new(Fixed::new(spec, rate.fps, rate.phase)),
             Family::Threshold => Box::new(Threshold::new(spec, level)),
