@@ -29,3 +29,45 @@ pub fn log_to_stderr() {
         log::set_max_level(LevelFilter::Info);
     }
 }
+
+/// Where long library jobs (an experiment's renders, a dataset's items)
+/// report how far they are, like [`log`] for messages: an application installs
+/// one with [`set_progress`] (the `mmbm` command draws progress bars); without
+/// one, progress goes nowhere.
+pub trait Progress: Send + Sync {
+    /// Starts a job of `total` steps; `what` names the steps ("frames",
+    /// "items"). The returned task is ended when it is dropped.
+    fn start(&self, what: &str, total: u64) -> Box<dyn ProgressTask>;
+}
+
+/// One running job of a [`Progress`].
+pub trait ProgressTask {
+    /// Says what the job does now (e.g. the walk and policy of a frame).
+    fn message(&self, msg: &str);
+    /// Counts `n` more steps done.
+    fn advance(&self, n: u64);
+}
+
+struct Nowhere;
+
+impl ProgressTask for Nowhere {
+    fn message(&self, _: &str) {}
+    fn advance(&self, _: u64) {}
+}
+
+static PROGRESS: std::sync::OnceLock<Box<dyn Progress>> = std::sync::OnceLock::new();
+
+/// Installs where progress goes (once per process; later calls are ignored
+/// and return false).
+pub fn set_progress(p: Box<dyn Progress>) -> bool {
+    PROGRESS.set(p).is_ok()
+}
+
+/// Starts a job's progress: reported to the installed [`Progress`] when
+/// `show` is true and one is installed, else nowhere.
+pub(crate) fn progress(show: bool, what: &str, total: u64) -> Box<dyn ProgressTask> {
+    match PROGRESS.get() {
+        Some(p) if show => p.start(what, total),
+        _ => Box::new(Nowhere),
+    }
+}

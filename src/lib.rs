@@ -24,7 +24,7 @@
 //! | 5 | [`trigger`] | trigger policies |
 //! | 6 | [`experiment`], [`dataset`] | the thesis experiment end to end; blur datasets at scale |
 //!
-//! The `mmbm` binary (`src/cli/`) sits on top; the throughput benchmarks are
+//! The `mmbm` command (the workspace's `cli/` crate) sits on top; the throughput benchmarks are
 //! `cargo bench` targets in `benches/`.
 #![deny(unsafe_code)]
 #![warn(missing_docs)]

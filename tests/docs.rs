@@ -5,7 +5,7 @@
 
 use mmbm::{mmbm, Method, Scene, Twist};
 use std::path::{Path, PathBuf};
-use std::process::Command;
+mod common;
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -196,7 +196,7 @@ fn readme_cli_example_prints_what_it_quotes() {
     let d = tempfile::tempdir().unwrap();
     let mut stdout = String::new();
     for args in &commands {
-        let o = Command::new(env!("CARGO_BIN_EXE_mmbm"))
+        let o = common::mmbm_cmd()
             .args(args)
             .current_dir(d.path())
             .output()

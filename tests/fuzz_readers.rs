@@ -278,7 +278,7 @@ fn simulate_streams_its_log() {
         .arg("-c")
         .arg(format!(
             "ulimit -v 150000 && exec '{}' simulate --duration 30 --rate 100000 --out /dev/null",
-            env!("CARGO_BIN_EXE_mmbm")
+            common::bin().display()
         ))
         .output()
         .unwrap();

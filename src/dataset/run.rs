@@ -10,7 +10,6 @@ use super::config::DatasetConfig;
 use super::item::{make, plan, ItemMeasures, ItemParams, Sources, FILES};
 use crate::error::{Error, Result};
 use crate::io::atomic::{write_atomic, PendingDir};
-use indicatif::{ProgressBar, ProgressStyle};
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 use std::collections::BTreeMap;
@@ -177,17 +176,7 @@ pub fn run(cfg: &DatasetConfig, out: &Path, shard: Shard, progress: bool) -> Res
     let items = out.join("items");
     std::fs::create_dir_all(&items).map_err(|e| Error::io(&items, e))?;
     let mine: Vec<u64> = (shard.k - 1..cfg.count).step_by(shard.n as usize).collect();
-    let bar = if progress {
-        ProgressBar::new(mine.len() as u64)
-    } else {
-        ProgressBar::hidden()
-    };
-    bar.set_style(
-        ProgressStyle::with_template(
-            "items {pos}/{len} [{elapsed_precise} < {eta_precise}] {per_sec} {msg}",
-        )
-        .unwrap_or_else(|_| ProgressStyle::default_bar()),
-    );
+    let bar = crate::diagnostics::progress(progress, "items", mine.len() as u64);
     let t0 = std::time::Instant::now();
     let mut lines = Vec::with_capacity(mine.len());
     let mut made = 0;
@@ -195,9 +184,9 @@ pub fn run(cfg: &DatasetConfig, out: &Path, shard: Shard, progress: bool) -> Res
         let existed = out.join(item_dir(i)).join("item.json").exists();
         lines.push(ensure_item(cfg, &src, out, i)?);
         made += u64::from(!existed);
-        bar.inc(1);
+        bar.advance(1);
     }
-    bar.finish_and_clear();
+    drop(bar);
     write_manifest(&out.join(shard.manifest_name()), &lines)?;
     Ok(RunSummary {
         items: mine.len() as u64,

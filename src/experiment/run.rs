@@ -11,7 +11,6 @@ use crate::io::atomic::write_atomic;
 use crate::metric::Scene;
 use crate::render::Quality;
 use crate::trigger::Frame;
-use indicatif::{ProgressBar, ProgressStyle};
 use std::collections::HashMap;
 use std::path::Path;
 use std::str::FromStr;
@@ -64,17 +63,7 @@ pub fn run(cfg: &ExperimentConfig, out: &Path, progress: bool) -> Result<Outcome
             }
         }
     }
-    let bar = if progress {
-        ProgressBar::new(plan.len() as u64)
-    } else {
-        ProgressBar::hidden()
-    };
-    bar.set_style(
-        ProgressStyle::with_template(
-            "rendering {pos}/{len} frames [{elapsed_precise} < {eta_precise}] {msg}",
-        )
-        .unwrap_or_else(|_| ProgressStyle::default_bar()),
-    );
+    let bar = crate::diagnostics::progress(progress, "rendering frames", plan.len() as u64);
     let check = quality_check(cfg, &walks, &plan, quality)?;
     let mut measures = HashMap::new();
     let mut extremes: HashMap<(usize, usize), Extremes> = HashMap::new();
@@ -82,7 +71,7 @@ pub fn run(cfg: &ExperimentConfig, out: &Path, progress: bool) -> Result<Outcome
     for (k, &(wi, pi, fi)) in plan.iter().enumerate() {
         let w = &walks[wi];
         let frame = &w.runs[pi].1[fi];
-        bar.set_message(format!("{} {}", w.name, frame.policy));
+        bar.message(&format!("{} {}", w.name, frame.policy));
         let r = render_and_measure(cfg, w, frame, cfg.camera(), quality, k as u32)?;
         if backend.is_empty() {
             backend = r.backend.clone();
@@ -100,9 +89,9 @@ pub fn run(cfg: &ExperimentConfig, out: &Path, progress: bool) -> Result<Outcome
             e.blurriest = (b, r.rgb.clone());
         }
         measures.insert((wi, pi, fi), r.measure);
-        bar.inc(1);
+        bar.advance(1);
     }
-    bar.finish_and_clear();
+    drop(bar);
     let sweep = super::sweep::exposure_sweep(cfg, &walks, quality)?;
 
     let mut records = Vec::new();

@@ -16,9 +16,66 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 
+/// The `mmbm` binary under test: `MMBM_BIN` if set, else the one cargo built
+/// beside this test binary (`target/<profile>/mmbm`, from the workspace's
+/// `cli/` crate). A plain `cargo test` (the workspace's default members)
+/// builds it before any test runs; `cargo test --test NAME` does not, so a
+/// command older than a source it is built from is refused as stale.
+pub fn bin() -> PathBuf {
+    static BIN: std::sync::OnceLock<PathBuf> = std::sync::OnceLock::new();
+    BIN.get_or_init(|| {
+        if let Some(p) = std::env::var_os("MMBM_BIN") {
+            return PathBuf::from(p);
+        }
+        let exe = std::env::current_exe().expect("the test binary's path");
+        let dir = exe
+            .parent()
+            .and_then(Path::parent)
+            .expect("the test binary lies in target/<profile>/deps");
+        let p = dir.join(format!("mmbm{}", std::env::consts::EXE_SUFFIX));
+        let build = "run `cargo test` from the workspace root (it builds cli/ too), or \
+                     `cargo build -p mmbm-cli` with this profile first, or set MMBM_BIN";
+        let Some(made) = modified(&p) else {
+            panic!("the mmbm command is not built at {}: {build}", p.display());
+        };
+        let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+        let mut newest = None;
+        for sub in ["src", "cli/src", "shaders", "Cargo.toml", "cli/Cargo.toml"] {
+            newest_in(&root.join(sub), &mut newest);
+        }
+        if let Some((t, f)) = newest {
+            assert!(
+                made >= t,
+                "the mmbm command at {} is older than {}: {build}",
+                p.display(),
+                f.display()
+            );
+        }
+        p
+    })
+    .clone()
+}
+
+fn modified(p: &Path) -> Option<std::time::SystemTime> {
+    std::fs::metadata(p).and_then(|m| m.modified()).ok()
+}
+
+/// The most recently modified file under `p` (a file or a folder).
+fn newest_in(p: &Path, newest: &mut Option<(std::time::SystemTime, PathBuf)>) {
+    if p.is_dir() {
+        for e in std::fs::read_dir(p).into_iter().flatten().flatten() {
+            newest_in(&e.path(), newest);
+        }
+    } else if let Some(t) = modified(p) {
+        if newest.as_ref().is_none_or(|(n, _)| t > *n) {
+            *newest = Some((t, p.to_path_buf()));
+        }
+    }
+}
+
 /// The `mmbm` binary under test, as a command to add arguments to.
 pub fn mmbm_cmd() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_mmbm"))
+    Command::new(bin())
 }
 
 /// Runs `mmbm ARGS` (stdin empty) and returns its output, whatever its status.

@@ -1,4 +1,8 @@
-//! Command-line parsing (clap derive) and dispatch to the subcommands.
+//! The `mmbm` command: a thin layer over the `mmbm` library. Command-line
+//! parsing (clap derive), progress bars (indicatif), signals (ctrlc) and
+//! dispatch to the subcommands, one module each. See `mmbm --help`.
+
+mod progress;
 
 mod args;
 mod assess;
@@ -25,7 +29,7 @@ use std::time::Duration;
 /// renderer, gait simulation and trigger policies.
 #[derive(Parser)]
 #[command(name = "mmbm", version, about, long_about = None, after_help = EXAMPLES)]
-pub struct Cli {
+struct Cli {
     #[command(subcommand)]
     command: Command,
 }
@@ -86,8 +90,13 @@ fn interrupted() -> i32 {
     130
 }
 
+fn main() {
+    std::process::exit(run());
+}
+
 /// Parses arguments, runs, prints errors; returns the exit code.
-pub fn main() -> i32 {
+fn run() -> i32 {
+    progress::install();
     mmbm::diagnostics::log_to_stderr();
     let cli = Cli::parse();
     // Ctrl-C (SIGINT): stop a live stream, which ends within its poll
