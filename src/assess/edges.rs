@@ -1,6 +1,6 @@
 //! Marziliano edge widths as the authors' JNBM and CPBD code measures them,
-//! shared by [`super::jnbm`](mod@super::jnbm),
-//! [`super::cpbd`](mod@super::cpbd) and [`super::whole_image`].
+//! shared by `jnbm`,
+//! `cpbd` and `whole_image`.
 //!
 //! On an array `A` (grey values, `w x h`, row-major: the whole image for
 //! CPBD, one 64x64 block for JNBM) and an edge map `E` (a vertical Sobel map,
@@ -53,7 +53,7 @@ pub enum AngleRule {
     /// `CPBD_compute.m`: rounded 0 (rising), rounded 180 or -180 (falling);
     /// `Gx = 0` counts as angle 0.
     Cpbd,
-    /// The earlier approximation ([`super::whole_image`]): `|angle| < 22.5`
+    /// The earlier approximation (`whole_image`): `|angle| < 22.5`
     /// rising, `|angle| >= 157.5` falling, pixels with `Gx = 0` skipped.
     Symmetric,
 }

@@ -37,7 +37,7 @@ pub fn laplacian(img: &GrayImage) -> Vec<f64> {
     out
 }
 
-/// Population variance of [`laplacian`]. Errors on an empty image.
+/// Population variance of `laplacian`. Errors on an empty image.
 pub fn laplacian_var(img: &GrayImage) -> Result<f64> {
     if img.width() == 0 || img.height() == 0 {
         return Err(Error::invalid("Laplacian variance", "empty image"));

@@ -14,7 +14,7 @@
 //! - [`jnbm_2d()`], [`cpbd_2d()`]: direction-aware variants that measure edge
 //!   widths along rows *and* columns (the originals only see horizontal widths,
 //!   so they are blind to vertical smear).
-//! - [`whole_image`]: the earlier whole-image approximation of JNBM and CPBD,
+//! - `whole_image`: the earlier whole-image approximation of JNBM and CPBD,
 //!   kept for comparison.
 //! - [`blur_effect()`]: Crete et al. 2007 blur effect exactly as scikit-image's
 //!   `skimage.measure.blur_effect` (0 sharp .. 1 blurred).
@@ -23,13 +23,13 @@
 //! [`assess`] computes all six; JNBM is `None` when it is undefined (no edge
 //! block with a measured width, see [`jnbm()`]).
 
-pub mod blur_effect;
-pub mod cpbd;
+pub(crate) mod blur_effect;
+pub(crate) mod cpbd;
 pub mod edges;
-pub mod jnbm;
-pub mod laplacian;
+pub(crate) mod jnbm;
+pub(crate) mod laplacian;
 pub mod matlab_edge;
-pub mod whole_image;
+pub(crate) mod whole_image;
 
 pub use blur_effect::{blur_effect, blur_effect_axes};
 pub use cpbd::{cpbd, cpbd_2d};

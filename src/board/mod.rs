@@ -1,10 +1,10 @@
 //! The thesis blob board, defined once ([`Board`], its colours), and what is
 //! done with it on images: red blob extraction and matching ([`blobs`]) and
-//! the camera pose from the blob centres ([`pose`]). The renderer paints the
+//! the camera pose from the blob centres (`pose`). The renderer paints the
 //! same board (`render::target`).
 
 pub mod blobs;
-pub mod pose;
+pub(crate) mod pose;
 
 use crate::camera::Camera;
 use crate::error::{finite, positive, Error, Result};

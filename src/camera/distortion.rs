@@ -174,7 +174,7 @@ impl Distortion {
     }
 
     /// The pinhole point whose distorted image is `(xd, yd)`, by Newton's
-    /// method from `(xd, yd)` to [`UNDISTORT_TOL`]; `None` when it does not
+    /// method from `(xd, yd)` to `UNDISTORT_TOL`; `None` when it does not
     /// converge (the model folds over or the point is outside its range).
     pub fn undistort(&self, xd: f64, yd: f64) -> Option<(f64, f64)> {
         if self.is_none() {

@@ -161,7 +161,7 @@ impl Camera {
     }
 
     /// Rejects zero/negative/NaN focal length or pitch, lengths outside
-    /// [`LENGTH_RANGE_MM`] (their squares and ratios, the sensor's area and
+    /// `LENGTH_RANGE_MM` (their squares and ratios, the sensor's area and
     /// the focal length in pixels, must stay far from the float range), an
     /// empty sensor, a non-finite principal point.
     pub fn validate(&self) -> Result<()> {
@@ -279,7 +279,7 @@ impl Camera {
     }
 
     /// Pinhole sensor point (mm) seen at the distorted sensor point `(ud, vd)`
-    /// mm (Newton's method, to [`super::distortion::UNDISTORT_TOL`] in
+    /// mm (Newton's method, to `distortion::UNDISTORT_TOL` in
     /// normalised units); `None` where it does not converge.
     #[inline]
     pub fn undistort_mm(&self, ud: f64, vd: f64) -> Option<(f64, f64)> {

@@ -1,17 +1,17 @@
-//! The camera (SPEC sections 1 and 9): pinhole intrinsics ([`intrinsics`]),
-//! lens distortion ([`distortion`]), rolling shutter ([`shutter`]), sensor
-//! noise ([`noise`]), thin-lens defocus ([`lens`]), blur in px of an MMBM over
-//! an exposure ([`blur`]) and the files that describe
-//! them, Gyroflow lens profiles included ([`mod@file`]). This layer imports
+//! The camera (SPEC sections 1 and 9): pinhole intrinsics (`intrinsics`),
+//! lens distortion (`distortion`), rolling shutter (`shutter`), sensor
+//! noise (`noise`), thin-lens defocus (`lens`), blur in px of an MMBM over
+//! an exposure (`blur`) and the files that describe
+//! them, Gyroflow lens profiles included (`file`). This layer imports
 //! nothing above `error`.
 
-pub mod blur;
-pub mod distortion;
-pub mod file;
-pub mod intrinsics;
-pub mod lens;
-pub mod noise;
-pub mod shutter;
+pub(crate) mod blur;
+pub(crate) mod distortion;
+pub(crate) mod file;
+pub(crate) mod intrinsics;
+pub(crate) mod lens;
+pub(crate) mod noise;
+pub(crate) mod shutter;
 
 pub use blur::{blur_px, checked_blur_px, checked_px_s, exposure_for_blur};
 pub use distortion::Distortion;

@@ -4,15 +4,15 @@
 //! machines (`--shard K/N`, SLURM job arrays, Kubernetes Indexed Jobs) gives
 //! the same bytes.
 //!
-//! - [`config`]: what items are drawn from (TOML, `--print-config`).
+//! - `config`: what items are drawn from (TOML, `--print-config`).
 //! - [`item`]: one item's parameters (drawn from the configuration and the
 //!   item's seed only) and files.
-//! - [`mod@run`]: making a shard (resumable), merging shard manifests, verifying
+//! - `run`: making a shard (resumable), merging shard manifests, verifying
 //!   a directory against its manifest.
 
-pub mod config;
+pub(crate) mod config;
 pub mod item;
-pub mod run;
+pub(crate) mod run;
 
 pub use config::DatasetConfig;
 pub use item::{ItemParams, Sources};

@@ -11,18 +11,18 @@
 //! both the true motion and the measurement (its simulated gyro noise is part
 //! of the truth), and the board's distance follows the log's forward velocity.
 
-pub mod benefit;
-pub mod config;
+pub(crate) mod benefit;
+pub(crate) mod config;
 mod crop;
-pub mod figures;
+pub(crate) mod figures;
 mod frames_csv;
-pub mod measure;
-pub mod report;
-pub mod run;
-pub mod sweep;
-pub mod truth;
-pub mod walk;
+pub(crate) mod measure;
+pub(crate) mod report;
+pub(crate) mod run;
+pub(crate) mod sweep;
+pub(crate) mod truth;
+pub(crate) mod walk;
 
 pub use config::ExperimentConfig;
-pub use report::Outcome;
+pub use report::{table_6, Outcome};
 pub use run::run;

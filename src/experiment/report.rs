@@ -2,7 +2,7 @@
 //! and `report.md` (findings computed from the data, the thesis's Tables
 //! 5.1, 6.1 and 6.2 recomputed per walk and policy).
 
-pub use super::frames_csv::{frames_csv, FRAMES_HEADER};
+pub use super::frames_csv::frames_csv;
 
 use super::config::ExperimentConfig;
 use super::measure::{FrameMeasure, FrameRecord};

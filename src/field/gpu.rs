@@ -209,7 +209,7 @@ impl FlowRunner {
         Ok((partials, field))
     }
 
-    /// `flow_tiles` for up to [`MAX_DISPATCH`] twists: per twist the sum of
+    /// `flow_tiles` for up to `MAX_DISPATCH` twists: per twist the sum of
     /// speeds (mm/s) over the grid, as f32 tile partials summed in f64, and
     /// (one twist, `with_field`) the field in px/s.
     pub fn tiles(

@@ -41,7 +41,7 @@ pub struct FlowParams {
     pub grid_h: u32,
     /// Twists in the dispatch.
     pub n_twists: u32,
-    /// Tiles of [`TILE`] samples per twist (`flow_tiles`).
+    /// Tiles of `TILE` samples per twist (`flow_tiles`).
     pub tiles: u32,
     /// Workgroups along x per dispatch row (`flow_tiles`).
     pub tiles_x: u32,
@@ -155,7 +155,7 @@ impl Grid {
         self.len() == 0
     }
 
-    /// Tiles of [`TILE`] samples.
+    /// Tiles of `TILE` samples.
     pub fn tiles(&self) -> u32 {
         (self.len() as u64).div_ceil(TILE as u64) as u32
     }

@@ -2,8 +2,8 @@
 //! section 2 at full sensor resolution, its mean speed (MMBM, mm/s), and
 //! batched MMBM for many twists in one dispatch.
 //!
-//! The same shape as the renderer: [`kernel`] holds the host structs shared
-//! with WGSL (with layout asserts), [`gpu`] the compiled kernels and their
+//! The same shape as the renderer: `kernel` holds the host structs shared
+//! with WGSL (with layout asserts), `gpu` the compiled kernels and their
 //! runner, [`cpu`] the CPU twins written from the same formula, and
 //! [`flow_field`] picks one by [`Backend`].
 //!
@@ -12,8 +12,8 @@
 //! host.
 
 pub mod cpu;
-pub mod gpu;
-pub mod kernel;
+pub(crate) mod gpu;
+pub(crate) mod kernel;
 
 pub use crate::gpu::Backend;
 pub use cpu::FieldMean;

@@ -1,10 +1,10 @@
 //! GPU support through wgpu: the process-wide device ([`context`]), the
-//! compute plumbing every kernel shares ([`compute`]: shader build under an
+//! compute plumbing every kernel shares (`compute`: shader build under an
 //! error scope, buffers, read-back) and the [`Backend`] choice. The kernels
 //! themselves live with their features (`field`, `render`), each beside its
 //! CPU twin.
 
-pub mod compute;
+pub(crate) mod compute;
 pub mod context;
 
 pub use context::{gpu, GpuContext};

@@ -1,7 +1,7 @@
 //! Gyro logs (SPEC section 5): a plain CSV with a header row, columns `t`
 //! (seconds by default), `wx, wy, wz` (rad/s by default), optional `vx, vy, vz`
 //! (m/s) and `depth` (m). Lines starting with `#` are comments. A ROS 2 MCAP
-//! file ([`super::mcap`]) or a Gyroflow `.gcsv` log ([`super::gcsv`]) is
+//! file (`mcap`) or a Gyroflow `.gcsv` log (`gcsv`) is
 //! turned into the same CSV text first.
 //!
 //! [`GyroReader`] streams the file in constant memory and validates every

@@ -1,6 +1,6 @@
 //! Files in and out: atomic output ([`atomic`]: temp file + rename), image
 //! files ([`images`]: EXR, sRGB PNG, textures) and gyro log readers
-//! ([`gyro`]: CSV, ROS 2 MCAP through [`mcap`] and Gyroflow `.gcsv` through
+//! (`gyro`: CSV, ROS 2 MCAP through `mcap` and Gyroflow `.gcsv` through
 //! [`gcsv`]; [`lines`]: one line at a time, for live streams); video frame
 //! tables ([`frames`]); [`input`]: the kind and size checks every reader
 //! shares (regular files and pipes only, capped lines, headers and image
@@ -13,4 +13,4 @@ pub mod gyro;
 pub mod images;
 pub mod input;
 pub mod lines;
-pub mod mcap;
+pub(crate) mod mcap;

@@ -30,10 +30,8 @@ use super::texture::MipTexture;
 use crate::board::{BLOB_RED, BOARD_WHITE};
 use crate::camera::Camera;
 
-pub use super::homography::{homographies, pixel_maps, table_lines, table_stride, target_bbox};
-pub use super::layout::{
-    GpuHomography, RenderParams, KIND_BLOBS, KIND_CHECKER, KIND_IMAGE, LOD_SCALE,
-};
+pub use super::homography::{homographies, pixel_maps, target_bbox};
+pub use super::layout::{RenderParams, KIND_BLOBS, KIND_CHECKER, KIND_IMAGE, LOD_SCALE};
 
 /// The defocus parameters ([`RenderParams::lens`]): the aperture radius is
 /// that of `A' = A s / (s - f)` (`A = f / N`), so that a point at depth `z`

@@ -4,7 +4,7 @@
 //! [`Trajectory`] during one exposure (box shutter). Each pixel is the mean
 //! over its area and the exposure time. Time: `N` instants (step midpoints,
 //! the same for every pixel), at each one the homography from pixel to target
-//! coordinates ([`kernel`]); `N` is chosen from the trajectory so that
+//! coordinates (`kernel`); `N` is chosen from the trajectory so that
 //! consecutive instants are at most `quality.max_spacing_px()` apart on the
 //! image (from the largest image path length over the sensor). Area, per
 //! [`Integrator`]: `analytic` (checker, blob board; the default for them)
@@ -12,22 +12,22 @@
 //! instant; `lattice` (any target; images) supersamples area and time with a
 //! rank-1 lattice and a per-pixel shift, at least `quality.min_samples()`.
 //!
-//! The GPU kernel is `shaders/render.wgsl` ([`gpu`]); its CPU twin ([`cpu`]) is
+//! The GPU kernel is `shaders/render.wgsl` (`gpu`); its CPU twin (`cpu`) is
 //! used when no adapter exists (announced once on stderr). [`maps`] gives the
-//! per-pixel blur ground truth (path length, displacement, speed), [`mod@psf`] the
+//! per-pixel blur ground truth (path length, displacement, speed), `psf` the
 //! point-spread function at a pixel.
 
-pub mod cpu;
-pub mod gpu;
+pub(crate) mod cpu;
+pub(crate) mod gpu;
 mod homography;
-pub mod kernel;
+pub(crate) mod kernel;
 mod layout;
 pub mod maps;
-pub mod psf;
+pub(crate) mod psf;
 mod sampling;
-pub mod target;
+pub(crate) mod target;
 pub mod texture;
-pub mod trajectory;
+pub(crate) mod trajectory;
 
 pub use crate::gpu::Backend;
 pub use maps::{blur_maps, BlurMaps, BlurMeans};
