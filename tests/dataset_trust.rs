@@ -273,6 +273,30 @@ fn verify_trusts_nothing_the_manifest_says() {
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(1), "{err}");
     assert!(err.contains("maps.exr: is not a regular file"), "{err}");
+    // So is a pipe in place of dataset.json (for --verify, --merge and a run).
+    let rec = out.join("dataset.json");
+    std::fs::remove_file(&rec).unwrap();
+    assert!(std::process::Command::new("mkfifo")
+        .arg(&rec)
+        .status()
+        .unwrap()
+        .success());
+    for args in [
+        &["--verify"][..],
+        &["--merge"],
+        &["--quiet", "--config", "ds.toml"],
+    ] {
+        std::fs::write(d.path().join("ds.toml"), tiny(2, 1).to_toml().unwrap()).unwrap();
+        let mut argv = vec!["dataset", "--out", "data"];
+        argv.extend(args);
+        let o = common::mmbm_within(d.path(), &argv, vec![], 60);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "{args:?}: {err}");
+        assert!(
+            err.contains("dataset.json") && err.contains("a pipe"),
+            "{args:?}: {err}"
+        );
+    }
 }
 
 /// Issue #23 item 6: `--merge` with a part named `...-of-1000000000000`

@@ -87,7 +87,7 @@ fn shard(a: &DatasetArgs) -> Result<(Shard, &'static str)> {
                 format!("{id} is below SLURM_ARRAY_TASK_MIN {min}"),
             )
         })?;
-        return Ok((Shard::new(k + 1, count)?, "SLURM job array"));
+        return Ok((Shard::new(k.saturating_add(1), count)?, "SLURM job array"));
     }
     if let Some(idx) = env("JOB_COMPLETION_INDEX") {
         let idx = num("JOB_COMPLETION_INDEX", idx)?;
@@ -97,7 +97,10 @@ fn shard(a: &DatasetArgs) -> Result<(Shard, &'static str)> {
                 "JOB_COMPLETION_INDEX is set (Kubernetes Indexed Job): give the Job's completions as --shard-count N",
             )
         })?;
-        return Ok((Shard::new(idx + 1, n)?, "Kubernetes Indexed Job"));
+        return Ok((
+            Shard::new(idx.saturating_add(1), n)?,
+            "Kubernetes Indexed Job",
+        ));
     }
     Ok((Shard::ALL, "no shard"))
 }

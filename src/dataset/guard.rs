@@ -53,6 +53,26 @@ pub(crate) fn sha256_of(r: &mut dyn std::io::Read, path: &Path) -> Result<(u64, 
     Ok((n, format!("{:x}", h.finalize())))
 }
 
+/// Reads a JSON file of the dataset directory (`dataset.json`, an
+/// `item.json`): a regular file only (a pipe there would block), at most
+/// [`crate::io::input::MAX_TEXT_BYTES`].
+pub(crate) fn read_json_file(p: &Path) -> Result<String> {
+    use std::io::Read;
+    let cap = crate::io::input::MAX_TEXT_BYTES;
+    let mut s = String::new();
+    crate::io::input::open_file(p)?
+        .take(cap + 1)
+        .read_to_string(&mut s)
+        .map_err(|e| Error::io(p, e))?;
+    if s.len() as u64 > cap {
+        return Err(Error::invalid(
+            show_path(p),
+            format!("longer than {cap} bytes, the most read"),
+        ));
+    }
+    Ok(s)
+}
+
 /// `v` as JSON with every object's keys sorted (whatever map type
 /// serde_json was built with).
 fn canonical(v: &Value) -> String {
@@ -123,7 +143,7 @@ impl Record {
                 ),
             ));
         }
-        let text = crate::io::input::read_text(&p)?;
+        let text = read_json_file(&p)?;
         let r: Record = serde_json::from_str(&text).map_err(|e| Error::Config {
             path: p.clone(),
             message: crate::error::clip(&e.to_string(), crate::error::MAX_MESSAGE),

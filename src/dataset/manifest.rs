@@ -349,7 +349,7 @@ fn check_line(out: &Path, root: &Path, rec: &Record, k: u64, l: &ManifestLine, p
     if let Some(e) = check_file(root, &json, None) {
         return p.push(e);
     }
-    let same = crate::io::input::read_text(&json)
+    let same = super::guard::read_json_file(&json)
         .ok()
         .and_then(|t| serde_json::from_str::<ManifestLine>(&t).ok())
         .is_some_and(|x| &x == l);

@@ -33,7 +33,7 @@ fn ensure_item(
     let fin = out.join(&rel);
     let json = fin.join("item.json");
     if json.exists() {
-        let text = crate::io::input::read_text(&json)?;
+        let text = super::guard::read_json_file(&json)?;
         let line: ManifestLine = serde_json::from_str(&text).map_err(|e| Error::Config {
             path: json.clone(),
             message: crate::error::clip(&e.to_string(), crate::error::MAX_MESSAGE),
