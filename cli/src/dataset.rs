@@ -13,7 +13,8 @@ use std::path::PathBuf;
 of the work gives the same bytes. Item files: DIR/items/NNNNNNNN/{blurred,sharp}.{exr,png}
 (linear EXR, sRGB PNG), flow.exr (flow.u, flow.v at exposure start, px/s), maps.exr (path_px,
 disp_px, speed_px_s), item.json (its manifest line: every parameter, the instantaneous MMBM at
-exposure start and the exposure MMBM, file sizes and SHA-256). A rerun skips complete items.
+exposure start and the exposure MMBM, file sizes and SHA-256). A rerun skips complete items; DIR/dataset.json holds the
+configuration's fingerprint, and a run with another configuration is refused (use a new --out).
 
 Sharding: --shard K/N (K from 1) makes the items with i mod N = K-1 and writes
 DIR/manifest.part-K-of-N.jsonl; without --shard, a SLURM job array (SLURM_ARRAY_TASK_ID,
@@ -35,7 +36,7 @@ pub struct DatasetArgs {
     /// Dataset directory.
     #[arg(long, value_name = "DIR", required_unless_present = "print_config")]
     pub out: Option<PathBuf>,
-    /// Make shard K of N (K from 1).
+    /// Make shard K of N (K from 1; N at most 1000000 and at most the number of items).
     #[arg(long, value_name = "K/N")]
     pub shard: Option<String>,
     /// Number of shards of a Kubernetes Indexed Job (with JOB_COMPLETION_INDEX).
@@ -44,7 +45,8 @@ pub struct DatasetArgs {
     /// Join DIR/manifest.part-K-of-N.jsonl into DIR/manifest.jsonl.
     #[arg(long, conflicts_with_all = ["config", "shard", "verify", "print_config"])]
     pub merge: bool,
-    /// Check DIR against DIR/manifest.jsonl (files, sizes, SHA-256, indices).
+    /// Check DIR against DIR/manifest.jsonl (files, sizes, SHA-256, indices, fingerprint; only the item
+    /// files inside DIR are read).
     #[arg(long, conflicts_with_all = ["config", "shard", "print_config"])]
     pub verify: bool,
     /// Print the default configuration as TOML and exit.
@@ -85,7 +87,7 @@ fn shard(a: &DatasetArgs) -> Result<(Shard, &'static str)> {
                 format!("{id} is below SLURM_ARRAY_TASK_MIN {min}"),
             )
         })?;
-        return Ok((Shard::new(k + 1, count)?, "SLURM job array"));
+        return Ok((Shard::new(k.saturating_add(1), count)?, "SLURM job array"));
     }
     if let Some(idx) = env("JOB_COMPLETION_INDEX") {
         let idx = num("JOB_COMPLETION_INDEX", idx)?;
@@ -95,7 +97,10 @@ fn shard(a: &DatasetArgs) -> Result<(Shard, &'static str)> {
                 "JOB_COMPLETION_INDEX is set (Kubernetes Indexed Job): give the Job's completions as --shard-count N",
             )
         })?;
-        return Ok((Shard::new(idx + 1, n)?, "Kubernetes Indexed Job"));
+        return Ok((
+            Shard::new(idx.saturating_add(1), n)?,
+            "Kubernetes Indexed Job",
+        ));
     }
     Ok((Shard::ALL, "no shard"))
 }

@@ -141,6 +141,39 @@ impl Sources {
     }
 }
 
+impl Sources {
+    /// SHA-256 (hex) of the decoded samples of the log `p` (time, angular
+    /// and linear velocity, depth, as f64 bits), for the dataset's
+    /// fingerprint: what the items are made from, whatever file it came in.
+    pub fn log_digest(&self, p: &Path) -> Result<String> {
+        use sha2::{Digest, Sha256};
+        let s = self.logs.get(p).ok_or_else(|| {
+            Error::invalid("motion", format!("log {} was not opened", p.display()))
+        })?;
+        let mut h = Sha256::new();
+        let opt = |h: &mut Sha256, v: Option<&[f64]>| match v {
+            Some(v) => {
+                h.update([1u8]);
+                for x in v {
+                    h.update(x.to_bits().to_le_bytes());
+                }
+            }
+            None => h.update([0u8]),
+        };
+        for x in s.samples() {
+            h.update(x.t.to_bits().to_le_bytes());
+            opt(&mut h, Some(&x.omega.to_array()));
+            opt(
+                &mut h,
+                x.velocity.map(|v| v.to_array()).as_ref().map(|a| &a[..]),
+            );
+            opt(&mut h, x.depth.as_ref().map(std::slice::from_ref));
+        }
+        h.update(format!("{:?}", s.readout()).as_bytes());
+        Ok(format!("{:x}", h.finalize()))
+    }
+}
+
 /// Draws the parameters of item `i` (depends only on `cfg` and `i`).
 pub fn plan(cfg: &DatasetConfig, src: &Sources, i: u64) -> Result<ItemParams> {
     let seed = item_seed(cfg.seed, i);

@@ -7,13 +7,23 @@
 //! - `config`: what items are drawn from (TOML, `--print-config`).
 //! - [`item`]: one item's parameters (drawn from the configuration and the
 //!   item's seed only) and files.
-//! - `run`: making a shard (resumable), merging shard manifests, verifying
-//!   a directory against its manifest.
+//! - `run`: making a shard (resumable); `shard`: which items a
+//!   shard makes, and the cap on shard counts.
+//! - `manifest`: merging shard manifests, verifying a directory against
+//!   its manifest (which is input: every path it names is confined).
+//! - `guard`: the configuration's fingerprint (`DIR/dataset.json`) and the
+//!   lock that keeps each shard to one writer.
 
 pub(crate) mod config;
+pub(crate) mod guard;
 pub mod item;
+pub(crate) mod manifest;
 pub(crate) mod run;
+pub(crate) mod shard;
 
 pub use config::DatasetConfig;
+pub use guard::{Record, RunLock};
 pub use item::{ItemParams, Sources};
-pub use run::{merge, run, verify, ManifestLine, RunSummary, Shard};
+pub use manifest::{merge, verify, ManifestLine};
+pub use run::{run, RunSummary};
+pub use shard::{Shard, MAX_SHARDS};
