@@ -48,7 +48,7 @@ impl GyroArgs {
             time_unit: self.time_unit,
             angle_unit: self.angle_unit,
             imu_to_camera: self.imu_rotation.unwrap_or(glam::DMat3::IDENTITY),
-            time_offset: mmbm::error::finite("--time-offset", self.time_offset)?,
+            time_offset: mmbm::check::finite("--time-offset", self.time_offset)?,
             topic: self.topic.clone(),
         })
     }
@@ -115,7 +115,7 @@ pub fn run(a: SeriesArgs) -> Result<()> {
     };
     let pitch = opts.scene.camera.pitch_x_mm;
     if let Some(te) = a.exposure {
-        mmbm::error::positive("--exposure (s)", te)?;
+        mmbm::check::positive("--exposure (s)", te)?;
     }
     let n = match &a.out {
         Some(p) => {

@@ -185,7 +185,7 @@ impl ExperimentConfig {
 
     /// Checks ranges (times positive, distances positive and ordered, a policy at least).
     pub fn validate(&self) -> Result<()> {
-        use crate::error::positive;
+        use crate::check::positive;
         positive("duration_s", self.duration_s)?;
         positive("rate_hz", self.rate_hz)?;
         let mut seeds = self.seeds.clone();
@@ -200,7 +200,7 @@ impl ExperimentConfig {
         positive("exposure_s", self.exposure_s)?;
         positive("start_distance_m", self.start_distance_m)?;
         positive("min_distance_m", self.min_distance_m)?;
-        crate::error::finite("speed_m_s", self.speed_m_s)?;
+        crate::check::finite("speed_m_s", self.speed_m_s)?;
         if self.min_distance_m > self.start_distance_m {
             return Err(Error::invalid(
                 "min_distance_m",
