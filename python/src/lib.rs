@@ -4,8 +4,11 @@
 //! library with the GIL released, and returns NumPy arrays. Library errors
 //! become `OSError` (files) or `ValueError` (everything else).
 
+mod camera;
+
+use camera::{camera, camera_json};
 use glam::DVec3;
-use mmbm::camera::{Camera, CameraFile};
+use mmbm::camera::Camera;
 use mmbm::gpu::Backend;
 use mmbm::io::gyro::{parse_rotation, GyroOptions, GyroSample};
 use mmbm::metric::{AnyMethod, Scene};
@@ -24,73 +27,6 @@ fn err(e: mmbm::Error) -> PyErr {
         mmbm::Error::Io { .. } => PyOSError::new_err(e.to_string()),
         _ => PyValueError::new_err(e.to_string()),
     }
-}
-
-/// The camera as the Python half passes it: a dict of the camera file's
-/// keys ([`CameraFile`], the one camera representation). The sides are
-/// checked by the library first ([`Camera::size_from`]), so a negative one
-/// is a `ValueError` that names the resolution.
-fn camera(spec: &Bound<'_, PyDict>) -> PyResult<Camera> {
-    let v = json(spec.as_any(), "camera")?;
-    if let (Some(w), Some(h)) = (v["width"].as_i64(), v["height"].as_i64()) {
-        Camera::size_from(w, h).map_err(err)?;
-    }
-    let file: CameraFile =
-        serde_json::from_value(v).map_err(|e| PyValueError::new_err(format!("camera: {e}")))?;
-    let cam = file.camera().map_err(err)?;
-    cam.validate().map_err(err)?;
-    Ok(cam)
-}
-
-/// A camera for the Python half: every key of its camera file, as JSON
-/// (the Python `Camera`'s fields are these keys).
-fn camera_json(c: &Camera) -> PyResult<String> {
-    serde_json::to_string(&CameraFile::of(c)).map_err(|e| PyValueError::new_err(e.to_string()))
-}
-
-/// A Python value (dict, list, tuple, str, bool, int, float, None) as JSON
-/// for the library's serde types; `key` names it in errors. JSON has no
-/// NaN or infinity, so a non-finite float is refused here, by name.
-fn json(x: &Bound<'_, PyAny>, key: &str) -> PyResult<serde_json::Value> {
-    use pyo3::types::{PyBool, PyList, PyString, PyTuple};
-    use serde_json::Value;
-    if x.is_none() {
-        return Ok(Value::Null);
-    }
-    if let Ok(b) = x.cast::<PyBool>() {
-        return Ok(Value::Bool(b.is_true()));
-    }
-    if let Ok(d) = x.cast::<PyDict>() {
-        let mut m = serde_json::Map::new();
-        for (k, v) in d.iter() {
-            let k: String = k
-                .extract()
-                .map_err(|_| PyValueError::new_err(format!("{key}: keys must be strings")))?;
-            let v = json(&v, &format!("{key}.{k}"))?;
-            m.insert(k, v);
-        }
-        return Ok(Value::Object(m));
-    }
-    if x.cast::<PyList>().is_ok() || x.cast::<PyTuple>().is_ok() {
-        let mut a = Vec::new();
-        for (i, v) in x.try_iter()?.enumerate() {
-            a.push(json(&v?, &format!("{key}[{i}]"))?);
-        }
-        return Ok(Value::Array(a));
-    }
-    if x.cast::<PyString>().is_ok() {
-        return Ok(Value::String(x.extract()?));
-    }
-    if let Ok(i) = x.extract::<i64>() {
-        return Ok(Value::from(i));
-    }
-    if let Ok(f) = x.extract::<f64>() {
-        mmbm::check::finite(key, f).map_err(err)?;
-        return Ok(Value::from(f));
-    }
-    Err(PyValueError::new_err(format!(
-        "{key}: expected a number, a string, a list or a dict"
-    )))
 }
 
 fn plane(p: Option<PyReadonlyArray1<f64>>) -> PyResult<Option<Plane>> {
