@@ -17,16 +17,6 @@ use std::hint::black_box;
 use std::process::ExitCode;
 use std::time::Instant;
 
-fn opencv() -> Distortion {
-    Distortion::Opencv {
-        k1: -0.28,
-        k2: 0.07,
-        p1: 0.001,
-        p2: -0.0015,
-        k3: -0.008,
-    }
-}
-
 fn metric() -> Result<()> {
     let polys: Vec<_> = twists(4096)
         .iter()
@@ -48,7 +38,7 @@ fn metric() -> Result<()> {
         for (k, cam) in [
             Camera::thesis(),
             Camera {
-                distortion: opencv(),
+                distortion: Distortion::WIDE_ANGLE,
                 ..Camera::thesis()
             },
         ]
@@ -93,7 +83,7 @@ fn render() -> Result<()> {
         (
             "distortion (OpenCV)",
             Camera {
-                distortion: opencv(),
+                distortion: Distortion::WIDE_ANGLE,
                 ..base
             },
         ),

@@ -183,28 +183,6 @@ pub fn quote(s: &str) -> String {
     format!("'{}'", shown(&one_line(s), 64))
 }
 
-/// Checks that `x` is finite, naming it in the error.
-pub fn finite(what: &str, x: f64) -> Result<f64> {
-    if x.is_finite() {
-        Ok(x)
-    } else {
-        Err(Error::invalid(
-            what,
-            format!("must be a finite number, got {x}"),
-        ))
-    }
-}
-
-/// Checks that `x` is finite and strictly positive, naming it in the error.
-pub fn positive(what: &str, x: f64) -> Result<f64> {
-    finite(what, x)?;
-    if x > 0.0 {
-        Ok(x)
-    } else {
-        Err(Error::invalid(what, format!("must be > 0, got {x}")))
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -13,6 +13,8 @@ use std::path::{Path, PathBuf};
 /// Layer of each top-level library module (keep in step with `src/lib.rs`).
 const LAYERS: &[(&str, u32)] = &[
     ("error", 0),
+    ("check", 0),
+    ("bounded", 0),
     ("stats", 0),
     ("diagnostics", 0),
     ("camera", 1),

@@ -96,39 +96,23 @@ pub struct CameraArgs {
 }
 
 impl CameraArgs {
-    /// The camera these options describe, validated.
+    /// The camera these options describe, validated: the file (or the
+    /// thesis camera) with the flags over it, by the library.
     pub fn camera(&self) -> Result<Camera> {
-        let mut c = match &self.camera {
-            Some(p) => Camera::load(p)?,
-            None => Camera::thesis(),
+        let over = mmbm::camera::CameraOverrides {
+            keys: mmbm::camera::CameraFile {
+                focal_mm: self.focal,
+                pitch_mm: self.pitch,
+                width: self.sensor.map(|(w, _)| w),
+                height: self.sensor.map(|(_, h)| h),
+                readout_s: self.rolling_readout,
+                readout_direction: self.readout_direction,
+                ..Default::default()
+            },
+            scale_to: self.scale_to,
+            light_e_per_s: self.light,
         };
-        if let Some(f) = self.focal {
-            c.focal_mm = f;
-        }
-        if let Some(p) = self.pitch {
-            c.pitch_x_mm = p;
-            c.pitch_y_mm = p;
-        }
-        if let Some((w, h)) = self.sensor {
-            c = c.with_resolution(w, h);
-        }
-        if let Some((w, h)) = self.scale_to {
-            c = c.scaled_to(w, h);
-        }
-        if let Some(r) = self.rolling_readout {
-            c.shutter.readout_s = r;
-        }
-        if let Some(d) = self.readout_direction {
-            c.shutter.direction = d;
-        }
-        if let Some(phi) = self.light {
-            c.noise = Some(mmbm::camera::Noise {
-                phi_e_per_s: phi,
-                ..c.noise.unwrap_or(mmbm::camera::Noise::at_light(phi))
-            });
-        }
-        c.validate()?;
-        Ok(c)
+        Camera::resolve(self.camera.as_deref(), &over)
     }
 }
 

@@ -45,7 +45,7 @@ pub fn run(a: EvalArgs) -> Result<()> {
         plane: a.scene.plane()?,
     };
     if let Some(te) = a.exposure {
-        mmbm::error::positive("--exposure (s)", te)?;
+        mmbm::check::positive("--exposure (s)", te)?;
     }
     let tw = Twist::new(a.omega, a.velocity.unwrap_or(DVec3::ZERO));
     let m = match method {

@@ -5,7 +5,8 @@
 use super::args::{parse_vec3, CameraArgs, SceneArgs};
 use clap::Args;
 use glam::DVec3;
-use mmbm::error::{positive, Result};
+use mmbm::check::positive;
+use mmbm::error::Result;
 use mmbm::{Scene, Twist};
 use std::path::PathBuf;
 

@@ -72,7 +72,7 @@ pub fn run(a: FramesArgs) -> Result<()> {
         }
     };
     let camera = a.camera.camera()?;
-    mmbm::error::finite("--gap", a.gap)?;
+    mmbm::check::finite("--gap", a.gap)?;
     let frames = read_frames(&a.frames)?;
     let samples = read_log(&a.gyro, a.gyro_opts.options()?)?;
     let camera = super::args::with_log_readout(camera, samples.readout(), &a.gyro)?;

@@ -94,7 +94,7 @@ fn parse_speed(s: &str) -> std::result::Result<f64, String> {
 /// `--idle-exit`: a finite number of seconds > 0.
 fn parse_idle(s: &str) -> std::result::Result<f64, String> {
     let x: f64 = s.parse().map_err(|_| format!("'{s}' is not a number"))?;
-    mmbm::error::positive("--idle-exit (s)", x).map_err(|e| e.to_string())
+    mmbm::check::positive("--idle-exit (s)", x).map_err(|e| e.to_string())
 }
 
 /// Runs `mmbm live`, stopped through `control` (the Ctrl-C handler's);

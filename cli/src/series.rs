@@ -5,7 +5,7 @@ use clap::Args;
 use mmbm::error::Result;
 use mmbm::io::gyro::{parse_rotation, AngleUnit, GyroOptions, GyroReader, TimeUnit};
 use mmbm::series::{self, SeriesOptions};
-use mmbm::{AnyMethod, Method, Scene};
+use mmbm::{AnyMethod, Scene};
 use std::path::PathBuf;
 
 /// Options for reading a gyro log (shared by the commands that read one).
@@ -48,7 +48,7 @@ impl GyroArgs {
             time_unit: self.time_unit,
             angle_unit: self.angle_unit,
             imu_to_camera: self.imu_rotation.unwrap_or(glam::DMat3::IDENTITY),
-            time_offset: mmbm::error::finite("--time-offset", self.time_offset)?,
+            time_offset: mmbm::check::finite("--time-offset", self.time_offset)?,
             topic: self.topic.clone(),
         })
     }
@@ -94,28 +94,17 @@ pub fn run(a: SeriesArgs) -> Result<()> {
             camera: a.camera.camera()?,
             plane: a.scene.plane()?,
         },
-        // (Unused by the GPU evaluator.)
-        method: match method {
-            AnyMethod::Cpu(m) => m,
-            AnyMethod::Gpu { .. } => Method::default(),
-        },
+        method,
         use_velocity: a.use_velocity,
     };
     if let Some(p) = &opts.scene.plane {
         p.validate_for(&opts.scene.camera)?;
     }
     let reader = GyroReader::open(&a.gyro, a.gyro_opts.options()?)?;
-    let mut eval: Box<series::BatchFn> = match method {
-        AnyMethod::Gpu { width, height } => {
-            mmbm::series::gpu::series_evaluator(opts, width, height)?
-        }
-        AnyMethod::Cpu(_) => {
-            Box::new(move |b: &[mmbm::io::gyro::GyroSample]| series::eval_batch_cpu(b, &opts))
-        }
-    };
+    let mut eval = series::evaluator(opts)?;
     let pitch = opts.scene.camera.pitch_x_mm;
     if let Some(te) = a.exposure {
-        mmbm::error::positive("--exposure (s)", te)?;
+        mmbm::check::positive("--exposure (s)", te)?;
     }
     let n = match &a.out {
         Some(p) => {

@@ -44,8 +44,9 @@ PathLike = Union[str, "os.PathLike[str]"]
 ArrayLike = Any
 
 
-# The thesis camera, from its one definition in the library (``Camera::thesis``).
-_THESIS = _mmbm.camera_thesis()
+# The thesis camera, from its one definition in the library (``Camera::thesis``),
+# as the keys of a camera file.
+_THESIS: Dict[str, Any] = json.loads(_mmbm.camera_thesis())
 
 
 @dataclass(frozen=True)
@@ -63,11 +64,11 @@ class Camera:
     (``{"f_number": 2.0, "focus_m": 1.5}``).
     """
 
-    focal_mm: float = _THESIS[0]
-    pitch_x_mm: float = _THESIS[1]
-    pitch_y_mm: float = _THESIS[2]
-    width: int = _THESIS[3]
-    height: int = _THESIS[4]
+    focal_mm: float = _THESIS["focal_mm"]
+    pitch_x_mm: float = _THESIS["pitch_x_mm"]
+    pitch_y_mm: float = _THESIS["pitch_y_mm"]
+    width: int = _THESIS["width"]
+    height: int = _THESIS["height"]
     cx: Optional[float] = None
     cy: Optional[float] = None
     skew: float = 0.0
@@ -82,51 +83,41 @@ class Camera:
             object.__setattr__(self, "cx", self.width / 2.0)
         if self.cy is None:
             object.__setattr__(self, "cy", self.height / 2.0)
-        _mmbm.camera_check(self._tuple())
+        _mmbm.camera_check(self._spec())
 
     @classmethod
     def from_file(cls, path: PathLike) -> "Camera":
         """Reads a camera file (TOML or JSON, as ``mmbm --camera FILE``)."""
-        f, px, py, w, h, cx, cy, skew, extras = _mmbm.camera_from_file(os.fspath(path))
-        x = json.loads(extras)
-        dist = x.get("distortion", {"model": "none"})
-        return cls(
-            f, px, py, w, h, cx, cy, skew,
-            readout_s=x["readout_s"],
-            readout_direction=x["readout_direction"],
-            distortion=None if dist.get("model") == "none" else dist,
-            noise=x.get("noise"),
-            lens=x.get("lens"),
-        )
+        # Every key of the file's camera, named as this class's fields.
+        return cls(**json.loads(_mmbm.camera_from_file(os.fspath(path))))
 
     def with_resolution(self, width: int, height: int) -> "Camera":
         """Same focal length and pitch, another size, principal point at the centre."""
         return dataclasses.replace(self, width=width, height=height, cx=None, cy=None)
 
-    def _extras(self) -> str:
-        x: dict = {"readout_s": float(self.readout_s), "readout_direction": self.readout_direction}
+    def _spec(self) -> Dict[str, Any]:
+        """The camera as the native module takes it: a camera file's keys."""
+        x: Dict[str, Any] = {
+            "focal_mm": float(self.focal_mm),
+            "pitch_x_mm": float(self.pitch_x_mm),
+            "pitch_y_mm": float(self.pitch_y_mm),
+            "width": int(self.width),
+            "height": int(self.height),
+            "cx": float(self.cx),  # type: ignore[arg-type]
+            "cy": float(self.cy),  # type: ignore[arg-type]
+            "skew": float(self.skew),
+            "readout_s": float(self.readout_s),
+            "readout_direction": self.readout_direction,
+        }
         for k in ("distortion", "noise", "lens"):
             v = getattr(self, k)
             if v is not None:
                 x[k] = v
-        return json.dumps(x)
-
-    def _tuple(self) -> Tuple[float, float, float, int, int, float, float, float, str]:
-        return (
-            float(self.focal_mm),
-            float(self.pitch_x_mm),
-            float(self.pitch_y_mm),
-            int(self.width),
-            int(self.height),
-            float(self.cx),  # type: ignore[arg-type]
-            float(self.cy),  # type: ignore[arg-type]
-            float(self.skew),
-            self._extras(),
-        )
+        return x
 
 
-def _cam(camera: Optional[Camera]) -> Tuple[float, float, float, int, int, float, float, float, str]:
-    return (camera or Camera())._tuple()
+def _cam(camera: Optional[Camera]) -> Dict[str, Any]:
+    return (camera or Camera())._spec()
 
 
 def _log(t: ArrayLike, omega: ArrayLike) -> Tuple[np.ndarray, np.ndarray]:
@@ -230,7 +221,7 @@ def frames(
     if readout_s is not None:
         rs = np.ascontiguousarray(np.broadcast_to(np.asarray(readout_s, dtype=np.float64), ts.shape))
     cam = camera or Camera()
-    e, blur, s0 = _mmbm.frames(cam._tuple(), tt, w, np.ascontiguousarray(ts), es, rs, method)
+    e, blur, s0 = _mmbm.frames(cam._spec(), tt, w, np.ascontiguousarray(ts), es, rs, method)
     return {
         "exposure_mmbm_mm_s": e,
         "blur_px": blur,
@@ -312,7 +303,7 @@ def render(
     if gyro is not None:
         g = {k: np.asarray(gyro[k], dtype=np.float64) for k in ("t", "omega", "velocity") if k in gyro}
     return _mmbm.render(
-        cam._tuple(),
+        cam._spec(),
         target,
         float(distance),
         [float(x) for x in tilt],

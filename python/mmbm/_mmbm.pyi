@@ -5,16 +5,17 @@ from typing import Any, Dict, List, Optional, Sequence, Tuple
 import numpy as np
 import numpy.typing as npt
 
-CamTuple = Tuple[float, float, float, int, int, float, float, float, str]
+# A camera: the keys of a camera file (focal_mm, pitch_x_mm, ..., distortion, noise, lens).
+CamSpec = Dict[str, Any]
 F64 = npt.NDArray[np.float64]
 F32 = npt.NDArray[np.float32]
 
-def camera_from_file(path: str) -> CamTuple: ...
-def camera_thesis() -> CamTuple: ...
-def camera_check(cam: CamTuple) -> None: ...
-def metric(cam: CamTuple, omega: F64, velocity: F64, plane_: Optional[F64], method: str) -> F64: ...
+def camera_from_file(path: str) -> str: ...
+def camera_thesis() -> str: ...
+def camera_check(cam: CamSpec) -> None: ...
+def metric(cam: CamSpec, omega: F64, velocity: F64, plane_: Optional[F64], method: str) -> F64: ...
 def series(
-    cam: CamTuple,
+    cam: CamSpec,
     t: F64,
     omega: F64,
     velocity: Optional[F64],
@@ -23,7 +24,7 @@ def series(
     method: str,
 ) -> F64: ...
 def frames(
-    cam: CamTuple, t: F64, omega: F64, t_start: F64, exposure_s: F64, readout_s: Optional[F64], method: str
+    cam: CamSpec, t: F64, omega: F64, t_start: F64, exposure_s: F64, readout_s: Optional[F64], method: str
 ) -> Tuple[F64, F64, F64]: ...
 def read_gyro(
     path: str,
@@ -34,10 +35,10 @@ def read_gyro(
     topic: Optional[str],
 ) -> Dict[str, F64]: ...
 def flow_field(
-    cam: CamTuple, omega: Sequence[float], velocity: Sequence[float], plane_: Optional[F64], backend_: str
+    cam: CamSpec, omega: Sequence[float], velocity: Sequence[float], plane_: Optional[F64], backend_: str
 ) -> F32: ...
 def render(
-    cam: CamTuple,
+    cam: CamSpec,
     target: str,
     distance: float,
     tilt: Sequence[float],

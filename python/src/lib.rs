@@ -4,6 +4,9 @@
 //! library with the GIL released, and returns NumPy arrays. Library errors
 //! become `OSError` (files) or `ValueError` (everything else).
 
+mod camera;
+
+use camera::{camera, camera_json};
 use glam::DVec3;
 use mmbm::camera::Camera;
 use mmbm::gpu::Backend;
@@ -19,78 +22,11 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::path::PathBuf;
 
-/// The camera as the Python half passes it: the pinhole intrinsics and the
-/// real-camera parts of SPEC 9 as a JSON object ([`Extras`]). The sides are
-/// taken as `i64` and checked by the library ([`Camera::size_from`]), so a
-/// negative one is a `ValueError` that names the resolution.
-type CamTuple = (f64, f64, f64, i64, i64, f64, f64, f64, String);
-
-/// The camera file's real-camera keys (rolling shutter, distortion, noise, lens).
-#[derive(serde::Serialize, serde::Deserialize, Default)]
-#[serde(deny_unknown_fields, default)]
-struct Extras {
-    readout_s: f64,
-    readout_direction: mmbm::camera::Readout,
-    distortion: mmbm::camera::Distortion,
-    noise: Option<mmbm::camera::Noise>,
-    lens: Option<mmbm::camera::Lens>,
-}
-
 fn err(e: mmbm::Error) -> PyErr {
     match e {
         mmbm::Error::Io { .. } => PyOSError::new_err(e.to_string()),
         _ => PyValueError::new_err(e.to_string()),
     }
-}
-
-fn camera(c: CamTuple) -> PyResult<Camera> {
-    let (focal_mm, pitch_x_mm, pitch_y_mm, width, height, cx, cy, skew, extras) = c;
-    let (width, height) = Camera::size_from(width, height).map_err(err)?;
-    let x: Extras = if extras.is_empty() {
-        Extras::default()
-    } else {
-        serde_json::from_str(&extras).map_err(|e| PyValueError::new_err(format!("camera: {e}")))?
-    };
-    let cam = Camera {
-        focal_mm,
-        pitch_x_mm,
-        pitch_y_mm,
-        width,
-        height,
-        cx,
-        cy,
-        skew,
-        distortion: x.distortion,
-        shutter: mmbm::camera::Shutter {
-            readout_s: x.readout_s,
-            direction: x.readout_direction,
-        },
-        noise: x.noise,
-        lens: x.lens,
-    };
-    cam.validate().map_err(err)?;
-    Ok(cam)
-}
-
-fn cam_tuple(c: &Camera) -> CamTuple {
-    (
-        c.focal_mm,
-        c.pitch_x_mm,
-        c.pitch_y_mm,
-        c.width as i64,
-        c.height as i64,
-        c.cx,
-        c.cy,
-        c.skew,
-        serde_json::to_string(&Extras {
-            readout_s: c.shutter.readout_s,
-            readout_direction: c.shutter.direction,
-            distortion: c.distortion,
-            noise: c.noise,
-            lens: c.lens,
-        })
-        .unwrap_or_default(),
-    )
 }
 
 fn plane(p: Option<PyReadonlyArray1<f64>>) -> PyResult<Option<Plane>> {
@@ -116,22 +52,23 @@ fn rows3(a: &PyReadonlyArray2<f64>) -> PyResult<Vec<DVec3>> {
         .collect())
 }
 
-/// Reads a camera file (TOML or JSON): the tuple the Python `Camera` holds.
+/// Reads a camera file (TOML or JSON): its every key, as JSON (the fields
+/// of the Python `Camera`).
 #[pyfunction]
-fn camera_from_file(path: PathBuf) -> PyResult<CamTuple> {
-    Ok(cam_tuple(&Camera::load(&path).map_err(err)?))
+fn camera_from_file(path: PathBuf) -> PyResult<String> {
+    camera_json(&Camera::load(&path).map_err(err)?)
 }
 
-/// The thesis camera.
+/// The thesis camera's every key, as JSON.
 #[pyfunction]
-fn camera_thesis() -> CamTuple {
-    cam_tuple(&Camera::thesis())
+fn camera_thesis() -> PyResult<String> {
+    camera_json(&Camera::thesis())
 }
 
-/// Validates a camera tuple.
+/// Validates a camera dict.
 #[pyfunction]
-fn camera_check(cam: CamTuple) -> PyResult<()> {
-    camera(cam).map(|_| ())
+fn camera_check(cam: Bound<'_, PyDict>) -> PyResult<()> {
+    camera(&cam).map(|_| ())
 }
 
 /// MMBM (mm/s) of each row of `omega` with the matching row of `velocity`.
@@ -139,14 +76,14 @@ fn camera_check(cam: CamTuple) -> PyResult<()> {
 #[pyo3(signature = (cam, omega, velocity, plane_, method))]
 fn metric<'py>(
     py: Python<'py>,
-    cam: CamTuple,
+    cam: Bound<'py, PyDict>,
     omega: PyReadonlyArray2<'py, f64>,
     velocity: PyReadonlyArray2<'py, f64>,
     plane_: Option<PyReadonlyArray1<'py, f64>>,
     method: &str,
 ) -> PyResult<Bound<'py, numpy::PyArray1<f64>>> {
     let scene = Scene {
-        camera: camera(cam)?,
+        camera: camera(&cam)?,
         plane: plane(plane_)?,
     };
     let method: AnyMethod = method.parse().map_err(err)?;
@@ -193,7 +130,7 @@ fn log_samples(t: &[f64], w: &[DVec3], v: Option<&[DVec3]>, d: Option<&[f64]>) -
 #[allow(clippy::too_many_arguments, clippy::type_complexity)]
 fn frames<'py>(
     py: Python<'py>,
-    cam: CamTuple,
+    cam: Bound<'py, PyDict>,
     t: PyReadonlyArray1<'py, f64>,
     omega: PyReadonlyArray2<'py, f64>,
     t_start: PyReadonlyArray1<'py, f64>,
@@ -215,7 +152,7 @@ fn frames<'py>(
             readout_s: rs.map(|r| r[k]),
         })
         .collect();
-    let cam = camera(cam)?;
+    let cam = camera(&cam)?;
     let opts = mmbm::series::SeriesOptions {
         scene: Scene {
             camera: cam,
@@ -252,7 +189,7 @@ fn frames<'py>(
 #[allow(clippy::too_many_arguments)]
 fn series<'py>(
     py: Python<'py>,
-    cam: CamTuple,
+    cam: Bound<'py, PyDict>,
     t: PyReadonlyArray1<'py, f64>,
     omega: PyReadonlyArray2<'py, f64>,
     velocity: Option<PyReadonlyArray2<'py, f64>>,
@@ -269,7 +206,7 @@ fn series<'py>(
     let samples = log_samples(t.as_slice()?, &w, v.as_deref(), d.as_deref());
     let opts = mmbm::series::SeriesOptions {
         scene: Scene {
-            camera: camera(cam)?,
+            camera: camera(&cam)?,
             plane: plane(plane_)?,
         },
         method: method.parse().map_err(err)?,
@@ -312,7 +249,8 @@ fn read_gyro<'py>(
         d.set_item("readout_s", r.readout_s)?;
         if let Some(dir) = r.direction {
             // The camera files' name of the direction, e.g. "top-to-bottom".
-            let name = serde_json::to_value(dir).map_err(|e| PyValueError::new_err(e.to_string()))?;
+            let name =
+                serde_json::to_value(dir).map_err(|e| PyValueError::new_err(e.to_string()))?;
             d.set_item("readout_direction", name.as_str().unwrap_or_default())?;
         }
     }
@@ -351,14 +289,14 @@ fn backend(b: &str) -> PyResult<Backend> {
 #[pyo3(signature = (cam, omega, velocity, plane_, backend_))]
 fn flow_field<'py>(
     py: Python<'py>,
-    cam: CamTuple,
+    cam: Bound<'py, PyDict>,
     omega: [f64; 3],
     velocity: [f64; 3],
     plane_: Option<PyReadonlyArray1<'py, f64>>,
     backend_: &str,
 ) -> PyResult<Bound<'py, numpy::PyArray3<f32>>> {
     let scene = Scene {
-        camera: camera(cam)?,
+        camera: camera(&cam)?,
         plane: plane(plane_)?,
     };
     let tw = Twist::new(DVec3::from(omega), DVec3::from(velocity));
@@ -384,7 +322,7 @@ fn flow_field<'py>(
 #[allow(clippy::too_many_arguments)]
 fn render<'py>(
     py: Python<'py>,
-    cam: CamTuple,
+    cam: Bound<'py, PyDict>,
     target: &str,
     distance: f64,
     tilt: [f64; 2],
@@ -403,7 +341,7 @@ fn render<'py>(
     maps: bool,
     sharp: bool,
 ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
-    let camera = camera(cam)?;
+    let camera = camera(&cam)?;
     // A rolling shutter's lines are exposed one after another: the motion
     // spans the readout plus the exposure (as in `mmbm render`).
     let span = exposure + camera.shutter.readout_s;
@@ -603,7 +541,10 @@ fn _mmbm(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("DEFAULT_DELAY_S", CameraTiming::DEFAULT_DELAY_S)?;
     m.add("DEFAULT_EXPOSURE_S", CameraTiming::DEFAULT_EXPOSURE_S)?;
     m.add("DEFAULT_READOUT_S", CameraTiming::DEFAULT_READOUT_S)?;
-    m.add("DEFAULT_MIN_INTERVAL_S", CameraTiming::DEFAULT_MIN_INTERVAL_S)?;
+    m.add(
+        "DEFAULT_MIN_INTERVAL_S",
+        CameraTiming::DEFAULT_MIN_INTERVAL_S,
+    )?;
     m.add("DEFAULT_PITCH_MM", CameraTiming::DEFAULT_PITCH_MM)?;
     Ok(())
 }

@@ -25,7 +25,8 @@
 //! (centre-to-centre distance, projected into pixels). Because expected
 //! centres are one pitch apart, a blob can match at most one of them.
 
-use crate::error::{finite, positive, Error, Result};
+use crate::check::{finite, positive};
+use crate::error::{Error, Result};
 use image::{GrayImage, Luma, RgbImage};
 use imageproc::region_labelling::{connected_components, Connectivity};
 use serde::Serialize;

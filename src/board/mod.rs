@@ -7,7 +7,8 @@ pub mod blobs;
 pub(crate) mod pose;
 
 use crate::camera::Camera;
-use crate::error::{finite, positive, Error, Result};
+use crate::check::{finite, positive};
+use crate::error::{Error, Result};
 use serde::Serialize;
 
 /// Linear RGB of the thesis board's red squares.

@@ -68,6 +68,17 @@ pub type Jac = [[f64; 2]; 2];
 const IDENTITY: Jac = [[1.0, 0.0], [0.0, 1.0]];
 
 impl Distortion {
+    /// A wide-angle module's OpenCV distortion (barrel `k1..k3` with
+    /// tangential `p1, p2`; the one of `tests/fixtures/camera/opencv.toml`):
+    /// the example the unit tests and the benchmarks share.
+    pub const WIDE_ANGLE: Distortion = Distortion::Opencv {
+        k1: -0.28,
+        k2: 0.07,
+        p1: 0.001,
+        p2: -0.0015,
+        k3: -0.008,
+    };
+
     /// True for the ideal pinhole.
     pub fn is_none(&self) -> bool {
         matches!(self, Distortion::None)
@@ -241,13 +252,7 @@ mod tests {
 
     fn models() -> Vec<Distortion> {
         vec![
-            Distortion::Opencv {
-                k1: -0.28,
-                k2: 0.07,
-                p1: 0.001,
-                p2: -0.0015,
-                k3: -0.008,
-            },
+            Distortion::WIDE_ANGLE,
             Distortion::Opencv {
                 k1: 0.12,
                 k2: -0.03,

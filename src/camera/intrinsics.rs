@@ -8,7 +8,8 @@ use super::distortion::{Distortion, Jac};
 use super::lens::Lens;
 use super::noise::Noise;
 use super::shutter::Shutter;
-use crate::error::{finite, positive, Error, Result};
+use crate::check::{finite, positive};
+use crate::error::{Error, Result};
 use serde::{Deserialize, Serialize};
 
 /// A camera: pinhole intrinsics plus, optionally, lens distortion, a rolling

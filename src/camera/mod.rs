@@ -2,8 +2,10 @@
 //! lens distortion (`distortion`), rolling shutter (`shutter`), sensor
 //! noise (`noise`), thin-lens defocus (`lens`), blur in px of an MMBM over
 //! an exposure (`blur`) and the files that describe
-//! them, Gyroflow lens profiles included (`file`). This layer imports
-//! nothing above `error`.
+//! them, Gyroflow lens profiles included (`file`: [`CameraFile`], the
+//! one camera representation of files, configurations, the command line and
+//! Python). This layer imports nothing above layer 0 (`error`, `check`, and
+//! `bounded` to read its files).
 
 pub(crate) mod blur;
 pub(crate) mod distortion;
@@ -15,6 +17,7 @@ pub(crate) mod shutter;
 
 pub use blur::{blur_px, checked_blur_px, checked_px_s, exposure_for_blur};
 pub use distortion::Distortion;
+pub use file::{CameraFile, CameraOverrides};
 pub use intrinsics::{Camera, SensorRect};
 pub use lens::Lens;
 pub use noise::Noise;

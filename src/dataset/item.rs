@@ -221,8 +221,10 @@ pub fn plan(cfg: &DatasetConfig, src: &Sources, i: u64) -> Result<ItemParams> {
     })
 }
 
+/// The items' camera: a configuration's camera with no `[camera]` keys
+/// (the thesis camera at `res`), as the experiment's is made.
 fn camera(res: [u32; 2]) -> Camera {
-    Camera::thesis().with_resolution(res[0], res[1])
+    crate::camera::CameraFile::default().thesis_at(res)
 }
 
 /// The samples an item's motion is a window of.

@@ -3,7 +3,7 @@
 //! the blob board walked towards from 6 m, the thesis policies and their
 //! successors.
 
-use crate::camera::{Distortion, Lens, Noise, Readout};
+use crate::camera::{CameraFile, Noise};
 use crate::error::{Error, Result};
 use crate::trigger::CameraTiming;
 use serde::{Deserialize, Serialize};
@@ -55,31 +55,12 @@ pub struct ExperimentConfig {
     pub sweep_exposures_s: Vec<f64>,
     /// Frames of the exposure sweep (the fixed-rate schedule's, evenly spread).
     pub sweep_frames: usize,
-    /// The real camera of SPEC section 9 (all off by default: the thesis's
-    /// ideal global-shutter pinhole).
-    pub camera: CameraSection,
-}
-
-/// The `[camera]` section: the thesis camera (focal length, pitch, at
-/// `resolution`) with any of the camera file's real-camera keys.
-#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct CameraSection {
-    /// Rolling-shutter readout, s (first to last line's exposure start).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub readout_s: Option<f64>,
-    /// Readout direction (default top-to-bottom).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub readout_direction: Option<Readout>,
-    /// Lens distortion.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub distortion: Option<Distortion>,
-    /// Sensor noise (a light level `phi_e_per_s` and the sensor's keys).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub noise: Option<Noise>,
-    /// Thin lens (defocus).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub lens: Option<Lens>,
+    /// The `[camera]` section: any of the camera file's keys
+    /// ([`CameraFile`]) over the thesis camera at `resolution`, e.g. the
+    /// real camera of SPEC section 9 (`readout_s`, `readout_direction`,
+    /// `[camera.distortion]`, `[camera.noise]`, `[camera.lens]`; all off by
+    /// default: the thesis's ideal global-shutter pinhole).
+    pub camera: CameraFile,
 }
 
 impl Default for ExperimentConfig {
@@ -120,7 +101,7 @@ impl Default for ExperimentConfig {
             max_frames_per_policy: 0,
             sweep_exposures_s: vec![0.01, 0.02, 0.035, 0.05, 0.07],
             sweep_frames: 12,
-            camera: CameraSection::default(),
+            camera: CameraFile::default(),
         }
     }
 }
@@ -157,13 +138,13 @@ impl ExperimentConfig {
     pub fn demo() -> Self {
         let d = Self::default();
         ExperimentConfig {
-            camera: CameraSection {
+            camera: CameraFile {
                 noise: Some(Noise {
                     seed: 1,
                     gain_dn_per_e: Some(255.0 / (Self::DEMO_LIGHT_E_PER_S * d.exposure_s)),
                     ..Noise::at_light(Self::DEMO_LIGHT_E_PER_S)
                 }),
-                ..CameraSection::default()
+                ..CameraFile::default()
             },
             ..d
         }
@@ -185,7 +166,7 @@ impl ExperimentConfig {
 
     /// Checks ranges (times positive, distances positive and ordered, a policy at least).
     pub fn validate(&self) -> Result<()> {
-        use crate::error::positive;
+        use crate::check::positive;
         positive("duration_s", self.duration_s)?;
         positive("rate_hz", self.rate_hz)?;
         let mut seeds = self.seeds.clone();
@@ -200,7 +181,7 @@ impl ExperimentConfig {
         positive("exposure_s", self.exposure_s)?;
         positive("start_distance_m", self.start_distance_m)?;
         positive("min_distance_m", self.min_distance_m)?;
-        crate::error::finite("speed_m_s", self.speed_m_s)?;
+        crate::check::finite("speed_m_s", self.speed_m_s)?;
         if self.min_distance_m > self.start_distance_m {
             return Err(Error::invalid(
                 "min_distance_m",
@@ -243,23 +224,9 @@ impl ExperimentConfig {
     }
 
     /// The camera: thesis focal length and pitch at `resolution`, with the
-    /// `[camera]` section's rolling shutter, distortion, noise and lens.
+    /// `[camera]` section's keys over it ([`CameraFile::thesis_at`]).
     pub fn camera(&self) -> crate::camera::Camera {
-        let mut c =
-            crate::camera::Camera::thesis().with_resolution(self.resolution[0], self.resolution[1]);
-        let s = &self.camera;
-        if let Some(r) = s.readout_s {
-            c.shutter.readout_s = r;
-        }
-        if let Some(d) = s.readout_direction {
-            c.shutter.direction = d;
-        }
-        if let Some(d) = s.distortion {
-            c.distortion = d;
-        }
-        c.noise = s.noise;
-        c.lens = s.lens;
-        c
+        self.camera.thesis_at(self.resolution)
     }
 
     /// The configuration as TOML (written into the report).
@@ -283,5 +250,48 @@ mod tests {
         // The ideal camera stays the experiment's default.
         assert!(ExperimentConfig::default().camera.noise.is_none());
         assert_eq!(ExperimentConfig::demo_full().camera.noise, Some(n));
+    }
+
+    #[test]
+    fn camera_sections_give_the_camera_they_always_gave() {
+        // The keys a `[camera]` section had before it was the camera file's schema.
+        let cfg: ExperimentConfig = toml::from_str(
+            "resolution = [320, 240]\n[camera]\nreadout_s = 0.012\n\
+             readout_direction = \"bottom-to-top\"\n\
+             [camera.distortion]\nmodel = \"fisheye\"\nk1 = 0.03\n\
+             [camera.noise]\nphi_e_per_s = 20000\n[camera.lens]\nf_number = 2\nfocus_m = 3\n",
+        )
+        .unwrap();
+        let mut want = crate::camera::Camera::thesis().with_resolution(320, 240);
+        want.shutter.readout_s = 0.012;
+        want.shutter.direction = crate::camera::Readout::BottomToTop;
+        want.distortion = crate::camera::Distortion::Fisheye {
+            k1: 0.03,
+            k2: 0.0,
+            k3: 0.0,
+            k4: 0.0,
+        };
+        want.noise = Some(Noise::at_light(20_000.0));
+        want.lens = Some(crate::camera::Lens {
+            f_number: 2.0,
+            focus_m: 3.0,
+        });
+        assert_eq!(cfg.camera(), want);
+        assert!(cfg.validate().is_ok());
+        // The camera file's other keys work there too, and the written
+        // configuration reads back to the same camera.
+        let other: ExperimentConfig =
+            toml::from_str("[camera]\nfocal_mm = 3.5\npitch_mm = 0.003\n").unwrap();
+        assert_eq!(other.camera().focal_mm, 3.5);
+        assert_eq!(other.camera().pitch_y_mm, 0.003);
+        for c in [
+            cfg,
+            other,
+            ExperimentConfig::demo(),
+            ExperimentConfig::default(),
+        ] {
+            let back: ExperimentConfig = toml::from_str(&c.to_toml()).unwrap();
+            assert_eq!(back.camera(), c.camera());
+        }
     }
 }

@@ -13,9 +13,13 @@
 //! - [`check_image_size`] refuses an image whose header claims more than
 //!   [`MAX_IMAGE_PIXELS`] before it is decoded; [`read_text`] reads a
 //!   configuration file of at most [`MAX_TEXT_BYTES`].
+//!
+//! The kind check and [`read_text`] live in `crate::bounded` (layer 0, so
+//! that the camera layer reads its files with the same caps) and are
+//! re-exported here.
 
+pub use crate::bounded::{is_regular_file, open_file, open_stream, read_text, MAX_TEXT_BYTES};
 use crate::error::{Error, Result};
-use std::fs::File;
 use std::io::{BufRead, Read};
 use std::path::{Path, PathBuf};
 
@@ -29,86 +33,6 @@ pub const MAX_HEADER_BYTES: usize = 16 << 20;
 /// Most pixels (width x height) an input image may declare to be decoded
 /// (16384 x 16384).
 pub const MAX_IMAGE_PIXELS: u64 = 1 << 28;
-
-/// Largest configuration file (TOML, JSON) read whole, bytes.
-pub const MAX_TEXT_BYTES: u64 = 64 << 20;
-
-fn refused(path: &Path, message: String) -> Error {
-    Error::io(
-        path,
-        std::io::Error::new(std::io::ErrorKind::InvalidInput, message),
-    )
-}
-
-/// What a file type is, in words.
-fn kind(ft: std::fs::FileType) -> &'static str {
-    use std::os::unix::fs::FileTypeExt;
-    if ft.is_dir() {
-        "a directory"
-    } else if ft.is_char_device() {
-        "a character device"
-    } else if ft.is_block_device() {
-        "a block device"
-    } else if ft.is_socket() {
-        "a socket"
-    } else if ft.is_fifo() {
-        "a pipe"
-    } else {
-        "not a regular file"
-    }
-}
-
-/// Checks the kind of what `path` names (links followed): a regular file,
-/// or a pipe when `pipe` is allowed.
-fn check_kind(path: &Path, pipe: bool) -> Result<()> {
-    use std::os::unix::fs::FileTypeExt;
-    let ft = std::fs::metadata(path)
-        .map_err(|e| Error::io(path, e))?
-        .file_type();
-    if ft.is_file() || (pipe && ft.is_fifo()) {
-        return Ok(());
-    }
-    let want = if pipe {
-        "a regular file or a pipe"
-    } else {
-        "a regular file"
-    };
-    Err(refused(path, format!("is {}: expected {want}", kind(ft))))
-}
-
-/// True when `path` names a regular file (links followed).
-pub fn is_regular_file(path: &Path) -> bool {
-    std::fs::metadata(path).is_ok_and(|m| m.is_file())
-}
-
-/// Opens a regular file for reading (anything else is refused unopened).
-pub fn open_file(path: &Path) -> Result<File> {
-    check_kind(path, false)?;
-    File::open(path).map_err(|e| Error::io(path, e))
-}
-
-/// Opens a regular file or a pipe for reading, as a stream.
-pub fn open_stream(path: &Path) -> Result<File> {
-    check_kind(path, true)?;
-    File::open(path).map_err(|e| Error::io(path, e))
-}
-
-/// Reads a whole text file (a configuration) of at most [`MAX_TEXT_BYTES`]
-/// from a regular file or a pipe.
-pub fn read_text(path: &Path) -> Result<String> {
-    let mut s = String::new();
-    open_stream(path)?
-        .take(MAX_TEXT_BYTES + 1)
-        .read_to_string(&mut s)
-        .map_err(|e| Error::io(path, e))?;
-    if s.len() as u64 > MAX_TEXT_BYTES {
-        return Err(refused(
-            path,
-            format!("longer than {MAX_TEXT_BYTES} bytes, the most read"),
-        ));
-    }
-    Ok(s)
-}
 
 /// The error for line `line` of `path` longer than `cap` bytes.
 pub fn line_too_long(path: &Path, line: u64, cap: usize) -> Error {

@@ -1,7 +1,8 @@
 //! Camera twist (angular + linear velocity in the camera frame) and the scene plane.
 
 use crate::camera::Camera;
-use crate::error::{finite, Error, Result};
+use crate::check::finite;
+use crate::error::{Error, Result};
 use glam::DVec3;
 
 /// Instantaneous camera motion in the camera frame (x right, y down, z forward).

@@ -83,7 +83,7 @@ pub fn arrows(camera: &Camera, u: &[f32], v: &[f32], exposure_s: f64) -> Result<
             ),
         ));
     }
-    crate::error::positive("exposure (s)", exposure_s)?;
+    crate::check::positive("exposure (s)", exposure_s)?;
     let nx = ARROWS_PER_ROW.min(camera.width).max(1);
     let ny = ((nx as f64 * h as f64 / w as f64).round() as u32).clamp(1, camera.height);
     let spacing = (w as f64 / nx as f64).min(h as f64 / ny as f64);

@@ -54,7 +54,7 @@ pub const MAX_TABLE: u64 = 1 << 21;
 /// the camera's readout plus the exposure (first line's exposure start to the
 /// last line's exposure end).
 fn check_timing(job: &RenderJob) -> Result<()> {
-    crate::error::positive("exposure", job.exposure_s)?;
+    crate::check::positive("exposure", job.exposure_s)?;
     let readout = job.camera.shutter.readout_s;
     let span = readout + job.exposure_s;
     let dur = job.trajectory.duration();

@@ -6,7 +6,8 @@
 //! camera at time `t` as `q(t)^-1 (X - c(t))`. Body-frame kinematics:
 //! `dR/dt = R [w]x`, `dc/dt = R v` (w rad/s, v m/s, t s).
 
-use crate::error::{positive, Error, Result};
+use crate::check::positive;
+use crate::error::{Error, Result};
 use crate::io::gyro::GyroSample;
 use crate::model::log::{check_times, is_gap, median_interval, min_interval, ImuLog};
 use crate::model::motion::Twist;
@@ -130,7 +131,7 @@ impl Trajectory {
         use_velocity: bool,
     ) -> Result<Self> {
         positive("exposure (s)", duration)?;
-        crate::error::finite("exposure start --at (s)", t0)?;
+        crate::check::finite("exposure start --at (s)", t0)?;
         let (first, last) = match (samples.first(), samples.last()) {
             (Some(a), Some(b)) if samples.len() >= 2 => (a.t, b.t),
             _ => {

@@ -9,7 +9,7 @@ use crate::io::gyro::GyroSample;
 
 /// The GPU twists of a batch of gyro samples under `opts` (each sample
 /// checked by [`sample_scene`]).
-pub fn batch_twists(batch: &[GyroSample], opts: &SeriesOptions) -> Result<Vec<TwistGpu>> {
+pub fn batch_twists<M>(batch: &[GyroSample], opts: &SeriesOptions<M>) -> Result<Vec<TwistGpu>> {
     let f = opts.scene.camera.focal_mm;
     batch
         .iter()
@@ -22,8 +22,13 @@ pub fn batch_twists(batch: &[GyroSample], opts: &SeriesOptions) -> Result<Vec<Tw
 
 /// A series batch evaluator on the GPU: MMBM (mm/s) of each sample on a
 /// `w x h` grid of cell centres (`0 x 0`: sensor resolution), the whole
-/// batch in one dispatch (or a few, for large grids).
-pub fn series_evaluator(opts: SeriesOptions, w: u32, h: u32) -> Result<Box<BatchFn<'static>>> {
+/// batch in one dispatch (or a few, for large grids). The options' method,
+/// of any type `M`, is not used.
+pub fn series_evaluator<M: Send + 'static>(
+    opts: SeriesOptions<M>,
+    w: u32,
+    h: u32,
+) -> Result<Box<BatchFn<'static>>> {
     opts.scene.camera.validate()?;
     let grid = Grid::new(&opts.scene.camera, w, h)?;
     let mut runner = FlowRunner::new()?;

@@ -12,7 +12,7 @@ pub mod gpu;
 
 use crate::error::{Error, Result};
 use crate::io::gyro::{GyroReader, GyroSample};
-use crate::metric::{Evaluator, Method, Scene};
+use crate::metric::{AnyMethod, Evaluator, Method, Scene};
 use crate::model::motion::{Plane, Twist};
 use rayon::prelude::*;
 use std::io::Write;
@@ -20,13 +20,15 @@ use std::io::Write;
 /// Samples evaluated per batch (also the GPU batch size).
 pub const BATCH: usize = 16_384;
 
-/// Options of a series run.
+/// Options of a series run. `M` is the method's type: a CPU [`Method`]
+/// (the default, for the evaluations that run only on the CPU) or an
+/// [`AnyMethod`], which may also name the GPU ([`evaluator`]).
 #[derive(Debug, Clone, Copy)]
-pub struct SeriesOptions {
+pub struct SeriesOptions<M = Method> {
     /// Camera and (optional) fixed scene plane.
     pub scene: Scene,
     /// Metric method.
-    pub method: Method,
+    pub method: M,
     /// Use the log's `vx, vy, vz` (and `depth` when present, else the scene plane).
     /// Off by default: the thesis metric is rotation-only.
     pub use_velocity: bool,
@@ -36,7 +38,7 @@ pub struct SeriesOptions {
 /// `use_velocity`; then the sample's `depth` (a fronto-parallel plane) or
 /// the options' plane, checked against the twist (errors name the sample's
 /// time).
-pub fn sample_scene(s: &GyroSample, opts: &SeriesOptions) -> Result<(Twist, Scene)> {
+pub fn sample_scene<M>(s: &GyroSample, opts: &SeriesOptions<M>) -> Result<(Twist, Scene)> {
     if !opts.use_velocity {
         return Ok((
             Twist::new(s.omega, glam::DVec3::ZERO),
@@ -127,6 +129,22 @@ pub fn mmbm_series_with(samples: &[GyroSample], opts: &SeriesOptions) -> Result<
 
 /// A batch evaluator: CPU methods, or a GPU one supplied by the caller.
 pub type BatchFn<'a> = dyn FnMut(&[GyroSample]) -> Result<Vec<f64>> + 'a;
+
+/// The batch evaluator of `opts`' method: [`eval_batch_cpu`] for a CPU
+/// rule, [`gpu::series_evaluator`] on its grid for `gpu[:WxH]`.
+pub fn evaluator(opts: SeriesOptions<AnyMethod>) -> Result<Box<BatchFn<'static>>> {
+    match opts.method {
+        AnyMethod::Gpu { width, height } => gpu::series_evaluator(opts, width, height),
+        AnyMethod::Cpu(method) => {
+            let cpu = SeriesOptions {
+                scene: opts.scene,
+                method,
+                use_velocity: opts.use_velocity,
+            };
+            Ok(Box::new(move |b: &[GyroSample]| eval_batch_cpu(b, &cpu)))
+        }
+    }
+}
 
 /// Streams `reader` through `eval` in batches of [`BATCH`] and writes the CSV.
 /// Parsing runs on a second thread, overlapped with evaluation and

@@ -127,8 +127,8 @@ pub fn simulate(
 /// the same checks (at most [`MAX_SAMPLES`]).
 pub fn samples(cfg: &GaitConfig, duration_s: f64, rate_hz: f64, seed: u64) -> Result<Samples> {
     cfg.validate()?;
-    crate::error::positive("duration", duration_s)?;
-    crate::error::positive("rate", rate_hz)?;
+    crate::check::positive("duration", duration_s)?;
+    crate::check::positive("rate", rate_hz)?;
     let n_f = (duration_s * rate_hz).round();
     if n_f < 2.0 {
         return Err(Error::invalid(

@@ -199,14 +199,14 @@ impl GaitConfig {
     /// non-negative as their meaning requires), naming the bad one.
     pub fn validate(&self) -> Result<()> {
         let nonneg = |what: &str, x: f64| -> Result<()> {
-            crate::error::finite(what, x)?;
+            crate::check::finite(what, x)?;
             if x < 0.0 {
                 return Err(Error::invalid(what, format!("must be >= 0, got {x}")));
             }
             Ok(())
         };
         nonneg("speed_m_s", self.speed_m_s)?;
-        crate::error::positive("step_hz", self.step_hz)?;
+        crate::check::positive("step_hz", self.step_hz)?;
         if self.step_hz > MAX_STEP_HZ {
             return Err(Error::invalid(
                 "step_hz",
@@ -226,12 +226,12 @@ impl GaitConfig {
         nonneg("amplitude_jitter", self.amplitude_jitter)?;
         for j in 0..3 {
             nonneg(&format!("sway[{j}]"), self.sway[j])?;
-            crate::error::finite(&format!("sway_phase[{j}]"), self.sway_phase[j])?;
+            crate::check::finite(&format!("sway_phase[{j}]"), self.sway_phase[j])?;
             nonneg(&format!("touchdown[{j}]"), self.touchdown[j])?;
-            crate::error::finite(&format!("bias[{j}]"), self.bias[j])?;
+            crate::check::finite(&format!("bias[{j}]"), self.bias[j])?;
         }
-        crate::error::positive("touchdown_decay_s", self.touchdown_decay_s)?;
-        crate::error::positive("touchdown_freq_hz", self.touchdown_freq_hz)?;
+        crate::check::positive("touchdown_decay_s", self.touchdown_decay_s)?;
+        crate::check::positive("touchdown_freq_hz", self.touchdown_freq_hz)?;
         nonneg("noise_std", self.noise_std)?;
         nonneg("bob_m", self.bob_m)?;
         nonneg("surge", self.surge)?;

@@ -109,7 +109,7 @@ impl Live {
     /// `mmbm_mm_s` and returns what it produced: a trigger at it, and frames
     /// whose exposure it completed.
     pub fn push(&mut self, t: f64, mmbm_mm_s: f64) -> Result<Vec<Event>> {
-        crate::error::finite("sample time", t)?;
+        crate::check::finite("sample time", t)?;
         crate::model::log::check_resolution(t, self.timing.exposure, "the exposure")?;
         if let Some(prev) = self.last_time() {
             if t <= prev {

@@ -278,7 +278,7 @@ impl Stream {
     ) -> Result<StreamOutcome> {
         let idle = match idle_exit {
             Some(s) => Some(pace::due(
-                crate::error::positive("UDP idle time (s)", s)?,
+                crate::check::positive("UDP idle time (s)", s)?,
                 1.0,
             )),
             None => None,

@@ -61,14 +61,14 @@ impl CameraTiming {
 
     /// Checks that the times are finite, the exposure positive and the others non-negative.
     pub fn validate(&self) -> Result<()> {
-        crate::error::positive("exposure", self.exposure)?;
-        crate::error::positive("pixel pitch (mm)", self.pitch_mm)?;
+        crate::check::positive("exposure", self.exposure)?;
+        crate::check::positive("pixel pitch (mm)", self.pitch_mm)?;
         for (what, x) in [
             ("delay", self.delay),
             ("readout", self.readout),
             ("min-interval", self.min_interval),
         ] {
-            crate::error::finite(what, x)?;
+            crate::check::finite(what, x)?;
             if x < 0.0 {
                 return Err(Error::invalid(what, format!("must be >= 0 s, got {x}")));
             }
