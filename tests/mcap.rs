@@ -73,6 +73,35 @@ fn damaged_files_are_errors() {
     let _ = read_log(&p, with_topic("/imu/data"));
 }
 
+/// Bits flipped in the fixture's compressed chunks can decode to a record
+/// that claims an exabyte: that is an error naming the file, not an
+/// allocation of the claimed size (which aborted the process).
+#[test]
+fn a_damaged_record_length_is_an_error_not_an_allocation() {
+    let bytes = std::fs::read(fixture("imu.mcap")).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join("huge.mcap");
+    let mut damaged = bytes;
+    for (at, bit) in [(10720, 64u8), (11949, 64), (4485, 1), (8925, 128)] {
+        damaged[at] ^= bit;
+    }
+    std::fs::write(&p, &damaged).unwrap();
+    let o = mmbm(&[
+        "series",
+        "--gyro",
+        p.to_str().unwrap(),
+        "--topic",
+        "/imu/data",
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("huge.mcap") && err.contains("MCAP record near message"),
+        "{err}"
+    );
+    assert!(o.stdout.is_empty());
+}
+
 #[test]
 fn every_gyro_command_takes_mcap() {
     let bag = fixture("imu.mcap");

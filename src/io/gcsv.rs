@@ -29,20 +29,25 @@
 //! - `frame_readout_time` is in milliseconds; [`GcsvHeader::readout_s`] is in
 //!   seconds. Other header keys are kept in [`GcsvHeader::fields`], unread.
 //!
-//! [`CsvStream`] turns the file into gyro CSV text (`t,wx,wy,wz`, s and
-//! rad/s, camera frame, shortest round-trip decimals) one line at a time, so
-//! that [`super::gyro::GyroReader`] applies its checks and options (order,
-//! gaps, `--imu-rotation` after the orientation, `--time-offset`) in constant
-//! memory. Each header line becomes a `#` comment line, so line numbers in the
-//! CSV are line numbers in the `.gcsv` file; a bad row is reported by the
-//! stream itself, naming the file, its line and the `.gcsv` column.
+//! [`GcsvReader`] yields the rows as samples (s, rad/s, camera frame) one
+//! line at a time, each with its line in the file, so that
+//! [`super::gyro::GyroReader`] applies its checks and options (order, gaps,
+//! `--imu-rotation` after the orientation, `--time-offset`) in constant
+//! memory, with no text in between; a bad row is reported by the reader
+//! itself, naming the file, its line and the `.gcsv` column. The head
+//! (magic line, header, column line) is read in small steps (`gcsv/head.rs`).
 
-use super::input::{line_too_long, open_stream, read_line, Line, MAX_HEADER_BYTES, MAX_LINE_BYTES};
+mod head;
+mod rows;
+
+use super::input::{check_increasing, line_too_long, open_stream, read_line, Line, MAX_LINE_BYTES};
 use crate::error::{quote, Error, Result};
 use glam::{DMat3, DVec3};
+use head::read_head;
+pub use rows::{GcsvReader, GcsvRow};
 use std::fs::File;
 use std::io::{BufRead, BufReader, Read};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// The first line of a `.gcsv` file (either form).
 pub const MAGIC: [&str; 2] = ["GYROFLOW IMU LOG", "CAMERA IMU LOG"];
@@ -234,381 +239,35 @@ fn utf8<'a>(bytes: &'a [u8], path: &Path, line: u64) -> Result<&'a str> {
         .map_err(|_| parse_err(path, line, "-", "the line is not UTF-8 text".into()))
 }
 
-/// Reads the magic line, the header and the column line. Returns the header,
-/// the columns and the number of lines read (the column line's number).
-fn read_head<R: BufRead>(src: &mut R, path: &Path) -> Result<(GcsvHeader, Columns, u64)> {
-    let mut buf = Vec::new();
-    if !next_line(src, &mut buf, path, 1)? || !is_magic(&buf) {
-        return Err(parse_err(
-            path,
-            1,
-            "-",
-            format!(
-                "not a Gyroflow IMU log: the first line must be '{}' or '{}'",
-                MAGIC[0], MAGIC[1]
-            ),
-        ));
-    }
-    let mut line = 1u64;
-    // (key, value, line)
-    let mut fields: Vec<(String, String, u64)> = Vec::new();
-    let mut head_bytes = buf.len();
-    let columns = loop {
-        if head_bytes > MAX_HEADER_BYTES {
-            return Err(parse_err(
-                path,
-                line,
-                "-",
-                format!("the header (before the column line) is longer than {MAX_HEADER_BYTES} bytes, the most read"),
-            ));
-        }
-        if !next_line(src, &mut buf, path, line + 1)? {
-            return Err(parse_err(
-                path,
-                line,
-                "-",
-                "the file ends before the column line (t,gx,gy,gz,...)".into(),
-            ));
-        }
-        line += 1;
-        head_bytes += buf.len() + 1;
-        let text = utf8(&buf, path, line)?.trim();
-        if text.is_empty() || text.starts_with('#') {
-            continue;
-        }
-        let names: Vec<String> = text.split(',').map(|s| s.trim().to_string()).collect();
-        if names[0] == "t" || names[0] == "time" {
-            break names;
-        }
-        match text.split_once(',') {
-            Some((k, v)) => fields.push((k.trim().to_string(), v.trim().to_string(), line)),
-            None => {
-                return Err(parse_err(
-                    path,
-                    line,
-                    "-",
-                    format!(
-                    "{}: expected a 'key,value' header line or the column line (t,gx,gy,gz,...)",
-                    quote(text)
-                ),
-                ))
-            }
-        }
-    };
-    // Keys that are read must appear at most once.
-    let find = |key: &str| -> Result<Option<(&str, u64)>> {
-        let mut hits = fields.iter().filter(|(k, _, _)| k == key);
-        let first = hits.next();
-        if let (Some(a), Some(b)) = (first, hits.next()) {
-            return Err(parse_err(
-                path,
-                b.2,
-                key,
-                format!(
-                    "header key '{key}' appears twice (lines {} and {})",
-                    a.2, b.2
-                ),
-            ));
-        }
-        Ok(first.map(|(_, v, l)| (v.as_str(), *l)))
-    };
-    let scale = |key: &str, what: &str| -> Result<f64> {
-        let (v, l) = find(key)?.ok_or_else(|| {
-            parse_err(
-                path,
-                line,
-                key,
-                format!("missing header key '{key}' ({what}); it must come before the column line"),
-            )
-        })?;
-        match v.parse::<f64>() {
-            Ok(x) if x.is_finite() && x > 0.0 => Ok(x),
-            _ => Err(parse_err(
-                path,
-                l,
-                key,
-                format!("{} is not a finite number > 0", quote(v)),
-            )),
-        }
-    };
-    let tscale = scale("tscale", "seconds per unit of t")?;
-    let gscale = scale("gscale", "rad/s per unit of gx, gy, gz")?;
-    let orientation = match find("orientation")? {
-        Some((v, l)) => {
-            parse_orientation(v).map_err(|m| parse_err(path, l, "orientation", m))?;
-            v.to_string()
-        }
-        None => DEFAULT_ORIENTATION.to_string(),
-    };
-    let readout_s = match find("frame_readout_time")? {
-        Some(("", _)) => None,
-        Some((v, l)) => match v.parse::<f64>() {
-            Ok(ms) if ms.is_finite() && ms >= 0.0 => Some(ms / 1000.0),
-            _ => {
-                return Err(parse_err(
-                    path,
-                    l,
-                    "frame_readout_time",
-                    format!("{} is not a finite number >= 0 (ms)", quote(v)),
-                ))
-            }
-        },
-        None => None,
-    };
-    let readout_direction = match find("frame_readout_direction")? {
-        Some(("", _)) => None,
-        Some((v, l)) => Some(ReadoutDirection::from_gyroflow(v).ok_or_else(|| {
-            parse_err(
-                path,
-                l,
-                "frame_readout_direction",
-                format!(
-                    "{}: expected 0 (top to bottom), 1 (bottom to top), 2 (left to right) or 3 (right to left)",
-                    quote(v)
-                ),
-            )
-        })?),
-        None => None,
-    };
-    for n in ["t", "gx", "gy", "gz"] {
-        if columns.iter().filter(|c| *c == n).count() > 1 {
-            return Err(parse_err(
-                path,
-                line,
-                n,
-                format!("column '{n}' appears more than once in the column line"),
-            ));
-        }
-    }
-    let need = |n: &str| {
-        columns.iter().position(|c| c == n).ok_or_else(|| {
-            parse_err(
-                path,
-                line,
-                n,
-                format!(
-                    "missing column '{n}' (the column line is: {})",
-                    columns.join(",")
-                ),
-            )
-        })
-    };
-    let g = [need("gx")?, need("gy")?, need("gz")?];
-    let header = GcsvHeader {
-        readout_s,
-        readout_direction,
-        orientation,
-        tscale,
-        gscale,
-        fields: fields.into_iter().map(|(k, v, _)| (k, v)).collect(),
-    };
-    let cols = Columns {
-        names: columns,
-        t: 0,
-        g,
-    };
-    Ok((header, cols, line))
-}
-
 /// Reads the header of the `.gcsv` file at `path` (up to its column line).
 pub fn read_header(path: &Path) -> Result<GcsvHeader> {
     let mut src = BufReader::new(open_stream(path)?);
     read_head(&mut src, path).map(|(h, _, _)| h)
 }
 
-/// A `.gcsv` file as gyro CSV text, converted one line at a time: `#` for
+/// The whole file as gyro CSV text, one line per line of the file: `#` for
 /// each line before the column line, `t,wx,wy,wz`, then one row per sample
-/// (s, rad/s, camera frame, `{:?}` decimals: shortest round trip). Blank and
-/// `#` lines among the samples stay as `#` lines. A bad row (field count,
-/// non-number, non-finite value, time not increasing) ends the text with an
-/// I/O error that carries the [`Error`] (file, line, `.gcsv` column);
-/// [`super::gyro::GyroReader`] reports that error as it is.
-pub struct CsvStream {
-    path: PathBuf,
-    src: BufReader<File>,
-    header: GcsvHeader,
-    cols: Columns,
-    axes: Axes,
-    line: u64,
-    last_t: Option<(f64, u64)>,
-    buf: Vec<u8>,
-    out: Vec<u8>,
-    pos: usize,
-    err: Option<Error>,
-    eof: bool,
-}
-
-impl CsvStream {
-    /// Opens `path` and reads its header (errors name the file, line and key).
-    pub fn open(path: &Path) -> Result<Self> {
-        let mut src = BufReader::with_capacity(1 << 16, open_stream(path)?);
-        let (header, cols, line) = read_head(&mut src, path)?;
-        let axes = camera_axes(
-            &parse_orientation(&header.orientation)
-                .map_err(|m| Error::invalid("orientation", m))?,
-        );
-        let mut out = b"#\n".repeat(line.saturating_sub(1) as usize);
-        out.extend_from_slice(b"t,wx,wy,wz\n");
-        Ok(CsvStream {
-            path: path.into(),
-            src,
-            header,
-            cols,
-            axes,
-            line,
-            last_t: None,
-            buf: Vec::new(),
-            out,
-            pos: 0,
-            err: None,
-            eof: false,
-        })
-    }
-
-    /// The file's header.
-    pub fn header(&self) -> &GcsvHeader {
-        &self.header
-    }
-
-    /// Converts the next line into `out`.
-    fn convert_line(&mut self) -> Result<bool> {
-        if !next_line(&mut self.src, &mut self.buf, &self.path, self.line + 1)? {
-            return Ok(false);
-        }
-        self.line += 1;
-        let (path, line) = (self.path.as_path(), self.line);
-        let text = utf8(&self.buf, path, line)?.trim();
-        if text.is_empty() || text.starts_with('#') {
-            self.out.extend_from_slice(b"#\n");
-            return Ok(true);
-        }
-        let fields: Vec<&str> = text.split(',').map(str::trim).collect();
-        let names = &self.cols.names;
-        if fields.len() != names.len() {
-            return Err(parse_err(
-                path,
-                line,
-                &format!(
-                    "field count (expected {}, found {})",
-                    names.len(),
-                    fields.len()
-                ),
-                format!(
-                    "a row must have one field per column of the column line ({})",
-                    names.join(",")
-                ),
-            ));
-        }
-        let num = |i: usize, scale: f64| -> Result<f64> {
-            let s = fields[i];
-            let x: f64 = s.parse().map_err(|_| {
-                parse_err(
-                    path,
-                    line,
-                    &names[i],
-                    format!("{} is not a number", quote(s)),
-                )
-            })?;
-            if !x.is_finite() {
-                return Err(parse_err(
-                    path,
-                    line,
-                    &names[i],
-                    format!("{} is not finite", quote(s)),
-                ));
-            }
-            let y = x * scale;
-            if !y.is_finite() {
-                return Err(parse_err(
-                    path,
-                    line,
-                    &names[i],
-                    format!("{} times the scale {scale} overflows", quote(s)),
-                ));
-            }
-            Ok(y)
-        };
-        let t = num(self.cols.t, self.header.tscale)?;
-        let g = [
-            num(self.cols.g[0], self.header.gscale)?,
-            num(self.cols.g[1], self.header.gscale)?,
-            num(self.cols.g[2], self.header.gscale)?,
-        ];
-        if let Some((prev, prev_line)) = self.last_t {
-            if t <= prev {
-                return Err(parse_err(
-                    path,
-                    line,
-                    &names[self.cols.t],
-                    format!(
-                        "time {t} s is not after the previous sample's {prev} s (line {prev_line}): time must strictly increase"
-                    ),
-                ));
-            }
-        }
-        self.last_t = Some((t, line));
-        let w = self.axes.map(|(a, s)| s * g[a]);
-        self.out
-            .extend_from_slice(format!("{t:?},{:?},{:?},{:?}\n", w[0], w[1], w[2]).as_bytes());
-        Ok(true)
-    }
-
-    /// Refills `out` with at least 32 KiB of converted lines (less at the end
-    /// of the file or before an error, which is kept for the next read).
-    fn fill(&mut self) {
-        self.out.clear();
-        self.pos = 0;
-        while !self.eof && self.err.is_none() && self.out.len() < 1 << 15 {
-            match self.convert_line() {
-                Ok(true) => {}
-                Ok(false) => self.eof = true,
-                Err(e) => self.err = Some(e),
-            }
-        }
-    }
-}
-
-impl Read for CsvStream {
-    fn read(&mut self, dst: &mut [u8]) -> std::io::Result<usize> {
-        if self.pos == self.out.len() {
-            self.fill();
-        }
-        if self.pos < self.out.len() {
-            let n = dst.len().min(self.out.len() - self.pos);
-            dst[..n].copy_from_slice(&self.out[self.pos..self.pos + n]);
-            self.pos += n;
-            return Ok(n);
-        }
-        match self.err.take() {
-            Some(e) => {
-                self.eof = true;
-                Err(std::io::Error::other(e))
-            }
-            None => Ok(0),
-        }
-    }
-}
-
-/// The [`Error`] inside an I/O error made by [`CsvStream`], if it is one.
-pub fn unwrap_error(e: std::io::Error) -> std::result::Result<Error, std::io::Error> {
-    if !e.get_ref().is_some_and(|inner| inner.is::<Error>()) {
-        return Err(e);
-    }
-    match e.into_inner().map(|inner| inner.downcast::<Error>()) {
-        Some(Ok(err)) => Ok(*err),
-        Some(Err(other)) => Err(std::io::Error::other(other)),
-        None => Err(std::io::Error::other("I/O error")),
-    }
-}
-
-/// The whole file as gyro CSV text ([`CsvStream`], read to the end).
+/// (s, rad/s, camera frame, `{:?}` decimals: shortest round trip), with `#`
+/// for blank and `#` lines among the samples. Times must strictly increase.
+/// (The readers take the samples from [`GcsvReader`]; this text is for
+/// other tools.)
 pub fn to_csv(path: &Path) -> Result<String> {
-    let mut s = String::new();
-    CsvStream::open(path)?
-        .read_to_string(&mut s)
-        .map_err(|e| unwrap_error(e).unwrap_or_else(|e| Error::io(path, e)))?;
+    let mut r = GcsvReader::open(path)?;
+    let comments = |n: u64| "#\n".repeat(n as usize);
+    let mut s = comments(r.lines_read().saturating_sub(1));
+    s += "t,wx,wy,wz\n";
+    let mut written = r.lines_read();
+    let mut prev = None;
+    while let Some(row) = r.next_row()? {
+        check_increasing(path, row.line, r.time_column(), row.t, prev)?;
+        prev = Some((row.t, row.line));
+        s += &comments(row.line - written - 1);
+        let w = row.omega;
+        s += &format!("{:?},{:?},{:?},{:?}\n", row.t, w.x, w.y, w.z);
+        written = row.line;
+    }
+    s += &comments(r.lines_read() - written);
     Ok(s)
 }
-
 #[cfg(test)]
 mod tests;

@@ -1,18 +1,24 @@
 //! Gyro logs (SPEC section 5): a plain CSV with a header row, columns `t`
 //! (seconds by default), `wx, wy, wz` (rad/s by default), optional `vx, vy, vz`
 //! (m/s) and `depth` (m). Lines starting with `#` are comments. A ROS 2 MCAP
-//! file (`mcap`) or a Gyroflow `.gcsv` log (`gcsv`) is
-//! turned into the same CSV text first.
+//! file (`mcap`) or a Gyroflow `.gcsv` log ([`super::gcsv`]) is read
+//! by its own reader, which yields the samples directly (no text in between).
 //!
 //! [`GyroReader`] streams the file in constant memory and validates every
-//! field; errors name the file, line and column.
+//! field, the same way for every format; errors name the file, line and
+//! column.
 
+mod plain;
+
+use super::gcsv::GcsvReader;
+use super::input::check_increasing;
+use super::mcap::ImuStream;
 use crate::error::{Error, Result};
 pub use crate::model::log::GyroSample;
 use crate::model::log::{is_gap, ImuLog, LogReadout};
 use glam::{DMat3, DVec3};
+use plain::{CsvSource, Raw};
 use serde::{Deserialize, Serialize};
-use std::io::{BufReader, Read};
 use std::path::{Path, PathBuf};
 use std::str::FromStr;
 
@@ -163,17 +169,23 @@ pub fn parse_rotation(s: &str) -> Result<DMat3> {
     Ok(m)
 }
 
-/// Streaming, validating reader of a gyro CSV.
+/// Where a [`GyroReader`]'s samples come from.
+enum Source {
+    /// A plain gyro CSV (a file or standard input).
+    Csv(CsvSource),
+    /// A Gyroflow `.gcsv` log.
+    Gcsv(GcsvReader),
+    /// A ROS 2 MCAP log (line numbers: message number + 1).
+    Mcap(ImuStream),
+}
+
+/// Streaming, validating reader of a gyro log (CSV, `.gcsv` or MCAP): each
+/// source yields its samples directly; the options, the time order and the
+/// gap rule are applied here, the same for every source.
 pub struct GyroReader {
     path: PathBuf,
-    reader: csv::Reader<BufReader<Box<dyn Read + Send>>>,
+    source: Source,
     opts: GyroOptions,
-    idx_t: usize,
-    idx_w: [usize; 3],
-    idx_v: Option<[usize; 3]>,
-    idx_depth: Option<usize>,
-    names: Vec<String>,
-    record: csv::StringRecord,
     last_t: Option<(f64, u64)>,
     intervals: Vec<f64>,
     median_dt: Option<f64>,
@@ -188,101 +200,41 @@ impl GyroReader {
     /// checks the header.
     pub fn open(path: &Path, opts: GyroOptions) -> Result<Self> {
         let mut readout = None;
-        use super::input::{open_stream, LineCap, MAX_LINE_BYTES};
-        let (file, path): (Box<dyn Read + Send>, &Path) = if path.as_os_str() == "-" {
+        let own_units = |what: &str| -> Result<()> {
+            if opts.time_unit != TimeUnit::S || opts.angle_unit != AngleUnit::Rad {
+                return Err(Error::invalid(path.display().to_string(), what));
+            }
+            Ok(())
+        };
+        let (source, path) = if path.as_os_str() == "-" {
             let name = Path::new("<stdin>");
-            let stdin = LineCap::new(std::io::stdin(), name, MAX_LINE_BYTES);
-            (Box::new(stdin), name)
+            (
+                Source::Csv(CsvSource::open(Box::new(std::io::stdin()), name)?),
+                name,
+            )
         } else if super::mcap::is_mcap(path) {
-            if opts.time_unit != TimeUnit::S || opts.angle_unit != AngleUnit::Rad {
-                return Err(Error::invalid(
-                    path.display().to_string(),
-                    "an MCAP log holds ROS units (s, rad/s): leave --time-unit and --angle-unit at their defaults",
-                ));
-            }
-            // The messages become CSV text so that they pass the same
-            // checks (order, gaps) and options (rotation, offset) as a CSV
-            // log; a line number in an error is the message number + 1.
-            let messages = super::mcap::read_imu(path, opts.topic.as_deref())?;
-            let text = super::mcap::to_csv(&messages).into_bytes();
-            (Box::new(std::io::Cursor::new(text)), path)
+            own_units("an MCAP log holds ROS units (s, rad/s): leave --time-unit and --angle-unit at their defaults")?;
+            (
+                Source::Mcap(ImuStream::open(path, opts.topic.as_deref())?),
+                path,
+            )
         } else if super::gcsv::is_gcsv(path) {
-            if opts.time_unit != TimeUnit::S || opts.angle_unit != AngleUnit::Rad {
-                return Err(Error::invalid(
-                    path.display().to_string(),
-                    "a Gyroflow .gcsv log carries its own scales (tscale, gscale): leave --time-unit and --angle-unit at their defaults",
-                ));
-            }
-            // Converted to CSV one line at a time (constant memory), with
-            // the same line numbers; a bad row is reported by the stream.
-            let stream = super::gcsv::CsvStream::open(path)?;
-            let h = stream.header();
+            own_units("a Gyroflow .gcsv log carries its own scales (tscale, gscale): leave --time-unit and --angle-unit at their defaults")?;
+            let rows = GcsvReader::open(path)?;
+            let h = rows.header();
             readout = h.readout_s.map(|readout_s| LogReadout {
                 readout_s,
                 direction: h.readout_direction,
             });
-            (Box::new(stream), path)
+            (Source::Gcsv(rows), path)
         } else {
-            let file = LineCap::new(open_stream(path)?, path, MAX_LINE_BYTES);
-            (Box::new(file), path)
+            let file = super::input::open_stream(path)?;
+            (Source::Csv(CsvSource::open(Box::new(file), path)?), path)
         };
-        let mut reader = csv::ReaderBuilder::new()
-            .comment(Some(b'#'))
-            .trim(csv::Trim::All)
-            .flexible(false)
-            .from_reader(BufReader::with_capacity(1 << 16, file));
-        let headers = reader
-            .headers()
-            .map_err(|e| csv_error(path, e, "header"))?
-            .clone();
-        let names: Vec<String> = headers.iter().map(|s| s.to_string()).collect();
-        for n in ["t", "wx", "wy", "wz", "vx", "vy", "vz", "depth"] {
-            if names.iter().filter(|h| *h == n).count() > 1 {
-                return Err(Error::Parse {
-                    path: path.into(),
-                    line: 1,
-                    column: n.into(),
-                    message: format!("column '{n}' appears more than once in the header"),
-                });
-            }
-        }
-        let find = |n: &str| names.iter().position(|h| h == n);
-        let need = |n: &str| {
-            find(n).ok_or_else(|| Error::Parse {
-                path: path.into(),
-                line: 1,
-                column: n.into(),
-                message: format!(
-                    "missing required column '{n}' (header is: {})",
-                    names.join(",")
-                ),
-            })
-        };
-        let idx_t = need("t")?;
-        let idx_w = [need("wx")?, need("wy")?, need("wz")?];
-        let idx_v = match (find("vx"), find("vy"), find("vz")) {
-            (Some(a), Some(b), Some(c)) => Some([a, b, c]),
-            (None, None, None) => None,
-            _ => {
-                return Err(Error::Parse {
-                    path: path.into(),
-                    line: 1,
-                    column: "vx,vy,vz".into(),
-                    message: "velocity columns must come as all three of vx, vy, vz".into(),
-                })
-            }
-        };
-        let idx_depth = find("depth");
         Ok(GyroReader {
             path: path.into(),
-            reader,
+            source,
             opts,
-            idx_t,
-            idx_w,
-            idx_v,
-            idx_depth,
-            names,
-            record: csv::StringRecord::new(),
             last_t: None,
             intervals: Vec::new(),
             median_dt: None,
@@ -300,12 +252,12 @@ impl GyroReader {
 
     /// True when the log has `vx, vy, vz`.
     pub fn has_velocity(&self) -> bool {
-        self.idx_v.is_some()
+        matches!(&self.source, Source::Csv(c) if c.has_velocity())
     }
 
     /// True when the log has `depth`.
     pub fn has_depth(&self) -> bool {
-        self.idx_depth.is_some()
+        matches!(&self.source, Source::Csv(c) if c.has_depth())
     }
 
     /// Prints [`GyroReader::warnings`] on stderr, one `warning: ...` line each.
@@ -325,90 +277,69 @@ impl GyroReader {
         self.count
     }
 
-    fn field(&self, idx: usize, line: u64) -> Result<f64> {
-        let s = &self.record[idx];
-        let col = &self.names[idx];
-        let x: f64 = s.parse().map_err(|_| Error::Parse {
-            path: self.path.clone(),
-            line,
-            column: col.clone(),
-            message: format!("{} is not a number", crate::error::quote(s)),
-        })?;
-        if !x.is_finite() {
-            return Err(Error::Parse {
-                path: self.path.clone(),
-                line,
-                column: col.clone(),
-                message: format!("{} is not finite", crate::error::quote(s)),
-            });
+    /// The next sample of the source, in the file's units and axes.
+    fn next_raw(&mut self) -> Result<Option<Raw>> {
+        match &mut self.source {
+            Source::Csv(c) => c.next_raw(),
+            Source::Gcsv(g) => Ok(g.next_row()?.map(|r| Raw {
+                line: r.line,
+                t: r.t,
+                w: r.omega,
+                v: None,
+                depth: None,
+            })),
+            Source::Mcap(m) => match m.next().transpose()? {
+                Some(msg) => Ok(Some(Raw {
+                    line: m.messages_read() as u64 + 1,
+                    t: msg.t,
+                    w: msg.omega,
+                    v: None,
+                    depth: None,
+                })),
+                None => Ok(None),
+            },
         }
-        Ok(x)
+    }
+
+    /// The time column's name in the source.
+    fn time_column(&self) -> &str {
+        match &self.source {
+            Source::Csv(c) => c.time_column(),
+            Source::Gcsv(g) => g.time_column(),
+            Source::Mcap(_) => "t",
+        }
+    }
+
+    /// The line where the end of the source is (where "no samples" is reported).
+    fn end_line(&self) -> u64 {
+        match &self.source {
+            Source::Csv(c) => c.position_line(),
+            Source::Gcsv(g) => g.lines_read() + 1,
+            Source::Mcap(m) => m.messages_read() as u64 + 2,
+        }
     }
 
     fn next_sample(&mut self) -> Result<Option<GyroSample>> {
-        let more = self
-            .reader
-            .read_record(&mut self.record)
-            .map_err(|e| csv_error(&self.path, e, "record"))?;
-        if !more {
+        let Some(raw) = self.next_raw()? else {
             if self.count == 0 {
                 return Err(Error::Parse {
                     path: self.path.clone(),
-                    line: self.reader.position().line(),
+                    line: self.end_line(),
                     column: "-".into(),
                     message: "the log has no samples".into(),
                 });
             }
             return Ok(None);
+        };
+        let s = self.opts.sample(raw.t, raw.w, raw.v, raw.depth);
+        let line = raw.line;
+        check_increasing(&self.path, line, self.time_column(), s.t, self.last_t)?;
+        if let Some((prev, _)) = self.last_t {
+            self.check_gap(s.t - prev, s.t, line);
         }
-        let line = self.record.position().map_or(0, |p| p.line());
-        let t =
-            self.field(self.idx_t, line)? * self.opts.time_unit.seconds() + self.opts.time_offset;
-        let k = match self.opts.angle_unit {
-            AngleUnit::Rad => 1.0,
-            AngleUnit::Deg => std::f64::consts::PI / 180.0,
-        };
-        let w = DVec3::new(
-            self.field(self.idx_w[0], line)?,
-            self.field(self.idx_w[1], line)?,
-            self.field(self.idx_w[2], line)?,
-        ) * k;
-        let velocity = match self.idx_v {
-            Some(i) => Some(
-                self.opts.imu_to_camera
-                    * DVec3::new(
-                        self.field(i[0], line)?,
-                        self.field(i[1], line)?,
-                        self.field(i[2], line)?,
-                    ),
-            ),
-            None => None,
-        };
-        let depth = match self.idx_depth {
-            Some(i) => Some(self.field(i, line)?),
-            None => None,
-        };
-        if let Some((prev, prev_line)) = self.last_t {
-            if t <= prev {
-                return Err(Error::Parse {
-                    path: self.path.clone(),
-                    line,
-                    column: self.names[self.idx_t].clone(),
-                    message: format!(
-                        "time {t} s is not after the previous sample's {prev} s (line {prev_line}): time must strictly increase"
-                    ),
-                });
-            }
-            self.check_gap(t - prev, t, line);
-        }
-        self.last_t = Some((t, line));
+        self.last_t = Some((s.t, line));
         self.count += 1;
-        Ok(Some(GyroSample {
-            t,
-            omega: self.opts.imu_to_camera * w,
-            velocity,
-            depth,
-        }))
+        Ok(Some(s))
     }
 
     /// Gap detection in constant memory: the median of the first 101 intervals
@@ -459,34 +390,6 @@ impl Iterator for GyroReader {
                 Some(Err(e))
             }
         }
-    }
-}
-
-/// A CSV reader error as an [`Error`]; an error made by the source itself (a
-/// `.gcsv` row, see [`super::gcsv::CsvStream`]) is returned as it is.
-fn csv_error(path: &Path, e: csv::Error, what: &str) -> Error {
-    let (line, column) = match e.kind() {
-        csv::ErrorKind::UnequalLengths {
-            pos,
-            expected_len,
-            len,
-        } => (
-            pos.as_ref().map_or(0, |p| p.line()),
-            format!("field count (expected {expected_len}, found {len})"),
-        ),
-        _ => (e.position().map_or(0, |p| p.line()), what.to_string()),
-    };
-    let message = e.to_string();
-    if let csv::ErrorKind::Io(io) = e.into_kind() {
-        if let Ok(inner) = super::gcsv::unwrap_error(io) {
-            return inner;
-        }
-    }
-    Error::Parse {
-        path: path.into(),
-        line,
-        column,
-        message,
     }
 }
 

@@ -101,9 +101,9 @@ pub fn read_line(src: &mut dyn BufRead, buf: &mut Vec<u8>, cap: usize) -> std::i
 /// A byte stream (for a CSV reader) that ends with an error at a line
 /// longer than `cap` bytes. A line break inside a quoted CSV field does not
 /// end the line (quotes are counted, except on `#` comment lines), so a
-/// record cannot grow past the cap either. The error is an I/O error that
-/// carries an [`Error`] naming the file and the line (see
-/// [`super::gcsv::unwrap_error`]).
+/// record cannot grow past the cap either. The stream keeps the typed
+/// [`Error`] (naming the file and the line) for [`LineCap::take_error`];
+/// the I/O error it returns carries only that error's text.
 pub struct LineCap<R> {
     inner: R,
     path: PathBuf,
@@ -113,6 +113,7 @@ pub struct LineCap<R> {
     quoted: bool,
     comment: bool,
     start: bool,
+    error: Option<Error>,
 }
 
 impl<R: Read> LineCap<R> {
@@ -127,7 +128,13 @@ impl<R: Read> LineCap<R> {
             quoted: false,
             comment: false,
             start: true,
+            error: None,
         }
+    }
+
+    /// The error that ended the stream (a line over the cap), once.
+    pub fn take_error(&mut self) -> Option<Error> {
+        self.error.take()
     }
 }
 
@@ -154,12 +161,36 @@ impl<R: Read> Read for LineCap<R> {
             }
             self.run += 1;
             if self.run > self.cap {
-                return Err(std::io::Error::other(line_too_long(
-                    &self.path, self.line, self.cap,
-                )));
+                let e = line_too_long(&self.path, self.line, self.cap);
+                let text = e.to_string();
+                self.error = Some(e);
+                return Err(std::io::Error::other(text));
             }
         }
         Ok(n)
+    }
+}
+
+/// Checks that time `t` (s) of the sample on `line` comes after the previous
+/// sample's (`prev`: its time, s, and line); the error names the file, the
+/// line and the time column `column`.
+pub fn check_increasing(
+    path: &Path,
+    line: u64,
+    column: &str,
+    t: f64,
+    prev: Option<(f64, u64)>,
+) -> Result<()> {
+    match prev {
+        Some((prev, prev_line)) if t <= prev => Err(Error::Parse {
+            path: path.into(),
+            line,
+            column: column.into(),
+            message: format!(
+                "time {t} s is not after the previous sample's {prev} s (line {prev_line}): time must strictly increase"
+            ),
+        }),
+        _ => Ok(()),
     }
 }
 

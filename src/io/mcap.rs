@@ -11,14 +11,18 @@
 //! - Topic: the one asked for, or the only topic with `sensor_msgs/msg/Imu`
 //!   messages; any other message is ignored.
 //!
-//! The whole file is read into memory (chunks are decompressed one at a
-//! time): keep IMU-only bags, or split off the IMU topic with
-//! `ros2 bag convert`, for logs far larger than the machine's memory.
+//! The file is streamed twice, in bounded memory (one record or chunk at a
+//! time, never the whole file): a first pass finds the IMU topics and checks
+//! every record and IMU message, a second yields the chosen topic's samples
+//! ([`ImuStream`]). A record may claim at most [`MAX_RECORD_BYTES`].
 
 use crate::error::{Error, Result};
+use ::mcap::sans_io::{LinearReaderOptions, MessageReadEvent, MessageReader};
 use glam::DVec3;
 use std::collections::BTreeMap;
-use std::path::Path;
+use std::fs::File;
+use std::io::Read;
+use std::path::{Path, PathBuf};
 
 /// The ROS 2 type name of the messages read.
 pub const IMU_SCHEMA: &str = "sensor_msgs/msg/Imu";
@@ -53,82 +57,238 @@ pub fn is_mcap(path: &Path) -> bool {
         .is_ok_and(|_| head == MAGIC)
 }
 
-/// Reads the IMU messages of `topic` (None: the only IMU topic) from the
-/// MCAP file at `path`, in file order.
-pub fn read_imu(path: &Path, topic: Option<&str>) -> Result<Vec<ImuMessage>> {
-    // A whole-file read: a regular file only (never a device or a pipe).
-    let mut bytes = Vec::new();
-    std::io::Read::read_to_end(&mut super::input::open_file(path)?, &mut bytes)
-        .map_err(|e| Error::io(path, e))?;
-    let bad = |what: String| Error::invalid(path.display().to_string(), what);
-    // Which topics carry IMU messages (read from the messages themselves:
-    // the summary section is optional).
-    let mut topics: BTreeMap<String, usize> = BTreeMap::new();
-    let stream = ::mcap::MessageStream::new(&bytes)
-        .map_err(|e| bad(format!("not a readable MCAP file: {e}")))?;
-    let mut messages = Vec::new();
-    for (k, m) in stream.enumerate() {
-        let m = m.map_err(|e| bad(format!("MCAP record near message {}: {e}", k + 1)))?;
-        let ch = &m.channel;
-        let is_imu = ch.schema.as_ref().is_some_and(|s| s.name == IMU_SCHEMA);
-        if !is_imu {
+/// Largest record an MCAP file may claim (a chunk's record included), bytes:
+/// a damaged length is an error, not an allocation of that size.
+pub const MAX_RECORD_BYTES: usize = 1 << 30;
+
+/// Bytes read from the file at a time.
+const READ_BYTES: usize = 1 << 16;
+
+/// The messages of an MCAP file in file order, read from the file as the
+/// reader asks for bytes (at most [`READ_BYTES`] at a time). A damaged
+/// record is an error naming the file and the message number near it.
+struct Messages {
+    path: PathBuf,
+    file: File,
+    reader: MessageReader,
+    /// Items yielded so far (messages and the error).
+    items: usize,
+    done: bool,
+}
+
+impl Messages {
+    fn open(path: &Path) -> Result<Self> {
+        // A regular file only (never a device or a pipe: it is read twice).
+        let file = super::input::open_file(path)?;
+        let options = LinearReaderOptions::default().with_record_length_limit(MAX_RECORD_BYTES);
+        Ok(Messages {
+            path: path.into(),
+            file,
+            reader: MessageReader::new_with_options(options),
+            items: 0,
+            done: false,
+        })
+    }
+
+    fn bad(&self, what: String) -> Error {
+        Error::invalid(self.path.display().to_string(), what)
+    }
+
+    /// Fills the reader's request for `need` bytes (fewer at the end of the file).
+    fn read(&mut self, need: usize) -> Result<()> {
+        let buf = self.reader.insert(need.clamp(1, READ_BYTES));
+        let n = loop {
+            match self.file.read(buf) {
+                Ok(n) => break n,
+                Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
+                Err(e) => return Err(Error::io(&self.path, e)),
+            }
+        };
+        self.reader.notify_read(n);
+        Ok(())
+    }
+}
+
+impl Iterator for Messages {
+    type Item = Result<::mcap::Message<'static>>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        while !self.done {
+            let event = match self.reader.next_event() {
+                None => break,
+                Some(e) => e,
+            };
+            match event {
+                Ok(MessageReadEvent::ReadRequest(need)) => {
+                    if let Err(e) = self.read(need) {
+                        self.done = true;
+                        return Some(Err(e));
+                    }
+                }
+                Ok(MessageReadEvent::Message(m)) => {
+                    self.items += 1;
+                    return Some(Ok(m));
+                }
+                Err(e) => {
+                    self.done = true;
+                    self.items += 1;
+                    let k = self.items;
+                    return Some(Err(self.bad(format!("MCAP record near message {k}: {e}"))));
+                }
+            }
+        }
+        self.done = true;
+        None
+    }
+}
+
+/// True when `m` is on a channel of [`IMU_SCHEMA`] messages.
+fn is_imu(m: &::mcap::Message) -> bool {
+    m.channel
+        .schema
+        .as_ref()
+        .is_some_and(|s| s.name == IMU_SCHEMA)
+}
+
+/// An IMU message's time: its header stamp, or its log time when the stamp is zero, s.
+fn stamp_or_log_time(stamp: f64, log_time_ns: u64) -> f64 {
+    if stamp == 0.0 {
+        log_time_ns as f64 / 1e9
+    } else {
+        stamp
+    }
+}
+
+/// What the first pass learns about one IMU topic.
+#[derive(Default)]
+struct TopicScan {
+    messages: usize,
+    /// The first message that does not decode: its number in the topic, why.
+    first_bad: Option<(usize, String)>,
+}
+
+/// The first pass: every record read, every IMU message decoded, counted by topic.
+fn scan(path: &Path) -> Result<BTreeMap<String, TopicScan>> {
+    let mut topics: BTreeMap<String, TopicScan> = BTreeMap::new();
+    for m in Messages::open(path)? {
+        let m = m?;
+        if !is_imu(&m) {
             continue;
         }
-        *topics.entry(ch.topic.clone()).or_default() += 1;
+        let ch = &m.channel;
+        let entry = topics.entry(ch.topic.clone()).or_default();
+        entry.messages += 1;
         if ch.message_encoding != "cdr" {
-            return Err(bad(format!(
-                "topic {}: message encoding '{}', expected 'cdr'",
-                ch.topic, ch.message_encoding
-            )));
+            return Err(Error::invalid(
+                path.display().to_string(),
+                format!(
+                    "topic {}: message encoding '{}', expected 'cdr'",
+                    ch.topic, ch.message_encoding
+                ),
+            ));
         }
-        messages.push((ch.topic.clone(), m.log_time, m.data.into_owned()));
+        if entry.first_bad.is_none() {
+            if let Err(e) = decode_imu(&m.data) {
+                entry.first_bad = Some((entry.messages, e));
+            }
+        }
     }
+    Ok(topics)
+}
+
+/// The topic read: `topic` if it has IMU messages, else the only IMU topic.
+fn choose(
+    path: &Path,
+    topics: &BTreeMap<String, TopicScan>,
+    topic: Option<&str>,
+) -> Result<String> {
+    let bad = |what: String| Error::invalid(path.display().to_string(), what);
     let list = || {
         if topics.is_empty() {
             "none".to_string()
         } else {
             topics
                 .iter()
-                .map(|(t, n)| format!("{t} ({n} messages)"))
+                .map(|(t, s)| format!("{t} ({} messages)", s.messages))
                 .collect::<Vec<_>>()
                 .join(", ")
         }
     };
-    let chosen = match topic {
-        Some(t) if topics.contains_key(t) => t.to_string(),
-        Some(t) => {
-            return Err(bad(format!(
-                "no {IMU_SCHEMA} messages on topic '{t}'; IMU topics: {}",
-                list()
-            )))
-        }
-        None if topics.len() == 1 => topics.keys().next().cloned().unwrap_or_default(),
-        None => {
-            return Err(bad(format!(
-                "choose an IMU topic with --topic; IMU topics: {}",
-                list()
-            )))
-        }
-    };
-    let mut out = Vec::new();
-    for (t, log_time, data) in &messages {
-        if *t != chosen {
-            continue;
-        }
-        let (stamp, omega) = decode_imu(data).map_err(|e| {
-            bad(format!(
-                "topic {chosen}, IMU message {}: {e}",
-                out.len() + 1
-            ))
-        })?;
-        let t = if stamp == 0.0 {
-            *log_time as f64 / 1e9
-        } else {
-            stamp
-        };
-        out.push(ImuMessage { t, omega });
+    match topic {
+        Some(t) if topics.contains_key(t) => Ok(t.to_string()),
+        Some(t) => Err(bad(format!(
+            "no {IMU_SCHEMA} messages on topic '{t}'; IMU topics: {}",
+            list()
+        ))),
+        None if topics.len() == 1 => Ok(topics.keys().next().cloned().unwrap_or_default()),
+        None => Err(bad(format!(
+            "choose an IMU topic with --topic; IMU topics: {}",
+            list()
+        ))),
     }
-    Ok(out)
+}
+
+/// The IMU messages of one topic of an MCAP file, in file order, streamed
+/// in bounded memory. [`ImuStream::open`] checks the whole file first (its
+/// records, the topic, every message of the topic), so a damaged file is an
+/// error before the first sample.
+pub struct ImuStream {
+    messages: Messages,
+    topic: String,
+    count: usize,
+}
+
+impl ImuStream {
+    /// Opens the MCAP file at `path` for the IMU messages of `topic` (None:
+    /// the only IMU topic in the file).
+    pub fn open(path: &Path, topic: Option<&str>) -> Result<Self> {
+        let topics = scan(path)?;
+        let chosen = choose(path, &topics, topic)?;
+        if let Some((k, e)) = topics.get(&chosen).and_then(|s| s.first_bad.as_ref()) {
+            return Err(Error::invalid(
+                path.display().to_string(),
+                format!("topic {chosen}, IMU message {k}: {e}"),
+            ));
+        }
+        Ok(ImuStream {
+            messages: Messages::open(path)?,
+            topic: chosen,
+            count: 0,
+        })
+    }
+
+    /// Messages yielded so far.
+    pub fn messages_read(&self) -> usize {
+        self.count
+    }
+}
+
+impl Iterator for ImuStream {
+    type Item = Result<ImuMessage>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        loop {
+            let m = match self.messages.next()? {
+                Ok(m) => m,
+                Err(e) => return Some(Err(e)),
+            };
+            if !is_imu(&m) || m.channel.topic != self.topic {
+                continue;
+            }
+            self.count += 1;
+            // Checked by the first pass; an error here means the file changed.
+            return Some(match decode_imu(&m.data) {
+                Ok((stamp, omega)) => Ok(ImuMessage {
+                    t: stamp_or_log_time(stamp, m.log_time),
+                    omega,
+                }),
+                Err(e) => Err(self.messages.bad(format!(
+                    "topic {}, IMU message {}: {e}",
+                    self.topic, self.count
+                ))),
+            });
+        }
+    }
 }
 
 /// A CDR reader: alignment counts from the end of the 4-byte encapsulation
@@ -211,19 +371,6 @@ pub fn decode_imu(data: &[u8]) -> std::result::Result<(f64, DVec3), String> {
         return Err(format!("angular velocity {w} is not finite"));
     }
     Ok((sec as f64 + nanosec as f64 / 1e9, w))
-}
-
-/// The messages as gyro CSV text (`t,wx,wy,wz`, shortest round-trip
-/// decimals), for the CSV reader's checks and options.
-pub fn to_csv(messages: &[ImuMessage]) -> String {
-    let mut s = String::from("t,wx,wy,wz\n");
-    for m in messages {
-        s.push_str(&format!(
-            "{},{},{},{}\n",
-            m.t, m.omega.x, m.omega.y, m.omega.z
-        ));
-    }
-    s
 }
 
 #[cfg(test)]

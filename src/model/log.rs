@@ -307,10 +307,20 @@ impl Integral {
             m: Vec::with_capacity(t.len()),
             cum: Vec::with_capacity(t.len()),
         };
-        for (&a, &b) in t.iter().zip(m) {
-            s.push(a, b);
-        }
+        s.rebuild(t, m);
         s
+    }
+
+    /// Makes this the integral of `m` over times `t`, as [`Integral::new`]
+    /// does (the same sums, bit for bit), reusing its buffers: no allocation
+    /// once they hold `t.len()` samples.
+    pub fn rebuild(&mut self, t: &[f64], m: &[f64]) {
+        self.t.clear();
+        self.m.clear();
+        self.cum.clear();
+        for (&a, &b) in t.iter().zip(m) {
+            self.push(a, b);
+        }
     }
 
     /// Appends one sample (time after the previous one).

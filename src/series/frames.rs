@@ -48,10 +48,31 @@ impl FrameMmbm {
     }
 }
 
-/// Mean over `[a, b]` of the piecewise-linear function through `(t[i], y[i])`
-/// (`t` increasing, covering `[a, b]`); the value at `a` when `b <= a`.
-fn window_mean(t: &[f64], y: &[f64], a: f64, b: f64) -> f64 {
-    Integral::new(t, y).mean(a, b)
+/// The buffers of a frames run's window means, built once per run and
+/// reused: the values at a window's samples and their [`Integral`] (no
+/// allocation in the `exact` integrand once warm).
+#[derive(Default)]
+struct Window {
+    /// The values at the window's samples.
+    y: Vec<f64>,
+    integral: Integral,
+}
+
+impl Window {
+    /// Mean over `[a, b]` of the piecewise-linear function through
+    /// `(t[i], y[i])` (`t` increasing, covering `[a, b]`); the value at `a`
+    /// when `b <= a`.
+    fn mean(&mut self, t: &[f64], a: f64, b: f64) -> f64 {
+        self.integral.rebuild(t, &self.y);
+        self.integral.mean(a, b)
+    }
+
+    /// [`Window::mean`] of the values `y`.
+    fn mean_of(&mut self, t: &[f64], y: impl IntoIterator<Item = f64>, a: f64, b: f64) -> f64 {
+        self.y.clear();
+        self.y.extend(y);
+        self.mean(t, a, b)
+    }
 }
 
 /// The rule's nodes grouped by line: (delay per second of readout, rule of
@@ -105,6 +126,9 @@ pub fn frame_mmbm(
     };
     let t: Vec<f64> = samples.iter().map(|s| s.t).collect();
     let (first, last) = (t[0], t[t.len() - 1]);
+    // One set of window buffers for the whole run (the `exact` integrand
+    // borrows it for each point).
+    let window = std::cell::RefCell::new(Window::default());
     let mut out = Vec::with_capacity(frames.len());
     let mut outside = Vec::new();
     for (k, f) in frames.iter().enumerate() {
@@ -155,9 +179,9 @@ pub fn frame_mmbm(
                         *tot += yi;
                     }
                     let w0 = a + readout * delay;
-                    e += window_mean(ts, &y, w0, w0 + f.exposure_s);
+                    e += window.borrow_mut().mean_of(ts, y, w0, w0 + f.exposure_s);
                 }
-                (e, window_mean(ts, &total, a, a))
+                (e, window.borrow_mut().mean_of(ts, total, a, a))
             }
             None => {
                 let Method::Exact { tol } = opts.method else {
@@ -171,9 +195,8 @@ pub fn frame_mmbm(
                     |u, v| {
                         let (px, py) = cam.mm_to_pixel(u, v);
                         let w0 = a + shutter.delay_s(px, py, cam.width, cam.height);
-                        let y: Vec<f64> =
-                            polys.iter().map(|p| point_speed(&cam, p, u, v)).collect();
-                        window_mean(ts, &y, w0, w0 + f.exposure_s)
+                        let y = polys.iter().map(|p| point_speed(&cam, p, u, v));
+                        window.borrow_mut().mean_of(ts, y, w0, w0 + f.exposure_s)
                     },
                     &cam.sensor_rect(),
                     tol,
@@ -183,7 +206,7 @@ pub fn frame_mmbm(
                     .iter()
                     .map(|p| crate::metric::mmbm_poly(&cam, p, opts.method).map(|m| m.mm_s))
                     .collect::<Result<_>>()?;
-                (e, window_mean(ts, &m, a, a))
+                (e, window.borrow_mut().mean_of(ts, m, a, a))
             }
         };
         if !(exposure.is_finite() && start.is_finite()) {
