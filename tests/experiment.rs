@@ -8,7 +8,7 @@ fn tiny_experiment_end_to_end() {
     let d = tempfile::tempdir().unwrap();
     let cfg = ExperimentConfig {
         walks: vec!["moderate".into()],
-        duration_s: 4.0,
+        duration_s: Some(4.0),
         policies: vec![
             "fixed:5".into(),
             "threshold:0.4".into(),
@@ -131,7 +131,7 @@ fn several_seeds_are_pooled_in_the_headline() {
     let cfg = ExperimentConfig {
         walks: vec!["moderate".into()],
         seeds: vec![3, 4],
-        duration_s: 4.0,
+        duration_s: Some(4.0),
         policies: vec!["fixed:5".into(), "threshold:0.4".into()],
         resolution: [160, 120],
         quality: "16:1.0".into(),

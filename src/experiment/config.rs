@@ -15,8 +15,13 @@ use std::path::{Path, PathBuf};
 pub struct ExperimentConfig {
     /// Walk modes to simulate: `slow`, `moderate`, `fast` (ignored with `gyro`).
     pub walks: Vec<String>,
-    /// Simulated duration per walk, s.
-    pub duration_s: f64,
+    /// Simulated duration of every walk, s; unset: each gait's thesis walk
+    /// time from `walk_s`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub duration_s: Option<f64>,
+    /// Each gait's walk time, s, when `duration_s` is unset: the thesis's
+    /// (Table 6.2: about 3 m at 0.085 / 0.17 / 0.53 m/s).
+    pub walk_s: WalkTimes,
     /// Gyro rate of the simulation, Hz.
     pub rate_hz: f64,
     /// Simulation seed.
@@ -38,7 +43,7 @@ pub struct ExperimentConfig {
     pub readout_s: f64,
     /// Minimum interval between MMBM triggers, s.
     pub min_interval_s: f64,
-    /// Target: `blobs` (thesis board) or `blobs:0.5` (half size, thesis Table 6.2).
+    /// Target: `blobs:0.5` (half size, thesis Table 6.2; the default) or `blobs` (the thesis board).
     pub target: String,
     /// Distance to the target at t = 0, m (the walk approaches it).
     pub start_distance_m: f64,
@@ -58,6 +63,39 @@ pub struct ExperimentConfig {
     /// The real camera of SPEC section 9 (all off by default: the thesis's
     /// ideal global-shutter pinhole).
     pub camera: CameraSection,
+}
+
+/// The walk time of each gait, s (`[walk_s]`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct WalkTimes {
+    /// Slow walk, s (thesis: 35).
+    pub slow: f64,
+    /// Moderate walk, s (thesis: 16).
+    pub moderate: f64,
+    /// Fast walk, s (thesis: 5).
+    pub fast: f64,
+}
+
+impl Default for WalkTimes {
+    fn default() -> Self {
+        WalkTimes {
+            slow: 35.0,
+            moderate: 16.0,
+            fast: 5.0,
+        }
+    }
+}
+
+impl WalkTimes {
+    /// The walk time of `gait`, s.
+    pub fn of(&self, gait: crate::sim::Gait) -> f64 {
+        match gait {
+            crate::sim::Gait::Slow => self.slow,
+            crate::sim::Gait::Moderate => self.moderate,
+            crate::sim::Gait::Fast => self.fast,
+        }
+    }
 }
 
 /// The `[camera]` section: the thesis camera (focal length, pitch, at
@@ -86,7 +124,8 @@ impl Default for ExperimentConfig {
     fn default() -> Self {
         ExperimentConfig {
             walks: vec!["moderate".into()],
-            duration_s: 18.0,
+            duration_s: None,
+            walk_s: WalkTimes::default(),
             rate_hz: 600.0,
             seed: 1,
             seeds: Vec::new(),
@@ -112,7 +151,7 @@ impl Default for ExperimentConfig {
             delay_s: CameraTiming::DEFAULT_DELAY_S,
             readout_s: CameraTiming::DEFAULT_READOUT_S,
             min_interval_s: CameraTiming::DEFAULT_MIN_INTERVAL_S,
-            target: "blobs".into(),
+            target: "blobs:0.5".into(),
             start_distance_m: 6.0,
             min_distance_m: 1.5,
             resolution: [640, 480],
@@ -135,10 +174,16 @@ impl ExperimentConfig {
         }
     }
 
-    /// The `mmbm demo --full` configuration: the demo over seeds 1 to 5.
+    /// The simulated duration of a walk of `gait`, s: `duration_s`, else the gait's `walk_s`.
+    pub fn walk_duration_s(&self, gait: crate::sim::Gait) -> f64 {
+        self.duration_s.unwrap_or_else(|| self.walk_s.of(gait))
+    }
+
+    /// The `mmbm demo --full` configuration: the demo over seeds 1 to 5 and all three gaits.
     pub fn demo_full() -> Self {
         ExperimentConfig {
             seeds: (1..=5).collect(),
+            walks: ["slow", "moderate", "fast"].map(String::from).to_vec(),
             ..Self::demo()
         }
     }
@@ -186,7 +231,12 @@ impl ExperimentConfig {
     /// Checks ranges (times positive, distances positive and ordered, a policy at least).
     pub fn validate(&self) -> Result<()> {
         use crate::error::positive;
-        positive("duration_s", self.duration_s)?;
+        if let Some(d) = self.duration_s {
+            positive("duration_s", d)?;
+        }
+        positive("walk_s.slow", self.walk_s.slow)?;
+        positive("walk_s.moderate", self.walk_s.moderate)?;
+        positive("walk_s.fast", self.walk_s.fast)?;
         positive("rate_hz", self.rate_hz)?;
         let mut seeds = self.seeds.clone();
         seeds.sort_unstable();
