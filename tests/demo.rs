@@ -41,7 +41,7 @@ fn demo_report_matches_the_docs() {
     // Every kept frame of the 12 policies rendered, with the new columns.
     let header = frames.lines().next().unwrap();
     assert!(
-        header.ends_with("blur_h_px,blur_v_px,jnbm_2d,cpbd_2d,gain"),
+        header.ends_with("blur_h_px,blur_v_px,jnbm_2d,cpbd_2d,gain,family"),
         "{header}"
     );
     let rendered = header.split(',').position(|c| c == "rendered").unwrap();
