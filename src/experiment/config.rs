@@ -115,10 +115,11 @@ impl Default for MapSection {
             seeds: Vec::new(),
             policies: [
                 "deadline:5+exp:3:0.02",
+                "deadline:5+exp:1:0.003",
                 "fixed:5+exp:2:0.02",
-                "deadline:5+exp:2:0.005",
                 "deadline:5",
                 "ae:5:cap=10ms",
+                "ae:5:cap=3ms",
             ]
             .map(String::from)
             .to_vec(),
@@ -143,17 +144,23 @@ impl MapSection {
     }
 
     /// The reduced map of `mmbm demo`: the half board on the moderate walk,
-    /// seeds 1-5, four lights, a coarser grid (3, 10, 20, 70 ms), one
-    /// gyro-driven candidate and one auto-exposure.
+    /// seeds 1-5, four lights, a coarser grid (3, 10, 20, 70 ms), three
+    /// gyro-driven candidates (trigger timing with a loose and a tight blur
+    /// budget, and alone) and one auto-exposure.
     pub fn reduced() -> Self {
         MapSection {
             lights_e_per_s: vec![1_000.0, 4_000.0, 20_000.0, 100_000.0],
             gaits: vec!["moderate".into()],
             boards: vec!["blobs:0.5".into()],
             seeds: (1..=5).collect(),
-            policies: ["deadline:5+exp:3:0.02", "ae:5:cap=10ms"]
-                .map(String::from)
-                .to_vec(),
+            policies: [
+                "deadline:5+exp:3:0.02",
+                "deadline:5+exp:1:0.003",
+                "deadline:5",
+                "ae:5:cap=10ms",
+            ]
+            .map(String::from)
+            .to_vec(),
             grid_ms: vec![3.0, 10.0, 20.0, 70.0],
             ..Self::default()
         }
