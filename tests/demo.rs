@@ -44,13 +44,9 @@ fn demo_report_matches_the_docs() {
         std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/README.md")).unwrap();
     let quoted: Vec<&str> = readme
         .lines()
-        .skip_while(|l| !l.starts_with("| light (e-/s) |"))
-        .take_while(|l| !l.is_empty())
-        .chain(
-            readme
-                .lines()
-                .filter(|l| l.starts_with("- ") && l.contains("best `mmbm`")),
-        )
+        .skip_while(|l| *l != "<!-- map -->")
+        .take_while(|l| *l != "<!-- /map -->")
+        .filter(|l| l.starts_with("| ") || l.starts_with("- "))
         .collect();
     assert!(quoted.len() >= 4, "README quotes no map");
     for l in &quoted {
