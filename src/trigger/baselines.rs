@@ -8,10 +8,11 @@
 //! maximum gain is the camera's business, not the policy's: the experiment
 //! caps `K_ref * gain` there (see `experiment::map`).
 
+use super::parse::parse_pos;
 use super::policy::{LogView, Observation, Policy};
 use super::rules::Fixed;
 use super::timing::CameraTiming;
-use crate::error::Result;
+use crate::error::{Error, Result};
 
 /// `fixed:FPS[@PHASE]@Tms`: the fixed-rate schedule with every frame exposed
 /// for `T` (at most the camera's exposure `T_ref`; a longer `T` is clamped
@@ -144,9 +145,108 @@ impl Policy for AutoExposure {
     }
 }
 
+/// Splits `FPS[@PHASE]@Tms` into `FPS[@PHASE]` and the exposure (s); a
+/// last `@` part that does not end in `ms` is the phase.
+pub(crate) fn split_exposure<'a>(r: &'a str, spec: &str) -> Result<(&'a str, Option<f64>)> {
+    match r.rsplit_once('@') {
+        Some((head, t)) if t.trim().ends_with("ms") => {
+            let ms = parse_pos(t.trim().trim_end_matches("ms"), "exposure (ms)", spec)?;
+            Ok((head, Some(ms * 1e-3)))
+        }
+        _ => Ok((r, None)),
+    }
+}
+
+/// The `key=value` arguments of `ae:FPS[...]`.
+pub(crate) fn parse_ae(keys: &[&str], spec: &str) -> Result<AeParams> {
+    let mut p = AeParams::default();
+    let unit = |v: &str, what: &str| -> Result<f64> {
+        let x = parse_pos(v, what, spec)?;
+        if x > 1.0 {
+            return Err(Error::invalid(
+                "policy",
+                format!("'{spec}': {what} must be in (0, 1], got {x}"),
+            ));
+        }
+        Ok(x)
+    };
+    for kv in keys {
+        let Some((k, v)) = kv.split_once('=') else {
+            return Err(Error::invalid(
+                "policy",
+                format!("'{spec}': '{kv}' is not key=value (cap=Tms, target=F, damp=F or scene=F)"),
+            ));
+        };
+        match k.trim() {
+            "cap" => {
+                let Some(ms) = v.trim().strip_suffix("ms") else {
+                    return Err(Error::invalid(
+                        "policy",
+                        format!("'{spec}': cap '{v}' needs its unit, e.g. cap=10ms"),
+                    ));
+                };
+                p.cap_s = Some(parse_pos(ms, "exposure cap (ms)", spec)? * 1e-3);
+            }
+            "target" => p.target = unit(v, "target level")?,
+            "damp" => p.damping = unit(v, "damping")?,
+            "scene" => p.scene_mean = unit(v, "scene mean radiance")?,
+            other => {
+                return Err(Error::invalid(
+                    "policy",
+                    format!(
+                        "'{spec}': unknown auto-exposure key '{other}' (cap, target, damp, scene)"
+                    ),
+                ))
+            }
+        }
+    }
+    Ok(p)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    use crate::trigger::{PolicyFamily, PolicySpec};
+
+    fn parse(s: &str) -> PolicySpec {
+        PolicySpec::parse(s).unwrap_or_else(|e| panic!("{s}: {e}"))
+    }
+
+    #[test]
+    fn baselines_and_families() {
+        let f = parse("fixed:5@3ms");
+        assert_eq!(f.fixed_exposure_s, Some(0.003));
+        assert_eq!(f.rate.map(|r| (r.fps, r.phase)), Some((5.0, 0.0)));
+        assert_eq!(f.policy_family(), PolicyFamily::FixedExposure);
+        assert!(!f.is_baseline());
+        let f = parse("fixed:5@0.1@2.5ms");
+        assert_eq!(f.fixed_exposure_s, Some(0.0025));
+        assert_eq!(f.rate.map(|r| r.phase), Some(0.1));
+        assert_eq!(parse("fixed:5@0.1").fixed_exposure_s, None);
+        let a = parse("ae:5:cap=10ms:damp=0.25");
+        let p = a.ae.unwrap();
+        assert_eq!(p.cap_s, Some(0.01));
+        assert_eq!((p.damping, p.target), (0.25, AeParams::TARGET));
+        assert_eq!(a.policy_family(), PolicyFamily::AutoExposure);
+        assert_eq!(parse("ae:5").ae.unwrap().cap_s, None);
+        for (s, fam) in [
+            ("fixed:5", "fixed"),
+            ("fixed:5+exp:2", "mmbm"),
+            ("threshold:0.4", "mmbm"),
+            ("deadline:5+exp:3:0.02", "mmbm"),
+            ("oracle:0.4", "oracle"),
+            ("fixed:5@10ms", "fixed-exposure"),
+            ("ae:5:cap=3ms", "auto-exposure"),
+        ] {
+            assert_eq!(parse(s).policy_family().name(), fam, "{s}");
+        }
+        // The error names what is wrong.
+        let e = PolicySpec::parse("ae:5:cap=10").unwrap_err().to_string();
+        assert!(e.contains("cap=10ms"), "{e}");
+        let e = PolicySpec::parse("ae:5:speed=1").unwrap_err().to_string();
+        assert!(e.contains("unknown auto-exposure key 'speed'"), "{e}");
+    }
 
     fn run(p: &mut dyn Policy) -> Vec<crate::trigger::Frame> {
         let t: Vec<f64> = (0..=6000).map(|k| k as f64 / 600.0).collect();
