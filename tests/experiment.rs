@@ -8,7 +8,7 @@ fn tiny_experiment_end_to_end() {
     let d = tempfile::tempdir().unwrap();
     let cfg = ExperimentConfig {
         walks: vec!["moderate".into()],
-        duration_s: 4.0,
+        duration_s: Some(4.0),
         policies: vec![
             "fixed:5".into(),
             "threshold:0.4".into(),
@@ -18,6 +18,8 @@ fn tiny_experiment_end_to_end() {
         quality: "16:1.0".into(),
         max_frames_per_policy: 4,
         start_distance_m: 3.0,
+        // The full board: at 320 x 240 the half board's blobs are too small for the pose bounds below.
+        target: "blobs".into(),
         ..ExperimentConfig::default()
     };
     let o = experiment::run(&cfg, d.path(), false).unwrap();
@@ -131,7 +133,7 @@ fn several_seeds_are_pooled_in_the_headline() {
     let cfg = ExperimentConfig {
         walks: vec!["moderate".into()],
         seeds: vec![3, 4],
-        duration_s: 4.0,
+        duration_s: Some(4.0),
         policies: vec!["fixed:5".into(), "threshold:0.4".into()],
         resolution: [160, 120],
         quality: "16:1.0".into(),

@@ -15,7 +15,7 @@ fn experiment_without_adapter_uses_cpu_twins() {
     assert!(mmbm::gpu::gpu().is_err());
     let d = tempfile::tempdir().unwrap();
     let cfg = ExperimentConfig {
-        duration_s: 2.0,
+        duration_s: Some(2.0),
         policies: vec!["fixed:5".into()],
         resolution: [160, 120],
         quality: "8:2.0".into(),

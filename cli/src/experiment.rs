@@ -52,6 +52,6 @@ pub fn run_and_print(cfg: &ExperimentConfig, out: &std::path::Path, progress: bo
         out.display(),
         out.display()
     );
-    println!("{}", experiment::table_6(&o.stats));
+    println!("{}", o.answer(&out.join("report.md")));
     Ok(())
 }

@@ -226,13 +226,14 @@ pub fn headline_md(hs: &[Headline], policies: &[PolicySpec]) -> String {
             None => "; no fixed-rate baseline was run, so no ratio".into(),
         }
     );
-    s += "| walk | policy | sharp frames/s [95 % CI] | vs baseline [95 % CI] | mean blur px [95 % CI] | rendered / kept |\n";
-    s += "|---|---|---|---|---|---|\n";
+    s += "| walk | policy | family | sharp frames/s [95 % CI] | vs baseline [95 % CI] | mean blur px [95 % CI] | rendered / kept |\n";
+    s += "|---|---|---|---|---|---|---|\n";
     for h in hs {
         s += &format!(
-            "| {} | {} | {} | {} | {} | {} / {} |\n",
+            "| {} | {} | {} | {} | {} | {} | {} / {} |\n",
             h.gait,
             h.policy,
+            h.policy.policy_family(),
             ci(&h.sharp_fps, 2),
             h.ratio
                 .as_ref()

@@ -15,8 +15,13 @@ use std::path::{Path, PathBuf};
 pub struct ExperimentConfig {
     /// Walk modes to simulate: `slow`, `moderate`, `fast` (ignored with `gyro`).
     pub walks: Vec<String>,
-    /// Simulated duration per walk, s.
-    pub duration_s: f64,
+    /// Simulated duration of every walk, s; unset: each gait's thesis walk
+    /// time from `walk_s`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub duration_s: Option<f64>,
+    /// Each gait's walk time, s, when `duration_s` is unset: the thesis's
+    /// (Table 6.2: about 3 m at 0.085 / 0.17 / 0.53 m/s).
+    pub walk_s: WalkTimes,
     /// Gyro rate of the simulation, Hz.
     pub rate_hz: f64,
     /// Simulation seed.
@@ -38,7 +43,7 @@ pub struct ExperimentConfig {
     pub readout_s: f64,
     /// Minimum interval between MMBM triggers, s.
     pub min_interval_s: f64,
-    /// Target: `blobs` (thesis board) or `blobs:0.5` (half size, thesis Table 6.2).
+    /// Target: `blobs:0.5` (half size, thesis Table 6.2; the default) or `blobs` (the thesis board).
     pub target: String,
     /// Distance to the target at t = 0, m (the walk approaches it).
     pub start_distance_m: f64,
@@ -61,13 +66,204 @@ pub struct ExperimentConfig {
     /// `[camera.distortion]`, `[camera.noise]`, `[camera.lens]`; all off by
     /// default: the thesis's ideal global-shutter pinhole).
     pub camera: CameraFile,
+    /// The benefit map of SPEC section 10 (off unless `lights_e_per_s` is set).
+    pub map: MapSection,
+}
+
+/// The policies of `mmbm demo`'s experiment (`demo --full` runs the
+/// defaults): the thesis's Table 6.2 (the fixed rate and its three
+/// thresholds), the learned phase predictor and its oracle, and trigger
+/// timing with exposure control.
+pub const DEMO_POLICIES: [&str; 7] = [
+    "fixed:5",
+    "threshold:0.8",
+    "threshold:0.4",
+    "threshold:0.2",
+    "phase:0.4",
+    "oracle:0.4",
+    "deadline:5+exp:3:0.02",
+];
+
+/// The `[map]` section: the benefit map over light x gait x board.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct MapSection {
+    /// The light levels (rows), e-/s for a white pixel; empty: no map.
+    pub lights_e_per_s: Vec<f64>,
+    /// Gaits (columns); empty: the experiment's `walks`.
+    pub gaits: Vec<String>,
+    /// Boards (columns, with the gaits): `blobs:0.5`, `blobs`.
+    pub boards: Vec<String>,
+    /// Seeds (at least 5 for the goals); empty: the experiment's seeds.
+    pub seeds: Vec<u64>,
+    /// The policies besides the baselines' grid: the gyro-driven candidates
+    /// (the best `mmbm` one is taken per cell) and the auto-exposure(s).
+    pub policies: Vec<String>,
+    /// The frame rate of `fixed` and of the fixed-exposure grid, frames/s.
+    pub fps: f64,
+    /// The fixed exposures of the best fixed exposure in hindsight, ms (at
+    /// most the experiment's `exposure_s`; that one is `fixed:FPS` itself).
+    pub grid_ms: Vec<f64>,
+    /// The sensor's maximum gain, in units of the full-well gain
+    /// `(2^bits - 1) / full_well` (256 = 48 dB; an assumption).
+    pub max_gain_x: f64,
+}
+
+impl Default for MapSection {
+    fn default() -> Self {
+        MapSection {
+            lights_e_per_s: Vec::new(),
+            gaits: Vec::new(),
+            boards: vec!["blobs:0.5".into(), "blobs".into()],
+            seeds: Vec::new(),
+            policies: [
+                "deadline:5+exp:3:0.02",
+                "deadline:5+exp:1:0.003",
+                "fixed:5+exp:2:0.02",
+                "deadline:5",
+                "ae:5:cap=10ms",
+                "ae:5:cap=3ms",
+            ]
+            .map(String::from)
+            .to_vec(),
+            fps: 5.0,
+            grid_ms: vec![
+                1.0, 2.0, 3.0, 5.0, 7.0, 10.0, 14.0, 20.0, 28.0, 40.0, 56.0, 70.0,
+            ],
+            max_gain_x: 256.0,
+        }
+    }
+}
+
+impl MapSection {
+    /// The whole map of `mmbm demo --full`: light 500 to 100,000 e-/s.
+    pub fn full() -> Self {
+        MapSection {
+            lights_e_per_s: vec![500.0, 1_000.0, 2_000.0, 4_000.0, 20_000.0, 100_000.0],
+            gaits: ["slow", "moderate", "fast"].map(String::from).to_vec(),
+            seeds: (1..=5).collect(),
+            ..Self::default()
+        }
+    }
+
+    /// The reduced map of `mmbm demo`: the half board on the moderate walk,
+    /// seeds 1-5, four lights, a coarser grid (3, 10, 20, 70 ms), three
+    /// gyro-driven candidates (trigger timing with a loose and a tight blur
+    /// budget, and alone) and one auto-exposure.
+    pub fn reduced() -> Self {
+        MapSection {
+            lights_e_per_s: vec![1_000.0, 4_000.0, 20_000.0, 100_000.0],
+            gaits: vec!["moderate".into()],
+            boards: vec!["blobs:0.5".into()],
+            seeds: (1..=5).collect(),
+            policies: [
+                "deadline:5+exp:3:0.02",
+                "deadline:5+exp:1:0.003",
+                "deadline:5",
+                "ae:5:cap=10ms",
+            ]
+            .map(String::from)
+            .to_vec(),
+            grid_ms: vec![3.0, 10.0, 20.0, 70.0],
+            ..Self::default()
+        }
+    }
+
+    /// Checks the section (each light, exposure and gain positive, the
+    /// strings parse); `max_exposure_s` is the experiment's exposure.
+    pub fn validate(&self, max_exposure_s: f64) -> Result<()> {
+        use crate::check::positive;
+        let key = |k: &str, e: Error| Error::invalid(format!("map.{k}"), e.to_string());
+        if self.lights_e_per_s.is_empty() {
+            return Ok(());
+        }
+        for &l in &self.lights_e_per_s {
+            positive("map.lights_e_per_s", l)?;
+        }
+        positive("map.fps", self.fps)?;
+        positive("map.max_gain_x", self.max_gain_x)?;
+        if self.grid_ms.is_empty() {
+            return Err(Error::invalid(
+                "map.grid_ms",
+                "at least one exposure is needed",
+            ));
+        }
+        for &t in &self.grid_ms {
+            positive("map.grid_ms", t)?;
+            if t * 1e-3 > max_exposure_s * (1.0 + 1e-9) {
+                return Err(Error::invalid(
+                    "map.grid_ms",
+                    format!(
+                        "{t} ms is longer than exposure_s ({} ms)",
+                        max_exposure_s * 1e3
+                    ),
+                ));
+            }
+        }
+        if self.boards.is_empty() {
+            return Err(Error::invalid("map.boards", "at least one board is needed"));
+        }
+        for b in &self.boards {
+            crate::render::Target::parse(b, 6.0).map_err(|e| key("boards", e))?;
+        }
+        for g in &self.gaits {
+            g.parse::<crate::sim::Gait>().map_err(|e| key("gaits", e))?;
+        }
+        for p in &self.policies {
+            crate::trigger::PolicySpec::parse(p).map_err(|e| key("policies", e))?;
+        }
+        let mut seeds = self.seeds.clone();
+        seeds.sort_unstable();
+        seeds.dedup();
+        if seeds.len() != self.seeds.len() || seeds.len() > 100 {
+            return Err(Error::invalid(
+                "map.seeds",
+                format!("{:?}: at most 100 seeds, each once", self.seeds),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// The walk time of each gait, s (`[walk_s]`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct WalkTimes {
+    /// Slow walk, s (thesis: 35).
+    pub slow: f64,
+    /// Moderate walk, s (thesis: 16).
+    pub moderate: f64,
+    /// Fast walk, s (thesis: 5).
+    pub fast: f64,
+}
+
+impl Default for WalkTimes {
+    fn default() -> Self {
+        WalkTimes {
+            slow: 35.0,
+            moderate: 16.0,
+            fast: 5.0,
+        }
+    }
+}
+
+impl WalkTimes {
+    /// The walk time of `gait`, s.
+    pub fn of(&self, gait: crate::sim::Gait) -> f64 {
+        match gait {
+            crate::sim::Gait::Slow => self.slow,
+            crate::sim::Gait::Moderate => self.moderate,
+            crate::sim::Gait::Fast => self.fast,
+        }
+    }
 }
 
 impl Default for ExperimentConfig {
     fn default() -> Self {
         ExperimentConfig {
             walks: vec!["moderate".into()],
-            duration_s: 18.0,
+            duration_s: None,
+            walk_s: WalkTimes::default(),
             rate_hz: 600.0,
             seed: 1,
             seeds: Vec::new(),
@@ -93,7 +289,7 @@ impl Default for ExperimentConfig {
             delay_s: CameraTiming::DEFAULT_DELAY_S,
             readout_s: CameraTiming::DEFAULT_READOUT_S,
             min_interval_s: CameraTiming::DEFAULT_MIN_INTERVAL_S,
-            target: "blobs".into(),
+            target: "blobs:0.5".into(),
             start_distance_m: 6.0,
             min_distance_m: 1.5,
             resolution: [640, 480],
@@ -102,6 +298,7 @@ impl Default for ExperimentConfig {
             sweep_exposures_s: vec![0.01, 0.02, 0.035, 0.05, 0.07],
             sweep_frames: 12,
             camera: CameraFile::default(),
+            map: MapSection::default(),
         }
     }
 }
@@ -116,10 +313,19 @@ impl ExperimentConfig {
         }
     }
 
-    /// The `mmbm demo --full` configuration: the demo over seeds 1 to 5.
+    /// The simulated duration of a walk of `gait`, s: `duration_s`, else the gait's `walk_s`.
+    pub fn walk_duration_s(&self, gait: crate::sim::Gait) -> f64 {
+        self.duration_s.unwrap_or_else(|| self.walk_s.of(gait))
+    }
+
+    /// The `mmbm demo --full` configuration: the demo over seeds 1 to 5 and all three gaits.
     pub fn demo_full() -> Self {
         ExperimentConfig {
             seeds: (1..=5).collect(),
+            walks: ["slow", "moderate", "fast"].map(String::from).to_vec(),
+            map: MapSection::full(),
+            policies: Self::default().policies,
+            sweep_exposures_s: Self::default().sweep_exposures_s,
             ..Self::demo()
         }
     }
@@ -146,6 +352,10 @@ impl ExperimentConfig {
                 }),
                 ..CameraFile::default()
             },
+            map: MapSection::reduced(),
+            policies: DEMO_POLICIES.map(String::from).to_vec(),
+            // The map's fixed-exposure grid replaces the exposure sweep.
+            sweep_exposures_s: Vec::new(),
             ..d
         }
     }
@@ -167,7 +377,12 @@ impl ExperimentConfig {
     /// Checks ranges (times positive, distances positive and ordered, a policy at least).
     pub fn validate(&self) -> Result<()> {
         use crate::check::positive;
-        positive("duration_s", self.duration_s)?;
+        if let Some(d) = self.duration_s {
+            positive("duration_s", d)?;
+        }
+        positive("walk_s.slow", self.walk_s.slow)?;
+        positive("walk_s.moderate", self.walk_s.moderate)?;
+        positive("walk_s.fast", self.walk_s.fast)?;
         positive("rate_hz", self.rate_hz)?;
         let mut seeds = self.seeds.clone();
         seeds.sort_unstable();
@@ -220,6 +435,13 @@ impl ExperimentConfig {
             positive("sweep_exposures_s", e)?;
         }
         self.camera().validate().map_err(|e| key("camera", e))?;
+        self.map.validate(self.exposure_s)?;
+        if !self.map.lights_e_per_s.is_empty() && self.gyro.is_some() {
+            return Err(Error::invalid(
+                "map",
+                "the benefit map simulates its gaits; it does not take a gyro log",
+            ));
+        }
         Ok(())
     }
 

@@ -11,7 +11,7 @@ use serde::{Serialize, Serializer};
 pub const FRAMES_HEADER: &str = "policy,trigger_t,blur_px,jnbm,blobs_found,blobs_ok,walk,exposure_start,exposure_end,\
 mmbm_trigger_mm_s,mmbm_exposure_mm_s,kept,rendered,distance_m,disp_px,cpbd,blur_effect,laplacian_var,\
 blobs_matched,samples_per_pixel,render_ms,pose_err_m,pose_err_deg,quality,seed,blobs_ok_fixed,\
-blur_h_px,blur_v_px,jnbm_2d,cpbd_2d,gain";
+blur_h_px,blur_v_px,jnbm_2d,cpbd_2d,gain,family";
 
 /// An f64 written as Rust's `Display` shows it (shortest round-trip digits,
 /// never an exponent: `1`, `0.0000001`, `NaN`, `inf`), not as the `csv`
@@ -72,6 +72,9 @@ struct FrameRow<'a> {
     jnbm_2d: Measured,
     cpbd_2d: Measured,
     gain: Shown,
+    /// SPEC section 10's family of the policy (`fixed`, `fixed-exposure`,
+    /// `auto-exposure`, `mmbm`, `oracle`).
+    family: &'static str,
 }
 
 impl<'a> FrameRow<'a> {
@@ -111,6 +114,8 @@ impl<'a> FrameRow<'a> {
             jnbm_2d: v(|m| m.jnbm_2d),
             cpbd_2d: v(|m| m.cpbd_2d),
             gain: Shown(f.gain),
+            family: crate::trigger::PolicySpec::parse(&f.policy)
+                .map_or("", |p| p.policy_family().name()),
         }
     }
 }
@@ -204,9 +209,9 @@ mod tests {
              deadline:5:0.4,0.30000000000000004,2,0.25,16,1,slow,1,0.0000001,\
              1000000000000000000000,-0,1,1,5.999652405925646,,123456789.125,\
              0.41040770904235263,73.92057289971574,15,64,52.500659,,11.599904771512902,\
-             fast,3,0,,0.0000000001,-1.5,0,1\n\
+             fast,3,0,,0.0000000001,-1.5,0,1,mmbm\n\
              fixed:5+exp:2:0.02,NaN,,,,,fast,1,inf,1000000000000000000000,-0,0,0,\
-             ,,,,,,,,,,,18446744073709551615,,,,,,2.5\n"
+             ,,,,,,,,,,,18446744073709551615,,,,,,2.5,mmbm\n"
         );
         assert_eq!(frames_csv(&records(), "fast").unwrap(), want);
         assert_eq!(
@@ -222,7 +227,7 @@ mod tests {
         let text = frames_csv(&records(), "fast").unwrap();
         let mut rd = csv::Reader::from_reader(text.as_bytes());
         let header: Vec<String> = rd.headers().unwrap().iter().map(String::from).collect();
-        assert_eq!(header.len(), 31);
+        assert_eq!(header.len(), 32);
         let rows: Vec<csv::StringRecord> = rd.records().map(|r| r.unwrap()).collect();
         assert_eq!(rows.len(), 2);
         let col = |row: &csv::StringRecord, name: &str| -> String {
@@ -240,6 +245,7 @@ mod tests {
         assert_eq!(col(&rows[1], "rendered"), "0");
         assert_eq!(col(&rows[1], "seed"), "18446744073709551615");
         assert_eq!(col(&rows[1], "gain"), "2.5");
+        assert_eq!(col(&rows[1], "family"), "mmbm");
         // The struct's own field names, as serde writes them, are the header.
         let mut w = csv::Writer::from_writer(Vec::new());
         w.serialize(FrameRow::new(&records()[1], "fast")).unwrap();

@@ -213,6 +213,9 @@ pub fn table_6(stats: &[PolicyStats]) -> String {
     s
 }
 
+/// The heat map's file name in the output directory.
+pub const MAP_FIGURE: &str = "benefit_map.png";
+
 /// What the experiment produced.
 pub struct Outcome {
     /// The walks with every policy's frames.
@@ -229,6 +232,43 @@ pub struct Outcome {
     pub sweep: Vec<super::sweep::SweepRow>,
     /// Where the frames were rendered (`gpu: <adapter>` or `cpu (N threads)`).
     pub backend: String,
+    /// The benefit map (when `[map]` has lights).
+    pub map: Option<super::map::BenefitMap>,
+}
+
+impl Outcome {
+    /// The few lines the terminal ends with: the benefit map's headline
+    /// ratios (or, without a map, each gait's best causal policy against the
+    /// fixed rate) with their intervals, and where the report is.
+    pub fn answer(&self, report: &std::path::Path) -> String {
+        if let Some(m) = &self.map {
+            return super::map_report::answer(m, report).join("\n");
+        }
+        let policies: Vec<PolicySpec> = self
+            .walks
+            .first()
+            .map(|w| w.runs.iter().map(|(p, _)| p.clone()).collect())
+            .unwrap_or_default();
+        let hs = super::benefit::headlines(&self.walks, &self.records, &policies);
+        let mut out = Vec::new();
+        let mut gaits: Vec<&str> = hs.iter().map(|h| h.gait.as_str()).collect();
+        gaits.dedup();
+        for g in gaits {
+            let best = hs
+                .iter()
+                .filter(|h| h.gait == g && h.policy.is_causal() && !h.policy.is_baseline())
+                .filter_map(|h| h.ratio.map(|r| (h, r)))
+                .max_by(|a, b| a.1.value.total_cmp(&b.1.value));
+            if let Some((h, r)) = best {
+                out.push(format!(
+                    "{g}: best causal policy `{}`: {:.2} sharp frames/s, {:.2}x the fixed rate [95 % CI {:.2}, {:.2}]",
+                    h.policy, h.sharp_fps.value, r.value, r.lo, r.hi
+                ));
+            }
+        }
+        out.push(format!("Report: {}", report.display()));
+        out.join("\n")
+    }
 }
 
 /// The baseline's blob success with both detectors and the blur that
@@ -374,6 +414,14 @@ pub fn report_md(
         .first()
         .map(|w| w.runs.iter().map(|(p, _)| p.clone()).collect())
         .unwrap_or_default();
+    if let Some(m) = &o.map {
+        s += &super::map_report::map_md(
+            m,
+            figs.iter()
+                .find(|f| f.as_str() == MAP_FIGURE)
+                .map(String::as_str),
+        );
+    }
     s += &super::benefit::headline_md(
         &super::benefit::headlines(walks, records, &policies),
         &policies,

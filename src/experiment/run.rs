@@ -93,6 +93,7 @@ pub fn run(cfg: &ExperimentConfig, out: &Path, progress: bool) -> Result<Outcome
     }
     drop(bar);
     let sweep = super::sweep::exposure_sweep(cfg, &walks, quality)?;
+    let map = super::map::benefit_map(cfg, quality, progress)?;
 
     let mut records = Vec::new();
     for (wi, w) in walks.iter().enumerate() {
@@ -119,7 +120,11 @@ pub fn run(cfg: &ExperimentConfig, out: &Path, progress: bool) -> Result<Outcome
                 .map_err(|e| Error::io(out.join("frames.csv"), e))
         })?;
 
-        let figs = figures::write_all(out, cfg, &walks, &records, &extremes)?;
+        let mut figs = figures::write_all(out, cfg, &walks, &records, &extremes)?;
+        if let Some(m) = &map {
+            super::map_report::heat_map_png(&out.join(super::report::MAP_FIGURE), m)?;
+            figs.push(super::report::MAP_FIGURE.to_string());
+        }
         let outcome = Outcome {
             walks,
             records,
@@ -128,6 +133,7 @@ pub fn run(cfg: &ExperimentConfig, out: &Path, progress: bool) -> Result<Outcome
             rendered: plan.len(),
             sweep,
             backend,
+            map,
         };
         let md = report_md(cfg, &outcome, &figs, check);
         write_atomic(&out.join("report.md"), |w| {

@@ -50,7 +50,7 @@ pub fn make_walk(
             let g = GaitConfig::preset(gait);
             (
                 walk.to_string(),
-                ImuLog::new(simulate(&g, cfg.duration_s, cfg.rate_hz, seed)?)?,
+                ImuLog::new(simulate(&g, cfg.walk_duration_s(gait), cfg.rate_hz, seed)?)?,
             )
         }
     };

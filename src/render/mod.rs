@@ -32,7 +32,7 @@ pub(crate) mod trajectory;
 pub use crate::gpu::Backend;
 pub use maps::{blur_maps, BlurMaps, BlurMeans};
 pub use psf::{psf, Psf};
-pub use target::{project, Target, TargetKind};
+pub use target::{project, Target, TargetKind, DEFAULT_BACKGROUND};
 pub use trajectory::{Pose, Trajectory};
 
 use crate::camera::Camera;

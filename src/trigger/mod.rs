@@ -34,6 +34,8 @@
 //! | policy | rule |
 //! |---|---|
 //! | `fixed:FPS[@PHASE]` | trigger at the first sample at or after `t_0 + PHASE + k / FPS` (slots the busy camera cannot take are skipped) |
+//! | `fixed:FPS[@PHASE]@Tms` | the same schedule, every frame exposed for `T` ms with the gain raised by the camera's exposure / `T` (see [`FixedExposure`]) |
+//! | `ae:FPS[@PHASE][:cap=Tms][:target=F][:damp=F][:scene=F]` | the same schedule with a motion-blind auto-exposure (see [`AutoExposure`]) |
 //! | `threshold:X` | thesis rule: camera free, minimum interval passed, the last three MMBM samples below `X` and strictly decreasing |
 //! | `adaptive[:X[:FPS]]` | thesis rule with an adaptive threshold (see [`Adaptive`]); `X` default 0.4, target `FPS` default 2.5 |
 //! | `oracle:X[:H]` | perfect future knowledge (see [`Oracle`]); `H` default 0.2 s |
@@ -51,6 +53,7 @@
 //! replayed log, one MMBM evaluation per sample for every policy, JSON lines
 //! out, [`Latency`] statistics, stopped through a [`StreamControl`].
 
+mod baselines;
 mod exposure;
 mod latency;
 mod live;
@@ -65,12 +68,14 @@ mod stats;
 mod stream;
 mod timing;
 
+pub use baselines::{AeParams, AutoExposure, FixedExposure};
 pub use exposure::Exposure;
 pub use latency::Latency;
 pub use live::{Event, Live};
 pub use pace::check_speed;
 pub use parse::{
-    parse_policy, ExposureControl, Family, PolicySpec, Rate, DEFAULT_HORIZON_S, THESIS_POLICY,
+    parse_policy, ExposureControl, Family, PolicyFamily, PolicySpec, Rate, DEFAULT_HORIZON_S,
+    THESIS_POLICY,
 };
 pub use phase::Phase;
 pub use policy::{Level, LogView, Observation, Policy};

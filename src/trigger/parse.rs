@@ -3,6 +3,7 @@
 //! its family, rate, threshold, causality and exposure control, and builds
 //! the boxed [`Policy`] that runs.
 
+use super::baselines::{parse_ae, split_exposure, AeParams, AutoExposure, FixedExposure};
 use super::exposure::Exposure;
 use super::phase::Phase;
 use super::policy::{Level, Policy};
@@ -66,7 +67,7 @@ fn parse_rate(s: &str, spec: &str) -> Result<(f64, f64)> {
     Ok((fps, p))
 }
 
-const GRAMMAR: &str = "fixed:FPS[@PHASE], threshold:X, adaptive[:X[:FPS]], oracle:X[:H], \
+const GRAMMAR: &str = "fixed:FPS[@PHASE][@Tms], ae:FPS[@PHASE][:cap=Tms][:target=F][:damp=F][:scene=F], threshold:X, adaptive[:X[:FPS]], oracle:X[:H], \
 forecast:X[:H], phase:X[:H], gate:X[:FPS[@PHASE]], gate0:X[:FPS[@PHASE]] or deadline:FPS[:X] (X in mm/s or pNN), \
 each optionally followed by +exp:B[:TMIN] (exposure control: blur budget B px, shortest exposure TMIN s)";
 
@@ -101,6 +102,8 @@ pub enum Family {
     Gate0,
     /// `deadline:FPS[:X]`.
     Deadline,
+    /// `ae:FPS[...]`, motion-blind auto-exposure.
+    Ae,
 }
 
 impl Family {
@@ -116,6 +119,7 @@ impl Family {
             Family::Gate => "gate",
             Family::Gate0 => "gate0",
             Family::Deadline => "deadline",
+            Family::Ae => "ae",
         }
     }
 
@@ -130,9 +134,45 @@ impl Family {
             Family::Gate,
             Family::Gate0,
             Family::Deadline,
+            Family::Ae,
         ]
         .into_iter()
         .find(|f| f.name() == s)
+    }
+}
+
+/// The family of SPEC section 10, by which the benefit map groups the
+/// policies (the `family` column of `frames.csv`). Not the rule ([`Family`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum PolicyFamily {
+    /// The thesis's fixed rate at the camera's exposure (`fixed:FPS[@PHASE]`).
+    Fixed,
+    /// A fixed rate at a fixed shorter exposure, gain raised (`fixed:FPS@Tms`).
+    FixedExposure,
+    /// Motion-blind auto-exposure (`ae:...`).
+    AutoExposure,
+    /// Every causal policy that reads the gyro (MMBM rules, gates, exposure control).
+    Mmbm,
+    /// Every non-causal one (the oracle; the best fixed exposure in hindsight).
+    Oracle,
+}
+
+impl PolicyFamily {
+    /// The family's name: `fixed`, `fixed-exposure`, `auto-exposure`, `mmbm`, `oracle`.
+    pub fn name(self) -> &'static str {
+        match self {
+            PolicyFamily::Fixed => "fixed",
+            PolicyFamily::FixedExposure => "fixed-exposure",
+            PolicyFamily::AutoExposure => "auto-exposure",
+            PolicyFamily::Mmbm => "mmbm",
+            PolicyFamily::Oracle => "oracle",
+        }
+    }
+}
+
+impl std::fmt::Display for PolicyFamily {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
     }
 }
 
@@ -184,6 +224,10 @@ pub struct PolicySpec {
     pub horizon: Option<f64>,
     /// Exposure control, when the string ends in `+exp:B[:TMIN]`.
     pub exposure: Option<ExposureControl>,
+    /// The fixed exposure of `fixed:FPS@Tms`, s.
+    pub fixed_exposure_s: Option<f64>,
+    /// The auto-exposure of `ae:...`.
+    pub ae: Option<AeParams>,
 }
 
 impl PolicySpec {
@@ -205,6 +249,11 @@ impl PolicySpec {
                 Error::invalid("policy", format!("'{spec}': {msg}; expected {GRAMMAR}"))
             };
             let mut inner = PolicySpec::parse(base)?;
+            if inner.fixed_exposure_s.is_some() || inner.ae.is_some() {
+                return Err(bad(
+                    "a fixed exposure (@Tms) or auto-exposure (ae) sets its own exposure; +exp does not apply",
+                ));
+            }
             let parts: Vec<&str> = modifier.trim().split(':').collect();
             let (budget, tmin) = match parts.as_slice() {
                 ["exp", b] => (*b, None),
@@ -250,9 +299,19 @@ impl PolicySpec {
             threshold: None,
             horizon: None,
             exposure: None,
+            fixed_exposure_s: None,
+            ae: None,
         };
         match (family, args) {
-            (Family::Fixed, [r]) => out.rate = Some(rate(r)?),
+            (Family::Fixed, [r]) => {
+                let (r, te) = split_exposure(r, spec)?;
+                out.rate = Some(rate(r)?);
+                out.fixed_exposure_s = te;
+            }
+            (Family::Ae, [r, keys @ ..]) => {
+                out.rate = Some(rate(r)?);
+                out.ae = Some(parse_ae(keys, spec)?);
+            }
             (Family::Threshold, [x]) => out.threshold = Some(level(x)?),
             (Family::Adaptive, []) => {
                 out.threshold = Some(Level::Abs(0.4));
@@ -297,6 +356,21 @@ impl PolicySpec {
         &self.text
     }
 
+    /// The family of SPEC section 10 (the benefit map's grouping).
+    pub fn policy_family(&self) -> PolicyFamily {
+        if !self.is_causal() {
+            PolicyFamily::Oracle
+        } else if self.ae.is_some() {
+            PolicyFamily::AutoExposure
+        } else if self.fixed_exposure_s.is_some() {
+            PolicyFamily::FixedExposure
+        } else if self.is_baseline() {
+            PolicyFamily::Fixed
+        } else {
+            PolicyFamily::Mmbm
+        }
+    }
+
     /// False for the policies that use knowledge of the future (the oracle).
     pub fn is_causal(&self) -> bool {
         self.family != Family::Oracle
@@ -305,7 +379,7 @@ impl PolicySpec {
     /// True for a plain fixed-rate policy (`fixed:FPS[@PHASE]`), the baseline
     /// the others are compared with; `fixed:5+exp:2` (exposure control) is not.
     pub fn is_baseline(&self) -> bool {
-        self.family == Family::Fixed && self.exposure.is_none()
+        self.family == Family::Fixed && self.exposure.is_none() && self.fixed_exposure_s.is_none()
     }
 
     /// True for the thesis's rule at its threshold ([`THESIS_POLICY`], no exposure control).
@@ -343,7 +417,16 @@ impl PolicySpec {
         let rate = self.rate.unwrap_or(DEFAULT_GATE_RATE);
         let h = self.horizon.unwrap_or(DEFAULT_HORIZON_S);
         match self.family {
-            Family::Fixed => Box::new(Fixed::new(spec, rate.fps, rate.phase)),
+            Family::Fixed => match self.fixed_exposure_s {
+                Some(te) => Box::new(FixedExposure::new(spec, rate.fps, rate.phase, te)),
+                None => Box::new(Fixed::new(spec, rate.fps, rate.phase)),
+            },
+            Family::Ae => Box::new(AutoExposure::new(
+                spec,
+                rate.fps,
+                rate.phase,
+                self.ae.unwrap_or_default(),
+            )),
             Family::Threshold => Box::new(Threshold::new(spec, level)),
             Family::Adaptive => Box::new(Adaptive::new(spec, level, rate.fps)),
             Family::Oracle => Box::new(Oracle::new(spec, level, h)),
@@ -437,6 +520,8 @@ mod tests {
             "gate0:0.4",
             "deadline:5:0.3",
             "deadline:5+exp:3:0.02",
+            "fixed:5@3ms",
+            "ae:5:cap=10ms",
         ] {
             let p = spec(s);
             let b = p.build();
@@ -459,6 +544,17 @@ mod tests {
             "fixed:5+exp:0",
             "gate:0.4:5@-1",
             "deadline:2000",
+            "fixed:5@0ms",
+            "fixed:5@xms",
+            "fixed:5@3ms+exp:2",
+            "ae",
+            "ae:5:cap=10",
+            "ae:5:cap=-1ms",
+            "ae:5:target=2",
+            "ae:5:damp=0",
+            "ae:5:speed=1",
+            "ae:5:10ms",
+            "ae:5+exp:2",
         ] {
             assert!(PolicySpec::parse(s).is_err(), "{s}");
         }

@@ -1,0 +1,376 @@
+//! The benefit map in the report: its table (the report's first), the
+//! detail per cell, the issue's goals checked against it, the lost cells
+//! with their reasons (all computed from the map), a heat map, and the few
+//! lines the terminal ends with.
+
+use super::benefit::{Estimate, BLOCK_S, BOOTSTRAP_SEED, RESAMPLES};
+use super::map::{BenefitMap, Cell};
+use crate::error::Result;
+use crate::io::atomic::write_atomic_path;
+use crate::plot::{ensure_font, plot_error};
+use plotters::prelude::*;
+use std::path::Path;
+
+/// Light below which a cell is dim (the goals' "<= 1,000 e-/s"), e-/s.
+pub const DIM_LIGHT: f64 = 1_000.0;
+
+fn ci(e: &Estimate) -> String {
+    if !e.value.is_finite() {
+        return "n/a (the baseline gets no sharp frame)".into();
+    }
+    if e.lo.is_finite() {
+        format!("{:.2}x [{:.2}, {:.2}]", e.value, e.lo, e.hi)
+    } else {
+        format!("{:.2}x", e.value)
+    }
+}
+
+fn opt(e: &Option<Estimate>) -> String {
+    e.as_ref().map_or("-".into(), ci)
+}
+
+fn board_name(b: &str) -> &str {
+    match b {
+        "blobs:0.5" | "blobs-half" => "half board",
+        "blobs" => "full board",
+        other => other,
+    }
+}
+
+/// The cell's column name: gait and board.
+pub fn column(c: &Cell) -> String {
+    format!("{}, {}", c.gait, board_name(&c.board))
+}
+
+/// True when the cell is lost: the best `mmbm` policy is below the best
+/// fixed exposure in hindsight or auto-exposure (the ratio's upper bound under 1).
+pub fn lost(c: &Cell) -> bool {
+    [&c.vs_hindsight, &c.vs_ae]
+        .iter()
+        .any(|e| e.is_some_and(|e| e.hi < 1.0))
+}
+
+/// The map's section of the report.
+pub fn map_md(m: &BenefitMap, figure: Option<&str>) -> String {
+    let mut s =
+        String::from("## Benefit map: gyro-driven capture against what users do instead\n\n");
+    let first = m.cells.first();
+    s += &format!(
+        "Sharp frames per second (kept, rendered, all 16 blobs at their true places) of the best causal gyro-driven \
+         policy (family `mmbm`) over the best fixed exposure in hindsight (family `oracle`: the fixed exposure of the \
+         grid {:?} ms with the most sharp frames in the cell) and over auto-exposure (`auto-exposure`). Seeds {:?}, \
+         {:.0}-s blocks ({} per cell), 95 % percentile bootstrap over {} resamplings of the blocks (bootstrap seed {}), \
+         paired block by block; the best policies are chosen on all blocks, then held fixed. Light = electrons per \
+         second in a white pixel; gain `K_ref = {} / (light x {:.0} ms)` (white fills the range at the reference \
+         exposure), raised by each policy to keep the brightness and capped at {}x the full-well gain ({:.3} DN/e-); \
+         read noise {} e-, full well {} e-, {} bits.\n\n",
+        m.grid_ms,
+        m.seeds,
+        BLOCK_S,
+        first.map_or(0, |c| c.blocks),
+        RESAMPLES,
+        BOOTSTRAP_SEED,
+        m.sensor.max_dn(),
+        m.t_ref_s * 1e3,
+        m.max_gain_x,
+        m.max_gain_x * m.sensor.max_dn() / m.sensor.full_well_e,
+        m.sensor.read_noise_e,
+        m.sensor.full_well_e,
+        m.sensor.bits,
+    );
+    let mut cols: Vec<String> = Vec::new();
+    for c in &m.cells {
+        if !cols.contains(&column(c)) {
+            cols.push(column(c));
+        }
+    }
+    s += "| light (e-/s) |";
+    for c in &cols {
+        s += &format!(" {c} |");
+    }
+    s += "\n|---|";
+    s += &"---|".repeat(cols.len());
+    s += "\n";
+    for &l in &m.lights {
+        s += &format!("| {l} |");
+        for col in &cols {
+            let Some(c) = m.cells.iter().find(|c| c.light == l && &column(c) == col) else {
+                s += " - |";
+                continue;
+            };
+            let w = &c.policies[c.winner];
+            s += &format!(
+                " {}vs best fixed {}; vs AE {}; won: `{}`{} |",
+                if lost(c) { "**lost** " } else { "" },
+                opt(&c.vs_hindsight),
+                opt(&c.vs_ae),
+                w.policy,
+                if c.hindsight == Some(c.winner) {
+                    " (best fixed in hindsight)"
+                } else {
+                    ""
+                }
+            );
+        }
+        s += "\n";
+    }
+    if let Some(f) = figure {
+        s += &format!("\n![benefit map]({f})\n");
+    }
+    s += "\n| light | gait, board | best `mmbm` (sharp/s) | best fixed in hindsight (sharp/s) | auto-exposure (sharp/s, % sharp) | `fixed` (sharp/s) | vs `fixed` |\n";
+    s += "|---|---|---|---|---|---|---|\n";
+    for c in &m.cells {
+        let p = |i: Option<usize>| {
+            i.map_or("-".into(), |i| {
+                format!("`{}` {:.2}", c.policies[i].policy, c.policies[i].sharp_fps)
+            })
+        };
+        let ae = c.ae.map_or("-".into(), |i| {
+            let a = &c.policies[i];
+            format!(
+                "`{}` {:.2}, {:.0} %",
+                a.policy,
+                a.sharp_fps,
+                100.0 * a.sharp as f64 / a.frames.max(1) as f64
+            )
+        });
+        s += &format!(
+            "| {} | {} | {} | {} | {} | {} | {} |\n",
+            c.light,
+            column(c),
+            p(c.best_mmbm),
+            p(c.hindsight),
+            ae,
+            p(c.fixed),
+            opt(&c.vs_fixed)
+        );
+    }
+    s += "\n";
+    s += &goals_md(m);
+    s += &format!(
+        "\nThe map rendered {} frames (each judged at all {} lights) in {:.0} s.\n\n",
+        m.renders,
+        m.lights.len(),
+        m.seconds
+    );
+    s
+}
+
+/// The reason a cell is lost, from its numbers.
+fn reason(c: &Cell) -> String {
+    let w = &c.policies[c.winner];
+    let Some(b) = c.best_mmbm.map(|i| &c.policies[i]) else {
+        return "no `mmbm` policy was run".into();
+    };
+    let share = |p: &super::map::CellPolicy| 100.0 * p.sharp as f64 / p.frames.max(1) as f64;
+    format!(
+        "`{}` gets {:.2} sharp/s ({:.0} % of {} frames sharp, mean exposure {:.1} ms, {} frames gain-capped) against \
+         `{}`'s {:.2} ({:.0} % of {}, mean exposure {:.1} ms, {} gain-capped)",
+        w.policy,
+        w.sharp_fps,
+        share(w),
+        w.frames,
+        w.mean_exposure_s * 1e3,
+        w.gain_capped,
+        b.policy,
+        b.sharp_fps,
+        share(b),
+        b.frames,
+        b.mean_exposure_s * 1e3,
+        b.gain_capped
+    )
+}
+
+/// The goals of issue 27, checked against the map (met or not, with the numbers).
+pub fn goals_md(m: &BenefitMap) -> String {
+    let mut s = String::from("Goals (issue 27), computed from the map:\n\n");
+    let met = |b: bool| if b { "met" } else { "not met" };
+    // 1. Half board, the demo's light, moderate walk: >= 1.5x fixed, CI above 1.
+    let demo = super::config::ExperimentConfig::DEMO_LIGHT_E_PER_S;
+    match m
+        .cells
+        .iter()
+        .find(|c| c.light == demo && c.gait == "moderate" && c.board == "blobs:0.5")
+    {
+        Some(c) => {
+            if let Some(r) = c.vs_fixed {
+                s += &format!(
+                    "- Half board, {demo} e-/s, moderate walk: the best `mmbm` policy gets {} the sharp frames per second \
+                     of `fixed` (goal >= 1.5x with the CI above 1: {}).\n",
+                    ci(&r),
+                    met(r.value >= 1.5 && r.lo > 1.0)
+                );
+            }
+        }
+        None => {
+            s += &format!("- The cell half board, {demo} e-/s, moderate walk is not in this map.\n")
+        }
+    }
+    // 2. Every cell: below neither; >= 1.3x AE where AE gets < 80 % sharp.
+    let n = m.cells.len();
+    let ok_both = m.cells.iter().filter(|c| !lost(c)).count();
+    s += &format!(
+        "- In {ok_both} of {n} cells the best `mmbm` policy is below neither the best fixed exposure in hindsight nor \
+         auto-exposure (each CI reaches 1; goal: every cell, {}).\n",
+        met(ok_both == n)
+    );
+    let weak: Vec<&Cell> = m
+        .cells
+        .iter()
+        .filter(|c| {
+            c.ae.is_some_and(|i| {
+                let a = &c.policies[i];
+                (a.sharp as f64) < 0.8 * a.frames as f64
+            })
+        })
+        .collect();
+    let weak_ok = weak
+        .iter()
+        .filter(|c| c.vs_ae.is_some_and(|r| r.value >= 1.3))
+        .count();
+    s += &format!(
+        "- Auto-exposure gets fewer than 80 % of its frames sharp in {} cells; there the best `mmbm` policy reaches \
+         1.3x auto-exposure in {weak_ok} (goal: all, {}).\n",
+        weak.len(),
+        met(weak_ok == weak.len())
+    );
+    // 3. Dim cells: >= 1.3x the best fixed exposure in hindsight, CI above 1.
+    let dim: Vec<&Cell> = m.cells.iter().filter(|c| c.light <= DIM_LIGHT).collect();
+    let dim_ok = dim
+        .iter()
+        .filter(|c| c.vs_hindsight.is_some_and(|r| r.value >= 1.3 && r.lo > 1.0))
+        .count();
+    s += &format!(
+        "- Dim cells (<= {DIM_LIGHT} e-/s): {dim_ok} of {} reach 1.3x the best fixed exposure in hindsight with the CI \
+         above 1 (goal: all, {}){}.\n",
+        dim.len(),
+        met(!dim.is_empty() && dim_ok == dim.len()),
+        dim.iter()
+            .map(|c| format!("; {} {}: {}", c.light, column(c), opt(&c.vs_hindsight)))
+            .collect::<String>()
+    );
+    for c in m.cells.iter().filter(|c| lost(c)) {
+        s += &format!("- Lost: {} e-/s, {}: {}.\n", c.light, column(c), reason(c));
+    }
+    s
+}
+
+/// The few lines the terminal ends with: the headline ratios and where the report is.
+pub fn answer(m: &BenefitMap, report: &Path) -> Vec<String> {
+    let mut out = Vec::new();
+    let won = m.cells.iter().filter(|c| !lost(c)).count();
+    out.push(format!(
+        "Benefit map ({} cells, seeds {:?}): gyro-driven capture is below neither the best fixed exposure in hindsight \
+         nor auto-exposure in {won} of {} cells.",
+        m.cells.len(),
+        m.seeds,
+        m.cells.len()
+    ));
+    for c in &m.cells {
+        out.push(format!(
+            "  {:>7} e-/s, {}: vs best fixed {}, vs auto-exposure {}",
+            c.light,
+            column(c),
+            opt(&c.vs_hindsight),
+            opt(&c.vs_ae)
+        ));
+    }
+    out.push(format!("Report: {}", report.display()));
+    out
+}
+
+/// The map as a heat map: rows light, columns gait x board, colour the best
+/// `mmbm` policy's ratio to the best fixed exposure in hindsight (log scale,
+/// red below 1, blue above), each cell labelled with its ratio.
+pub fn heat_map_png(path: &Path, m: &BenefitMap) -> Result<()> {
+    ensure_font()?;
+    let mut cols: Vec<String> = Vec::new();
+    for c in &m.cells {
+        if !cols.contains(&column(c)) {
+            cols.push(column(c));
+        }
+    }
+    let (nc, nr) = (cols.len().max(1), m.lights.len().max(1));
+    write_atomic_path(path, |tmp| {
+        let e = plot_error(path);
+        let root = BitMapBackend::new(tmp, (420 + 220 * nc as u32, 140 + 70 * nr as u32))
+            .into_drawing_area();
+        root.fill(&WHITE).map_err(&e)?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(
+                "best mmbm / best fixed exposure in hindsight (sharp frames/s)",
+                ("sans-serif", 18),
+            )
+            .margin(10)
+            .x_label_area_size(40)
+            .y_label_area_size(110)
+            .build_cartesian_2d(-0.5..nc as f64 - 0.5, -0.5..nr as f64 - 0.5)
+            .map_err(&e)?;
+        let lights = m.lights.clone();
+        let colnames = cols.clone();
+        chart
+            .configure_mesh()
+            .disable_mesh()
+            .x_labels(nc)
+            .y_labels(nr)
+            .x_label_formatter(&|x| {
+                colnames
+                    .get(x.round().max(0.0) as usize)
+                    .filter(|_| (x - x.round()).abs() < 0.01)
+                    .cloned()
+                    .unwrap_or_default()
+            })
+            .y_label_formatter(&|y| {
+                lights
+                    .get(y.round().max(0.0) as usize)
+                    .filter(|_| (y - y.round()).abs() < 0.01)
+                    .map(|l| format!("{l} e-/s"))
+                    .unwrap_or_default()
+            })
+            .draw()
+            .map_err(&e)?;
+        for c in &m.cells {
+            let (Some(ci), Some(ri)) = (
+                cols.iter().position(|x| *x == column(c)),
+                m.lights.iter().position(|&l| l == c.light),
+            ) else {
+                continue;
+            };
+            let r = c.vs_hindsight.map_or(f64::NAN, |r| r.value);
+            // log2 ratio in [-1, 1] -> red .. white .. blue.
+            let t = if r.is_finite() && r > 0.0 {
+                r.log2().clamp(-1.0, 1.0)
+            } else {
+                0.0
+            };
+            let colour = if t >= 0.0 {
+                let v = (255.0 * (1.0 - t)) as u8;
+                RGBColor(v, v, 255)
+            } else {
+                let v = (255.0 * (1.0 + t)) as u8;
+                RGBColor(255, v, v)
+            };
+            let (x, y) = (ci as f64, ri as f64);
+            chart
+                .draw_series(std::iter::once(Rectangle::new(
+                    [(x - 0.5, y - 0.5), (x + 0.5, y + 0.5)],
+                    colour.filled(),
+                )))
+                .map_err(&e)?;
+            let label = if r.is_finite() {
+                format!("{r:.2}x{}", if lost(c) { " lost" } else { "" })
+            } else {
+                "n/a".into()
+            };
+            chart
+                .draw_series(std::iter::once(Text::new(
+                    label,
+                    (x - 0.2, y + 0.05),
+                    ("sans-serif", 18),
+                )))
+                .map_err(&e)?;
+        }
+        root.present().map_err(&e)?;
+        Ok(())
+    })
+}
