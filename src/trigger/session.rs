@@ -45,7 +45,7 @@ impl Policies {
         &self.timing
     }
 
-    /// Runs every policy over a log ([`run`](super::run)): `mmbm_mm_s[i]`
+    /// Runs every policy over a log ([`run()`]): `mmbm_mm_s[i]`
     /// is the MMBM at the time of `samples[i]` (samples, or bare times in
     /// s). One list of frames per policy, in the order of [`Self::specs`].
     pub fn run<S: Timed>(&self, samples: &[S], mmbm_mm_s: &[f64]) -> Result<Vec<Vec<Frame>>> {
