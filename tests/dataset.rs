@@ -311,3 +311,86 @@ fn a_terminated_run_leaves_no_partial_item() {
         assert!(!err.contains("removed 0 temporary"), "SIG{sig}: {err}");
     }
 }
+
+/// A `[camera]` section (issue #22): its keys are in every item's parameters
+/// and in the fingerprint, the items are made with that camera (again from
+/// the manifest line alone), and a configuration without it has no `camera`
+/// key anywhere. A bad section is an error naming it.
+#[test]
+fn a_camera_section_makes_another_dataset() {
+    let d = tempfile::tempdir().unwrap();
+    let p = d.path();
+    let section =
+        "[camera]\nfocal_mm = 3.0\nreadout_s = 0.01\nreadout_direction = \"bottom-to-top\"\n";
+    let toml = format!(
+        "count = 2\ntextures = \"{}\"\nmotion = [\"sim:fast\"]\nresolution = [48, 36]\n",
+        textures().display()
+    );
+    std::fs::write(p.join("plain.toml"), &toml).unwrap();
+    std::fs::write(p.join("cam.toml"), format!("{toml}{section}")).unwrap();
+    let plain = DatasetConfig::load(&p.join("plain.toml")).unwrap();
+    let cam = DatasetConfig::load(&p.join("cam.toml")).unwrap();
+    assert_eq!(cam.camera.focal_mm, Some(3.0));
+    assert_eq!(cam.camera().shutter.readout_s, 0.01);
+    assert!(!plain.to_toml().unwrap().contains("camera"));
+    assert!(cam.to_toml().unwrap().contains("[camera]"));
+
+    let (a, b) = (
+        dataset::Record::of(&plain, &Sources::open(&plain).unwrap()).unwrap(),
+        dataset::Record::of(&cam, &Sources::open(&cam).unwrap()).unwrap(),
+    );
+    assert_ne!(a.fingerprint, b.fingerprint);
+    assert!(a.inputs.get("camera").is_none());
+    assert_eq!(b.inputs["camera"]["focal_mm"], 3.0);
+
+    let (da, db) = (p.join("plain"), p.join("cam"));
+    dataset::run(&plain, &da, Shard::ALL, false).unwrap();
+    dataset::run(&cam, &db, Shard::ALL, false).unwrap();
+    let lines = |dir: &Path| -> Vec<ManifestLine> {
+        std::fs::read_to_string(dir.join("manifest.jsonl"))
+            .unwrap()
+            .lines()
+            .map(|l| serde_json::from_str(l).unwrap())
+            .collect()
+    };
+    let raw = std::fs::read_to_string(da.join("manifest.jsonl")).unwrap();
+    assert!(!raw.contains("camera"), "{raw}");
+    let src = Sources::open(&cam).unwrap();
+    for (x, y) in lines(&da).iter().zip(lines(&db)) {
+        assert_eq!(x.params.camera, Default::default());
+        assert_eq!(y.params.camera, cam.camera);
+        // The shorter focal length sees a wider field: a wider texture.
+        assert!(y.params.texture_width_m > x.params.texture_width_m);
+        let blurred = |dir: &Path, l: &ManifestLine| {
+            std::fs::read(dir.join(&l.dir).join("blurred.exr")).unwrap()
+        };
+        assert!(blurred(&da, x) != blurred(&db, &y), "item {}", x.index);
+        // Made again from the line alone: the same bytes.
+        let again = tempfile::tempdir().unwrap();
+        assert_eq!(make(&y.params, &src, again.path()).unwrap(), y.measures);
+        for f in FILES {
+            let (u, v) = (
+                std::fs::read(again.path().join(f)).unwrap(),
+                std::fs::read(db.join(&y.dir).join(f)).unwrap(),
+            );
+            assert!(u == v, "item {} {f} differs when re-rendered", y.index);
+        }
+    }
+
+    std::fs::write(
+        p.join("bad.toml"),
+        format!("{toml}[camera]\nfocal_mm = -1\n"),
+    )
+    .unwrap();
+    let o = mmbm_in(
+        p,
+        &["dataset", "--quiet", "--config", "bad.toml", "--out", "bad"],
+    );
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("bad.toml") && err.contains("camera"), "{err}");
+    assert!(
+        !p.join("bad/items").exists()
+            || std::fs::read_dir(p.join("bad/items")).unwrap().count() == 0
+    );
+}

@@ -126,14 +126,26 @@ pub fn with_log_readout(
 ) -> Result<Camera> {
     let (camera, applied) = mmbm::model::log::LogReadout::apply(readout, camera)?;
     if applied {
-        eprintln!(
-            "rolling shutter from {}: readout {} s, {:?}",
-            gyro.display(),
-            camera.shutter.readout_s,
-            camera.shutter.direction
-        );
+        print_log_readout(&camera, gyro);
     }
     Ok(camera)
+}
+
+/// Says on stderr that `session`'s camera took the rolling shutter of the
+/// log `gyro` (as [`with_log_readout`] does), when it did.
+pub fn report_log_readout(session: &mmbm::trigger::Session, gyro: &Path) {
+    if session.readout_from_log() {
+        print_log_readout(session.camera(), gyro);
+    }
+}
+
+fn print_log_readout(camera: &Camera, gyro: &Path) {
+    eprintln!(
+        "rolling shutter from {}: readout {} s, {:?}",
+        gyro.display(),
+        camera.shutter.readout_s,
+        camera.shutter.direction
+    );
 }
 
 /// Scene depth options.
@@ -215,15 +227,15 @@ pub struct TimingArgs {
 }
 
 impl TimingArgs {
-    /// The camera timing with exposure `exposure` (s) and pixel pitch
-    /// `pitch_mm` (mm); validated by its users.
-    pub fn timing(&self, exposure: f64, pitch_mm: f64) -> CameraTiming {
+    /// The camera timing with exposure `exposure` (s); the pixel pitch is
+    /// the default until a [`mmbm::trigger::Session`] takes the camera's.
+    pub fn timing(&self, exposure: f64) -> CameraTiming {
         CameraTiming {
             delay: self.delay,
             exposure,
             readout: self.readout,
             min_interval: self.min_interval,
-            pitch_mm,
+            ..CameraTiming::default()
         }
     }
 }

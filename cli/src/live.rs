@@ -6,9 +6,8 @@ use super::series::GyroArgs;
 use clap::Args;
 use mmbm::error::Result;
 use mmbm::io::gyro::GyroReader;
-use mmbm::series::SeriesOptions;
-use mmbm::trigger::{Live, PolicySpec, Stream, StreamControl, StreamEnd, StreamOptions};
-use mmbm::{Method, Scene};
+use mmbm::trigger::{PolicySpec, Session, SessionConfig, StreamControl, StreamEnd, StreamOptions};
+use mmbm::Method;
 use std::path::PathBuf;
 
 /// Decide camera triggers live from an IMU stream: one JSON line per trigger.
@@ -100,7 +99,6 @@ fn parse_idle(s: &str) -> std::result::Result<f64, String> {
 /// Runs `mmbm live`, stopped through `control` (the Ctrl-C handler's);
 /// returns the exit code: 0, 2 for a `--strict` stop, 130 when interrupted.
 pub fn run(a: LiveArgs, control: &StreamControl) -> Result<i32> {
-    let method = a.method;
     let gyro = a.gyro_opts.options()?;
     // A replayed log is opened first: its own readout (a .gcsv header's)
     // applies when the camera gives none, as in `trigger` and `frames`.
@@ -108,34 +106,26 @@ pub fn run(a: LiveArgs, control: &StreamControl) -> Result<i32> {
         Some(path) => Some((path, GyroReader::open(path, gyro.clone())?)),
         None => None,
     };
-    let mut camera = a.camera.camera()?;
-    if let Some((path, r)) = &reader {
-        camera = super::args::with_log_readout(camera, r.readout(), path)?;
-    }
-    // A rolling shutter keeps the camera busy for its line readout as well.
-    let timing = a
-        .timing
-        .timing(a.exposure, camera.pitch_x_mm)
-        .with_rolling_readout(camera.shutter.readout_s);
-    timing.validate()?;
-    let series = SeriesOptions {
-        scene: Scene {
-            camera,
+    let session = Session::new(
+        SessionConfig {
+            camera: a.camera.camera()?,
             plane: a.scene.plane()?,
+            timing: a.timing.timing(a.exposure),
+            method: a.method,
+            use_velocity: a.use_velocity,
+            policies: a.policy.clone(),
         },
-        method,
-        use_velocity: a.use_velocity,
-    };
-    let mut runs = Vec::new();
-    for p in &a.policy {
-        runs.push(Live::new(p.build(), timing)?);
+        reader.as_ref().and_then(|(_, r)| r.readout()),
+    )?;
+    if let Some((path, _)) = &reader {
+        super::args::report_log_readout(&session, path);
     }
     let opts = StreamOptions {
         all: a.all,
         strict: a.strict,
         stats: a.stats,
     };
-    let mut stream = Stream::new(runs, series, opts, control.clone())?;
+    let mut stream = session.stream(opts, control.clone())?;
     let stdout = std::io::stdout();
     let mut out = stdout.lock();
     let outcome = if let Some((path, reader)) = reader.as_mut() {

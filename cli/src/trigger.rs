@@ -5,9 +5,8 @@ use super::series::GyroArgs;
 use clap::Args;
 use mmbm::error::{Error, Result};
 use mmbm::io::gyro::read_log;
-use mmbm::series::SeriesOptions;
-use mmbm::trigger::{self, Frame, PolicySpec};
-use mmbm::{Method, Scene};
+use mmbm::trigger::{self, Frame, PolicySpec, Session, SessionConfig};
+use mmbm::Method;
 use std::io::Write;
 use std::path::PathBuf;
 
@@ -115,42 +114,31 @@ pub fn run(a: TriggerArgs) -> Result<()> {
     if let Some(p) = &a.out {
         mmbm::io::atomic::check_output(p)?;
     }
-    let method = a.method;
-    let mut policies = Vec::new();
-    for p in &a.policy {
-        policies.push(p.build());
-    }
     let camera = a.camera.camera()?;
     let samples = read_log(&a.gyro, a.gyro_opts.options()?)?;
-    let camera = super::args::with_log_readout(camera, samples.readout(), &a.gyro)?;
-    // A rolling shutter keeps the camera busy for its line readout as well.
-    let timing = a
-        .timing
-        .timing(a.exposure, camera.pitch_x_mm)
-        .with_rolling_readout(camera.shutter.readout_s);
-    timing.validate()?;
-    let opts = SeriesOptions {
-        scene: Scene {
+    let session = Session::new(
+        SessionConfig {
             camera,
             plane: a.scene.plane()?,
+            timing: a.timing.timing(a.exposure),
+            method: a.method,
+            use_velocity: a.use_velocity,
+            policies: a.policy.clone(),
         },
-        method,
-        use_velocity: a.use_velocity,
-    };
-    let m = mmbm::series::mmbm_series_with(&samples, &opts)?;
-    let duration = samples[samples.len() - 1].t - samples[0].t;
-    let mut all = Vec::new();
+        samples.readout(),
+    )?;
+    super::args::report_log_readout(&session, &a.gyro);
+    let run = session.run(&samples)?;
     let mut text = String::new();
-    for (p, spec) in policies.iter_mut().zip(&a.policy) {
-        let frames = trigger::run(&samples, &m, p.as_mut(), &timing)?;
+    for (frames, spec) in run.frames.iter().zip(&a.policy) {
         text.push_str(&summary_text(
-            &frames,
+            frames,
             spec.as_str(),
-            duration,
-            timing.pitch_mm,
+            run.duration_s,
+            session.timing().pitch_mm,
         ));
-        all.push(frames);
     }
+    let all = run.frames;
     let write = |w: &mut dyn Write| -> Result<()> {
         trigger::write_frames(w, &[], true)?;
         for f in &all {

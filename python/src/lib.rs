@@ -476,17 +476,17 @@ fn trigger<'py>(
         min_interval,
         pitch_mm,
     };
-    let mut frames = Vec::new();
-    for p in &policies {
-        let f = py
-            .detach(|| {
-                let mut policy = mmbm::trigger::parse_policy(p)?;
-                // The runner uses only the times: no samples are made up.
-                mmbm::trigger::run(&t, &m, policy.as_mut(), &timing)
-            })
-            .map_err(err)?;
-        frames.extend(f);
-    }
+    let frames = py
+        .detach(|| {
+            let specs = policies
+                .iter()
+                .map(|p| mmbm::trigger::PolicySpec::parse(p))
+                .collect::<mmbm::Result<Vec<_>>>()?;
+            // The runner uses only the times: no samples are made up.
+            mmbm::trigger::Policies::new(specs, timing)?.run(&t, &m)
+        })
+        .map_err(err)?
+        .concat();
     frames
         .iter()
         .map(|f| {

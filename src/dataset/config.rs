@@ -1,5 +1,6 @@
 //! The dataset configuration (TOML): what items are drawn from.
 
+use crate::camera::{Camera, CameraFile};
 use crate::error::{Error, Result};
 use crate::render::Quality;
 use crate::sim::Gait;
@@ -36,6 +37,17 @@ pub struct DatasetConfig {
     /// Use the motion's linear velocity where it has one (simulated walks do;
     /// logs without vx,vy,vz are rotation only).
     pub use_velocity: bool,
+    /// The `[camera]` section: any of the camera file's keys ([`CameraFile`])
+    /// over the thesis camera at `resolution` ([`DatasetConfig::camera`]), as
+    /// the experiment's. Left out when empty, so a configuration without it
+    /// serialises (and fingerprints) as it always did.
+    #[serde(skip_serializing_if = "is_empty")]
+    pub camera: CameraFile,
+}
+
+/// True for a `[camera]` section with no keys.
+pub(crate) fn is_empty(c: &CameraFile) -> bool {
+    *c == CameraFile::default()
 }
 
 impl Default for DatasetConfig {
@@ -52,6 +64,7 @@ impl Default for DatasetConfig {
             resolution: [640, 480],
             quality: "default".into(),
             use_velocity: true,
+            camera: CameraFile::default(),
         }
     }
 }
@@ -78,6 +91,13 @@ impl DatasetConfig {
     /// The configuration as TOML.
     pub fn to_toml(&self) -> Result<String> {
         toml::to_string(self).map_err(|e| Error::invalid("dataset config", e.to_string()))
+    }
+
+    /// The items' camera: the thesis focal length and pitch at
+    /// `resolution`, with the `[camera]` section's keys over it
+    /// ([`CameraFile::thesis_at`]). Not validated (see [`Self::validate`]).
+    pub fn camera(&self) -> Camera {
+        self.camera.thesis_at(self.resolution)
     }
 
     /// Checks every value (not the files: see [`super::Sources::open`]).
@@ -113,6 +133,14 @@ impl DatasetConfig {
         let [w, h] = self.resolution;
         if w == 0 || h == 0 || w as u64 * h as u64 > crate::render::MAX_PIXELS {
             return Err(key("resolution", format!("{w}x{h} is not a usable size")));
+        }
+        let cam = self.camera();
+        cam.validate().map_err(|e| key("camera", e.to_string()))?;
+        if cam.width as u64 * cam.height as u64 > crate::render::MAX_PIXELS {
+            return Err(key(
+                "camera",
+                format!("{}x{} is not a usable size", cam.width, cam.height),
+            ));
         }
         self.quality
             .parse::<Quality>()

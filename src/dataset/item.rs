@@ -2,7 +2,7 @@
 //! item's own seed) and the files made from them.
 
 use super::config::{DatasetConfig, MotionSource};
-use crate::camera::Camera;
+use crate::camera::{Camera, CameraFile};
 use crate::error::{Error, Result};
 use crate::field::flow_field;
 use crate::io::gyro::{read_log, GyroOptions, GyroSample};
@@ -51,6 +51,10 @@ pub struct ItemParams {
     pub quality: String,
     /// Linear velocity used.
     pub use_velocity: bool,
+    /// The configuration's `[camera]` keys over the thesis camera at
+    /// `resolution` (absent when there are none).
+    #[serde(default, skip_serializing_if = "super::config::is_empty")]
+    pub camera: CameraFile,
 }
 
 /// The seed of item `i` (SplitMix64 of the master seed and `i`).
@@ -117,16 +121,22 @@ impl Sources {
             ));
         }
         let mut logs = HashMap::new();
+        let readout_s = cfg.camera().shutter.readout_s;
         for m in &cfg.motion {
             if let MotionSource::Log(p) = MotionSource::parse(m)? {
                 let s = read_log(&p, GyroOptions::default())?;
                 let span = s.last().map_or(0.0, |l| l.t) - s.first().map_or(0.0, |f| f.t);
-                if span < cfg.exposure_s[1] {
+                if span < cfg.exposure_s[1] + readout_s {
                     return Err(Error::invalid(
                         p.display().to_string(),
                         format!(
-                            "the log spans {span:.4} s, shorter than the longest exposure ({} s)",
-                            cfg.exposure_s[1]
+                            "the log spans {span:.4} s, shorter than the longest exposure ({} s){}",
+                            cfg.exposure_s[1],
+                            if readout_s > 0.0 {
+                                format!(" plus the camera's readout ({readout_s} s)")
+                            } else {
+                                String::new()
+                            }
                         ),
                     ));
                 }
@@ -177,6 +187,9 @@ impl Sources {
 /// Draws the parameters of item `i` (depends only on `cfg` and `i`).
 pub fn plan(cfg: &DatasetConfig, src: &Sources, i: u64) -> Result<ItemParams> {
     let seed = item_seed(cfg.seed, i);
+    let cam = cfg.camera();
+    // A rolling shutter's motion spans its readout too (0: global shutter).
+    let readout_s = cam.shutter.readout_s;
     let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
     let mut draw = |r: [f64; 2]| {
         let u: f64 = rng.gen();
@@ -196,14 +209,13 @@ pub fn plan(cfg: &DatasetConfig, src: &Sources, i: u64) -> Result<ItemParams> {
             let s = src.logs.get(&p).ok_or_else(|| {
                 Error::invalid("motion", format!("log {} was not opened", p.display()))
             })?;
-            let (a, b) = (s[0].t, s[s.len() - 1].t - exposure_s);
+            let (a, b) = (s[0].t, s[s.len() - 1].t - exposure_s - readout_s);
             (
                 a + (b - a) * u_start,
                 s.iter().all(|x| x.velocity.is_some()),
             )
         }
     };
-    let cam = camera(cfg.resolution);
     let fov_w = distance_m * cam.width as f64 * cam.pitch_x_mm / cam.focal_mm;
     Ok(ItemParams {
         index: i,
@@ -218,21 +230,25 @@ pub fn plan(cfg: &DatasetConfig, src: &Sources, i: u64) -> Result<ItemParams> {
         resolution: cfg.resolution,
         quality: cfg.quality.clone(),
         use_velocity: cfg.use_velocity && has_velocity,
+        camera: cfg.camera.clone(),
     })
 }
 
-/// The items' camera: a configuration's camera with no `[camera]` keys
-/// (the thesis camera at `res`), as the experiment's is made.
-fn camera(res: [u32; 2]) -> Camera {
-    crate::camera::CameraFile::default().thesis_at(res)
+/// An item's camera: its `[camera]` keys over the thesis camera at its
+/// resolution, validated (parameters may come from a manifest).
+fn camera(p: &ItemParams) -> Result<Camera> {
+    let cam = p.camera.thesis_at(p.resolution);
+    cam.validate()
+        .map_err(|e| Error::invalid("item camera", e.to_string()))?;
+    Ok(cam)
 }
 
 /// The samples an item's motion is a window of.
-fn samples(p: &ItemParams, src: &Sources) -> Result<ImuLog> {
+fn samples(p: &ItemParams, readout_s: f64, src: &Sources) -> Result<ImuLog> {
     match MotionSource::parse(&p.motion)? {
         MotionSource::Sim(g) => ImuLog::new(simulate(
             &GaitConfig::preset(g),
-            SIM_SETTLE_S + 1.0 + p.exposure_s + 0.5,
+            SIM_SETTLE_S + 1.0 + p.exposure_s + readout_s + 0.5,
             600.0,
             p.seed,
         )?),
@@ -296,9 +312,9 @@ fn write_rgb(dir: &Path, stem: &str, o: &RenderOutput) -> Result<()> {
 /// the CPU twin: deterministic per pixel, so the same build gives the same
 /// bytes on machines of the same architecture and C library.
 pub fn make(p: &ItemParams, src: &Sources, dir: &Path) -> Result<ItemMeasures> {
-    let cam = camera(p.resolution);
-    let s = samples(p, src)?;
-    // The motion spans the readout (none: dataset cameras are global-shutter) plus the exposure.
+    let cam = camera(p)?;
+    let s = samples(p, cam.shutter.readout_s, src)?;
+    // The motion spans the readout (none for a global shutter) plus the exposure.
     let span = cam.shutter.readout_s + p.exposure_s;
     let traj = Trajectory::from_imu_log(&s, p.start_s, span, p.use_velocity)?;
     let tex = src.textures_dir.join(&p.texture);

@@ -52,6 +52,13 @@
 //! of `mmbm live` around it: samples from text lines, UDP datagrams or a
 //! replayed log, one MMBM evaluation per sample for every policy, JSON lines
 //! out, [`Latency`] statistics, stopped through a [`StreamControl`].
+//!
+//! # Assembly
+//!
+//! [`Session`] puts a run together once for `mmbm trigger`, `mmbm live` and
+//! Python: the camera with a log's readout applied, the scene, the timing
+//! with the camera's pitch and rolling readout, the method and the
+//! [`Policies`]; it evaluates a log's series and runs every policy over it.
 
 mod baselines;
 mod exposure;
@@ -64,6 +71,7 @@ mod policy;
 mod predict;
 mod rules;
 mod run;
+mod session;
 mod stats;
 mod stream;
 mod timing;
@@ -82,6 +90,7 @@ pub use policy::{Level, LogView, Observation, Policy};
 pub use predict::{Forecast, Oracle};
 pub use rules::{Adaptive, Deadline, Fixed, Gate, Threshold};
 pub use run::run;
+pub use session::{Policies, Session, SessionConfig, SessionRun};
 pub use stats::{
     prediction_error, summary, summary_over, write_frames, ErrorStats, Summary, Table51,
     FRAME_HEADER,

@@ -59,6 +59,16 @@ impl CameraTiming {
         }
     }
 
+    /// This timing for `camera`: its pixel pitch (x, mm) for exposure
+    /// control, and its rolling readout added ([`Self::with_rolling_readout`]).
+    pub fn for_camera(self, camera: &crate::camera::Camera) -> Self {
+        CameraTiming {
+            pitch_mm: camera.pitch_x_mm,
+            ..self
+        }
+        .with_rolling_readout(camera.shutter.readout_s)
+    }
+
     /// Checks that the times are finite, the exposure positive and the others non-negative.
     pub fn validate(&self) -> Result<()> {
         crate::check::positive("exposure", self.exposure)?;
