@@ -7,7 +7,7 @@ use crate::io::gyro::{read_log, GyroOptions};
 use crate::metric::{Method, Scene};
 use crate::model::log::ImuLog;
 use crate::sim::{simulate, Gait, GaitConfig};
-use crate::trigger::{self, CameraTiming, Frame, PolicySpec};
+use crate::trigger::{CameraTiming, Frame, Policies, PolicySpec};
 use std::str::FromStr;
 
 /// One walk (simulated or a real log) with its MMBM series and every policy's frames.
@@ -67,13 +67,13 @@ pub fn make_walk(
         }
         distance.push(d);
     }
-    let timing = timing(cfg);
-    let mut runs = Vec::new();
-    for p in &cfg.policies {
-        let spec = PolicySpec::parse(p)?;
-        let frames = trigger::run(&samples, &mmbm, spec.build().as_mut(), &timing)?;
-        runs.push((spec, frames));
-    }
+    let specs = cfg
+        .policies
+        .iter()
+        .map(|p| PolicySpec::parse(p))
+        .collect::<Result<Vec<_>>>()?;
+    let frames = Policies::new(specs.clone(), timing(cfg))?.run(&samples, &mmbm)?;
+    let runs: Vec<(PolicySpec, Vec<Frame>)> = specs.into_iter().zip(frames).collect();
     let seed = if cfg.gyro.is_some() { 0 } else { seed };
     Ok(Walk {
         name: if suffix && cfg.gyro.is_none() {
@@ -98,7 +98,7 @@ pub fn timing(cfg: &ExperimentConfig) -> CameraTiming {
         exposure: cfg.exposure_s,
         readout: cfg.readout_s,
         min_interval: cfg.min_interval_s,
-        pitch_mm: cfg.camera().pitch_x_mm,
+        pitch_mm: 0.0,
     }
-    .with_rolling_readout(cfg.camera.readout_s.unwrap_or(0.0))
+    .for_camera(&cfg.camera())
 }
