@@ -15,6 +15,7 @@ const LAYERS: &[(&str, u32)] = &[
     ("error", 0),
     ("stats", 0),
     ("diagnostics", 0),
+    ("cancel", 0),
     ("camera", 1),
     ("model", 1),
     ("io", 1),
