@@ -43,6 +43,50 @@ use std::path::Path;
 /// Pixel pitch (mm) assumed for a Gyroflow profile without a focal length in mm.
 pub const NOMINAL_PITCH_MM: f64 = 0.001;
 
+/// Largest camera file read, bytes (a real one is under 10 kB; Gyroflow
+/// profiles a few kB). Bounds the parsers' time and memory: a 6 MB TOML
+/// array took 5.7 s and 530 MB to refuse.
+pub const MAX_CAMERA_BYTES: u64 = 1 << 20;
+
+/// The text of the camera file `path`: a regular file or a pipe (a device
+/// such as `/dev/zero` is refused before it is opened) of at most [`MAX_CAMERA_BYTES`].
+fn read_camera_text(path: &Path) -> Result<String> {
+    use std::io::Read;
+    let refused = |message: String| Error::Config {
+        path: path.into(),
+        message,
+    };
+    // Checked before opening: opening a device can have effects of its own.
+    let kind = std::fs::metadata(path)
+        .map_err(|e| Error::io(path, e))?
+        .file_type();
+    #[cfg(unix)]
+    let pipe = std::os::unix::fs::FileTypeExt::is_fifo(&kind);
+    #[cfg(not(unix))]
+    let pipe = false;
+    if !(kind.is_file() || pipe) {
+        return Err(refused(
+            "is not a regular file or a pipe: a camera file is read whole".into(),
+        ));
+    }
+    let f = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
+    let mut bytes = Vec::new();
+    f.take(MAX_CAMERA_BYTES + 1)
+        .read_to_end(&mut bytes)
+        .map_err(|e| Error::io(path, e))?;
+    if bytes.len() as u64 > MAX_CAMERA_BYTES {
+        return Err(refused(format!(
+            "longer than {MAX_CAMERA_BYTES} bytes, the most a camera file may have"
+        )));
+    }
+    String::from_utf8(bytes).map_err(|e| {
+        refused(format!(
+            "not UTF-8 text (byte {} is not part of a character)",
+            e.utf8_error().valid_up_to()
+        ))
+    })
+}
+
 /// On-disk camera description.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -96,7 +140,7 @@ impl Camera {
     /// with `fisheye_params`). Missing principal point fields default to the
     /// sensor centre. Errors name the file and the key.
     pub fn load(path: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+        let text = read_camera_text(path)?;
         let config = |message: String| Error::Config {
             path: path.into(),
             message,
