@@ -77,18 +77,32 @@ pub fn open_stream(path: &Path) -> Result<File> {
 /// Reads a whole text file (a configuration) of at most [`MAX_TEXT_BYTES`]
 /// from a regular file or a pipe.
 pub fn read_text(path: &Path) -> Result<String> {
-    let mut s = String::new();
+    read_text_at_most(path, MAX_TEXT_BYTES)
+}
+
+/// Reads a whole UTF-8 text file of at most `max` bytes from a regular file
+/// or a pipe (a longer one, or one that is not UTF-8, is refused by name).
+pub fn read_text_at_most(path: &Path, max: u64) -> Result<String> {
+    let mut bytes = Vec::new();
     open_stream(path)?
-        .take(MAX_TEXT_BYTES + 1)
-        .read_to_string(&mut s)
+        .take(max + 1)
+        .read_to_end(&mut bytes)
         .map_err(|e| Error::io(path, e))?;
-    if s.len() as u64 > MAX_TEXT_BYTES {
+    if bytes.len() as u64 > max {
         return Err(refused(
             path,
-            format!("longer than {MAX_TEXT_BYTES} bytes, the most read"),
+            format!("longer than {max} bytes, the most read"),
         ));
     }
-    Ok(s)
+    String::from_utf8(bytes).map_err(|e| {
+        refused(
+            path,
+            format!(
+                "not UTF-8 text (byte {} is not part of a character)",
+                e.utf8_error().valid_up_to()
+            ),
+        )
+    })
 }
 
 #[cfg(test)]

@@ -67,6 +67,10 @@ pub enum Error {
     /// No usable GPU adapter, or a GPU operation failed.
     #[error("GPU: {}", shown(.0, MAX_SHOWN))]
     Gpu(String),
+    /// The call was cancelled from outside ([`crate::cancel`]: Ctrl-C in
+    /// Python) before it finished; it returned nothing.
+    #[error("interrupted")]
+    Interrupted,
 }
 
 impl Error {

@@ -16,7 +16,7 @@
 //!
 //! | layer | modules | holds |
 //! |---|---|---|
-//! | 0 | [`error`], [`check`], [`bounded`], [`stats`], [`diagnostics`] | the error enum; value checks (finite, positive) that name the value; bounded whole-file reading (file kinds, the text cap); mean and percentile; where the library's warnings go (the `log` facade) |
+//! | 0 | [`error`], [`check`], [`bounded`], [`stats`], [`diagnostics`], [`cancel`] | the error enum; value checks (finite, positive) that name the value; bounded whole-file reading (file kinds, the text cap); mean and percentile; where the library's warnings go (the `log` facade); stopping long calls from outside |
 //! | 1 | [`camera`], [`model`], [`io`], [`gpu`] | the camera (intrinsics, distortion, shutter, noise, lens); motion, flow; files; the wgpu device and compute plumbing |
 //! | 2 | [`metric`], [`board`], [`plot`], [`sim`], [`assess`] | MMBM rules; the thesis board, blobs, pose; figures; gait simulation; image blur metrics |
 //! | 3 | [`field`], [`tables`] | the flow-field kernel (GPU + CPU twin); thesis tables |
@@ -33,6 +33,7 @@ pub mod assess;
 pub mod board;
 pub mod bounded;
 pub mod camera;
+pub mod cancel;
 pub mod check;
 pub mod dataset;
 pub mod diagnostics;

@@ -3,6 +3,9 @@
 //! value or an error, never a panic; an error names the file.
 
 mod common;
+// Hostile camera files and dataset manifests (issue #23).
+#[path = "fuzz_readers/hostile.rs"]
+mod hostile;
 
 use mmbm::experiment::ExperimentConfig;
 use mmbm::io::gyro::{read_log, GyroOptions};

@@ -17,6 +17,7 @@ const LAYERS: &[(&str, u32)] = &[
     ("bounded", 0),
     ("stats", 0),
     ("diagnostics", 0),
+    ("cancel", 0),
     ("camera", 1),
     ("model", 1),
     ("io", 1),

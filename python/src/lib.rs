@@ -22,6 +22,9 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::path::PathBuf;
 
+mod interrupt;
+use interrupt::interruptible;
+
 fn err(e: mmbm::Error) -> PyErr {
     match e {
         mmbm::Error::Io { .. } => PyOSError::new_err(e.to_string()),
@@ -88,23 +91,23 @@ fn metric<'py>(
     };
     let method: AnyMethod = method.parse().map_err(err)?;
     let (w, v) = (rows3(&omega)?, rows3(&velocity)?);
-    let out = py
-        .detach(|| {
-            w.iter()
-                .zip(&v)
-                .map(|(w, v)| {
-                    let tw = Twist::new(*w, *v);
-                    match method {
-                        AnyMethod::Cpu(m) => mmbm::mmbm(&scene, &tw, m),
-                        AnyMethod::Gpu { width, height } => scene
-                            .validate_for(&tw)
-                            .and_then(|_| mmbm::field::mmbm_gpu(&scene, &tw, width, height)),
-                    }
-                    .map(|m| m.mm_s)
-                })
-                .collect::<mmbm::Result<Vec<f64>>>()
-        })
-        .map_err(err)?;
+    let long = w.len() > interrupt::SMALL_ROWS || matches!(method, AnyMethod::Gpu { .. });
+    let out = interrupt::interruptible_if(py, err, long, || {
+        w.iter()
+            .zip(&v)
+            .map(|(w, v)| {
+                mmbm::cancel::check()?;
+                let tw = Twist::new(*w, *v);
+                match method {
+                    AnyMethod::Cpu(m) => mmbm::mmbm(&scene, &tw, m),
+                    AnyMethod::Gpu { width, height } => scene
+                        .validate_for(&tw)
+                        .and_then(|_| mmbm::field::mmbm_gpu(&scene, &tw, width, height)),
+                }
+                .map(|m| m.mm_s)
+            })
+            .collect::<mmbm::Result<Vec<f64>>>()
+    })?;
     Ok(Array1::from(out).into_pyarray(py))
 }
 
@@ -161,9 +164,9 @@ fn frames<'py>(
         method: method.parse().map_err(err)?,
         use_velocity: false,
     };
-    let (rows, _) = py
-        .detach(|| mmbm::series::frames::frame_mmbm(&samples, &opts, &video))
-        .map_err(err)?;
+    let (rows, _) = interruptible(py, err, || {
+        mmbm::series::frames::frame_mmbm(&samples, &opts, &video)
+    })?;
     let e: Vec<f64> = rows
         .iter()
         .map(|r| r.exposure_mm_s.unwrap_or(f64::NAN))
@@ -212,9 +215,7 @@ fn series<'py>(
         method: method.parse().map_err(err)?,
         use_velocity: v.is_some(),
     };
-    let out = py
-        .detach(|| mmbm::series::mmbm_series_with(&samples, &opts))
-        .map_err(err)?;
+    let out = interruptible(py, err, || mmbm::series::mmbm_series_with(&samples, &opts))?;
     Ok(Array1::from(out).into_pyarray(py))
 }
 
@@ -240,9 +241,7 @@ fn read_gyro<'py>(
         time_offset,
         topic,
     };
-    let log = py
-        .detach(|| mmbm::io::gyro::read_log(&path, opts))
-        .map_err(err)?;
+    let log = interruptible(py, err, || mmbm::io::gyro::read_log(&path, opts))?;
     let d = samples_dict(py, &log)?;
     // The file's own rolling-shutter readout (a Gyroflow .gcsv header's).
     if let Some(r) = log.readout() {
@@ -301,9 +300,7 @@ fn flow_field<'py>(
     };
     let tw = Twist::new(DVec3::from(omega), DVec3::from(velocity));
     let b = backend(backend_)?;
-    let f = py
-        .detach(|| mmbm::field::flow_field(&scene, &tw, 0, 0, b))
-        .map_err(err)?;
+    let f = interruptible(py, err, || mmbm::field::flow_field(&scene, &tw, 0, 0, b))?;
     let (w, h) = (f.width as usize, f.height as usize);
     let a = Array3::from_shape_fn((h, w, 2), |(y, x, c)| {
         if c == 0 {
@@ -379,15 +376,13 @@ fn render<'py>(
         integrator: integrator.parse::<Integrator>().map_err(err)?,
         with_maps: maps,
     };
-    let out = py
-        .detach(|| {
-            if sharp {
-                mmbm::render::render_sharp(&job)
-            } else {
-                mmbm::render::render_frame(&job)
-            }
-        })
-        .map_err(err)?;
+    let out = interruptible(py, err, || {
+        if sharp {
+            mmbm::render::render_sharp(&job)
+        } else {
+            mmbm::render::render_frame(&job)
+        }
+    })?;
     let (w, h) = (out.width as usize, out.height as usize);
     let img = Array3::from_shape_vec((h, w, 3), out.rgb)
         .map_err(|e| PyValueError::new_err(e.to_string()))?
@@ -446,9 +441,7 @@ fn simulate<'py>(
         Some(p) => mmbm::sim::GaitConfig::load(&p, g).map_err(err)?,
         None => mmbm::sim::GaitConfig::preset(g),
     };
-    let s = py
-        .detach(|| mmbm::sim::simulate(&cfg, duration, rate, seed))
-        .map_err(err)?;
+    let s = interruptible(py, err, || mmbm::sim::simulate(&cfg, duration, rate, seed))?;
     samples_dict(py, &s)
 }
 
@@ -476,17 +469,15 @@ fn trigger<'py>(
         min_interval,
         pitch_mm,
     };
-    let frames = py
-        .detach(|| {
-            let specs = policies
-                .iter()
-                .map(|p| mmbm::trigger::PolicySpec::parse(p))
-                .collect::<mmbm::Result<Vec<_>>>()?;
-            // The runner uses only the times: no samples are made up.
-            mmbm::trigger::Policies::new(specs, timing)?.run(&t, &m)
-        })
-        .map_err(err)?
-        .concat();
+    let frames = interruptible(py, err, || {
+        let specs = policies
+            .iter()
+            .map(|p| mmbm::trigger::PolicySpec::parse(p))
+            .collect::<mmbm::Result<Vec<_>>>()?;
+        // The runner uses only the times: no samples are made up.
+        mmbm::trigger::Policies::new(specs, timing)?.run(&t, &m)
+    })?
+    .concat();
     frames
         .iter()
         .map(|f| {
@@ -508,9 +499,7 @@ fn trigger<'py>(
 /// Reads a float EXR: `{channel: (H, W) float32}`.
 #[pyfunction]
 fn read_exr<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bound<'py, PyDict>> {
-    let (w, h, chans) = py
-        .detach(|| mmbm::io::images::read_exr(&path))
-        .map_err(err)?;
+    let (w, h, chans) = interruptible(py, err, || mmbm::io::images::read_exr(&path))?;
     let d = PyDict::new(py);
     for (name, v) in chans {
         let a =
@@ -525,6 +514,12 @@ fn read_exr<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bound<'py, PyDict>>
 fn _mmbm(m: &Bound<'_, PyModule>) -> PyResult<()> {
     // The library's warnings (gaps in a log, the CPU twin standing in) on stderr.
     mmbm::diagnostics::log_to_stderr();
+    // NumPy's C API now, not at the first array a call returns: imported
+    // lazily, after a long call during which a Ctrl-C came, the import ran
+    // the pending handler, failed with KeyboardInterrupt, and the numpy
+    // crate turned that into a panic (a PanicException about the capsule).
+    m.py().import("numpy")?;
+    numpy::PyArray1::<f64>::zeros(m.py(), 0, false);
     m.add_function(wrap_pyfunction!(camera_from_file, m)?)?;
     m.add_function(wrap_pyfunction!(camera_thesis, m)?)?;
     m.add_function(wrap_pyfunction!(camera_check, m)?)?;

@@ -50,6 +50,11 @@ use std::path::Path;
 /// Pixel pitch (mm) assumed for a Gyroflow profile without a focal length in mm.
 pub const NOMINAL_PITCH_MM: f64 = 0.001;
 
+/// Largest camera file read, bytes (a real one is under 10 kB; Gyroflow
+/// profiles a few kB). Bounds the parsers' time and memory: a 6 MB TOML
+/// array took 5.7 s and 530 MB to refuse.
+pub const MAX_CAMERA_BYTES: u64 = 1 << 20;
+
 /// The camera file's keys (SPEC sections 1 and 9), every one optional: on
 /// its own ([`CameraFile::camera`]) a file needs `focal_mm`, a pitch
 /// (`pitch_mm`, or `pitch_x_mm` and `pitch_y_mm`), `width` and `height`;
@@ -237,7 +242,7 @@ impl Camera {
     /// ([`crate::bounded::read_text`]: a regular file or a pipe, at most
     /// [`crate::bounded::MAX_TEXT_BYTES`]). Errors name the file and the key.
     pub fn load(path: &Path) -> Result<Self> {
-        let text = crate::bounded::read_text(path)?;
+        let text = crate::bounded::read_text_at_most(path, MAX_CAMERA_BYTES)?;
         let cam = CameraFile::parse(&text, path)?;
         cam.validate().map_err(|e| Error::Config {
             path: path.into(),

@@ -17,7 +17,7 @@ pub(crate) mod shutter;
 
 pub use blur::{blur_px, checked_blur_px, checked_px_s, exposure_for_blur};
 pub use distortion::Distortion;
-pub use file::{CameraFile, CameraOverrides};
+pub use file::{CameraFile, CameraOverrides, MAX_CAMERA_BYTES};
 pub use intrinsics::{Camera, SensorRect};
 pub use lens::Lens;
 pub use noise::Noise;

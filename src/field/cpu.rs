@@ -221,11 +221,19 @@ pub fn flow_tiles(grid: &Grid, tw: &TwistGpu, with_field: bool) -> FieldMean {
     } else {
         Vec::new()
     };
+    // Once a stop is requested (crate::cancel) the tiles left are skipped;
+    // the caller checks the token and drops the field.
+    let stop = crate::cancel::current();
     let partials: Vec<f32> = if with_field {
         field
             .par_chunks_mut(TILE as usize)
             .enumerate()
-            .map(|(t, f)| tile(&p, tw, t as u32, f))
+            .map(|(t, f)| {
+                if stop.is_cancelled() {
+                    return 0.0;
+                }
+                tile(&p, tw, t as u32, f)
+            })
             .collect()
     } else {
         (0..p.tiles)

@@ -108,6 +108,8 @@ pub fn flow_field(
             (f.mean_mm_s, f.field)
         }
     };
+    // A stop requested during the pass (crate::cancel): the field is partial.
+    crate::cancel::check()?;
     if !mean.is_finite()
         || field
             .iter()

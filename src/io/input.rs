@@ -60,20 +60,38 @@ pub enum Line {
 /// it (not counting its `\n`): a longer line is read to its end in bounded memory and reported as
 /// [`Line::TooLong`].
 pub fn read_line(src: &mut dyn BufRead, buf: &mut Vec<u8>, cap: usize) -> std::io::Result<Line> {
+    // Never stopped: `None` cannot come back.
+    Ok(read_line_or_stop(src, buf, cap, &|| false)?.unwrap_or(Line::Eof))
+}
+
+/// [`read_line`] that gives up once `stop()` is true, asked before each
+/// chunk the source yields (a few kB): an endless line (input that never
+/// sends its `\n`) is left at a stop request instead of when it ends.
+/// `None` when stopped (the part read is dropped). A read blocked on a
+/// silent source is not interrupted.
+pub fn read_line_or_stop(
+    src: &mut dyn BufRead,
+    buf: &mut Vec<u8>,
+    cap: usize,
+    stop: &dyn Fn() -> bool,
+) -> std::io::Result<Option<Line>> {
     buf.clear();
     let mut total = 0usize;
     loop {
+        if stop() {
+            return Ok(None);
+        }
         let chunk = match src.fill_buf() {
             Ok(c) => c,
             Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
             Err(e) => return Err(e),
         };
         if chunk.is_empty() {
-            return Ok(match (total, total > cap) {
+            return Ok(Some(match (total, total > cap) {
                 (0, _) => Line::Eof,
                 (_, true) => Line::TooLong,
                 _ => Line::Read,
-            });
+            }));
         }
         let (n, end) = match chunk.iter().position(|&b| b == b'\n') {
             Some(i) => (i + 1, true),
@@ -85,12 +103,12 @@ pub fn read_line(src: &mut dyn BufRead, buf: &mut Vec<u8>, cap: usize) -> std::i
         total = total.saturating_add(n - usize::from(end));
         src.consume(n);
         if end {
-            return Ok(if total > cap {
+            return Ok(Some(if total > cap {
                 buf.truncate(cap);
                 Line::TooLong
             } else {
                 Line::Read
-            });
+            }));
         }
         if total > cap {
             buf.truncate(cap);

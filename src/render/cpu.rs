@@ -189,9 +189,15 @@ pub fn render(
 ) -> Vec<f32> {
     let (w, h) = (p.dims[0], p.dims[1]);
     let inv = 1.0 / p.dims[3] as f32;
+    // Once a stop is requested (crate::cancel) the pixels left are skipped;
+    // the caller checks the token and drops the image.
+    let stop = crate::cancel::current();
     let run = || {
         let mut out = vec![0.0f32; (w * h * 3) as usize];
         out.par_chunks_mut(3).enumerate().for_each(|(idx, o)| {
+            if stop.is_cancelled() {
+                return;
+            }
             let (i, j) = (idx as u32 % w, idx as u32 / w);
             let s = if analytic {
                 pixel_sum_analytic(p, homs, i, j)

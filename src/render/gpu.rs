@@ -232,6 +232,8 @@ pub fn render(
         let nr = rows.min(h - row0);
         let mut k0 = 0;
         while k0 < n {
+            // A stop request (crate::cancel) is seen between dispatches.
+            crate::cancel::check()?;
             let k1 = (k0 + kstep).min(n);
             let pr = with_range(p, row0, nr, k0, k1);
             ctx.queue.write_buffer(b_par, 0, bytemuck::bytes_of(&pr));

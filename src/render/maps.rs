@@ -219,9 +219,15 @@ pub fn blur_maps(
     let poses = inv_poses(traj, steps.max(1));
     let (w, h) = (cam.width as usize, cam.height as usize);
     let dur = traj.duration();
+    // Once a stop is requested (crate::cancel) the pixels left are NaN; the
+    // caller checks the token and drops the maps.
+    let stop = crate::cancel::current();
     let vals: Vec<(f32, f32)> = (0..w * h)
         .into_par_iter()
         .map(|idx| {
+            if stop.is_cancelled() {
+                return (f32::NAN, f32::NAN);
+            }
             let (i, j) = (idx % w, idx / w);
             match path_disp(cam, target, &poses, i as f64 + 0.5, j as f64 + 0.5) {
                 Some((l, d)) => (l as f32, d as f32),
@@ -252,9 +258,13 @@ fn blur_maps_rolling(
     let rows = cam.shutter.direction.is_rows();
     let (w, h) = (cam.width as usize, cam.height as usize);
     let (lines, len) = if rows { (h, w) } else { (w, h) };
+    let stop = crate::cancel::current();
     let per_line: Vec<Vec<(f32, f32)>> = (0..lines)
         .into_par_iter()
         .map(|l| {
+            if stop.is_cancelled() {
+                return vec![(f32::NAN, f32::NAN); len];
+            }
             let c = l as f64 + 0.5;
             let t0 = cam.shutter.delay_s(c, c, cam.width, cam.height);
             let start = traj.pose_at(t0);

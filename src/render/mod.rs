@@ -421,6 +421,8 @@ fn render_frame_stream(job: &RenderJob, stream: u64) -> Result<RenderOutput> {
             )
         }
     };
+    // A stop requested during the pass (crate::cancel): the image is partial.
+    crate::cancel::check()?;
     let mut rgb = rgb;
     if let Some(noise) = &cam.noise {
         noise.apply(&mut rgb, job.exposure_s, stream)?;
@@ -429,6 +431,7 @@ fn render_frame_stream(job: &RenderJob, stream: u64) -> Result<RenderOutput> {
         let steps = ((lmax / 0.25).ceil() as usize).clamp(64, 4096);
         maps::blur_maps(cam, &job.target, &job.trajectory, job.exposure_s, steps)
     });
+    crate::cancel::check()?;
     Ok(RenderOutput {
         width: cam.width,
         height: cam.height,

@@ -132,6 +132,7 @@ pub fn frame_mmbm(
     let mut out = Vec::with_capacity(frames.len());
     let mut outside = Vec::new();
     for (k, f) in frames.iter().enumerate() {
+        crate::cancel::check()?;
         f.check()
             .map_err(|(column, message)| Error::invalid(format!("frame {k}: {column}"), message))?;
         let readout = f.readout_s.unwrap_or(cam.shutter.readout_s);

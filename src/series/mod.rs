@@ -122,6 +122,7 @@ pub fn mmbm_series_with(samples: &[GyroSample], opts: &SeriesOptions) -> Result<
     opts.scene.camera.validate()?;
     let mut out = Vec::with_capacity(samples.len());
     for chunk in samples.chunks(BATCH) {
+        crate::cancel::check()?;
         out.extend(eval_batch_cpu(chunk, opts)?);
     }
     Ok(out)

@@ -119,7 +119,13 @@ pub fn simulate(
 ) -> Result<Vec<GyroSample>> {
     let it = samples(cfg, duration_s, rate_hz, seed)?;
     let mut out = Vec::with_capacity(it.len());
-    out.extend(it);
+    for (k, s) in it.enumerate() {
+        // A stop request (crate::cancel) is seen every 2^16 samples.
+        if k % (1 << 16) == 0 {
+            crate::cancel::check()?;
+        }
+        out.push(s);
+    }
     Ok(out)
 }
 

@@ -60,6 +60,10 @@ pub fn run<S: Timed>(
     let mut free_at = f64::NEG_INFINITY;
     let mut last_trigger = None;
     for i in 0..t.len() {
+        // A stop request (crate::cancel) is seen every 4096 samples.
+        if i % 4096 == 0 {
+            crate::cancel::check()?;
+        }
         let start = t[i] + timing.delay;
         let end = start + timing.exposure;
         if end > t_last {

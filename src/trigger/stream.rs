@@ -18,15 +18,16 @@
 //!
 //! A [`StreamControl`] shared with the caller (a signal handler) stops a
 //! stream: during a replay's wait or a UDP poll within [`POLL`], on a line
-//! reader at its next line (a read blocked on a silent input is not
-//! interrupted: see [`StreamControl::wait_ended`]).
+//! reader at its next chunk of input, within a line too (an endless line
+//! with no `\n`); a read blocked on a silent input is not interrupted: see
+//! [`StreamControl::wait_ended`].
 
 use super::latency::Latency;
 use super::live::{Event, Live};
 use super::pace::{self, Pacer};
 use crate::error::{Error, Result};
 use crate::io::gyro::{GyroOptions, GyroSample};
-use crate::io::input::{line_too_long, read_line, Line, MAX_LINE_BYTES};
+use crate::io::input::{line_too_long, read_line_or_stop, Line, MAX_LINE_BYTES};
 use crate::io::lines::LineParser;
 use crate::metric::Evaluator;
 use crate::series::{check_values, sample_mmbm, SeriesOptions};
@@ -246,7 +247,14 @@ impl Stream {
             }
             // A line over the cap is read to its end in bounded memory and
             // is a malformed line.
-            match read_line(input, &mut raw, MAX_LINE_BYTES).map_err(|e| Error::io(source, e))? {
+            // A stop request is seen within a line too (an endless one).
+            let stop = || self.control.is_stopped();
+            let read = read_line_or_stop(input, &mut raw, MAX_LINE_BYTES, &stop)
+                .map_err(|e| Error::io(source, e))?;
+            let Some(read) = read else {
+                return Ok(self.outcome(StreamEnd::Stopped));
+            };
+            match read {
                 Line::Eof => return Ok(self.outcome(StreamEnd::Eof)),
                 Line::TooLong => {
                     line_no += 1;

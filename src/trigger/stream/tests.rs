@@ -227,3 +227,67 @@ fn replay_speed_and_idle_time_are_checked() {
     assert!(matches!(o.end, StreamEnd::Idle));
     assert!(out.is_empty());
 }
+
+/// An input that sends two samples, then one endless line (digits, never a
+/// `\n`), 4 kB per read; the `stop_after`-th read of the line asks `control`
+/// to stop.
+struct EndlessLine {
+    head: &'static [u8],
+    reads: usize,
+    stop_after: usize,
+    control: StreamControl,
+    chunk: [u8; 4096],
+}
+
+impl std::io::Read for EndlessLine {
+    fn read(&mut self, _: &mut [u8]) -> std::io::Result<usize> {
+        unreachable!("read through BufRead")
+    }
+}
+
+impl BufRead for EndlessLine {
+    fn fill_buf(&mut self) -> std::io::Result<&[u8]> {
+        if !self.head.is_empty() {
+            return Ok(self.head);
+        }
+        self.reads += 1;
+        if self.reads == self.stop_after {
+            self.control.stop();
+        }
+        // A line that never ends (bounded here only to fail, not hang, if
+        // the stop is missed: 4 GB would take minutes).
+        if self.reads > 1_000_000 {
+            return Ok(b"\n");
+        }
+        Ok(&self.chunk)
+    }
+    fn consume(&mut self, n: usize) {
+        if !self.head.is_empty() {
+            self.head = &self.head[n..];
+        }
+    }
+}
+
+/// Issue #23: Ctrl-C during an endless stdin line (no `\n`) was seen only
+/// when the line ended. The line reader now returns at the stop request,
+/// within one chunk of input.
+#[test]
+fn a_stop_is_seen_within_an_endless_line() {
+    let control = StreamControl::default();
+    let mut input = EndlessLine {
+        head: b"t,wx,wy,wz\n0,0,0,0.1\n0.01,0,0,0.1\n",
+        reads: 0,
+        stop_after: 100,
+        control: control.clone(),
+        chunk: [b'7'; 4096],
+    };
+    let mut out = Vec::new();
+    let mut s = stream(&["fixed:5"], ALL, control);
+    let o = s
+        .lines(&mut input, GyroOptions::default(), "<in>", &mut out)
+        .unwrap();
+    assert!(matches!(o.end, StreamEnd::Stopped), "{:?}", o.end);
+    assert_eq!((o.samples, ts(&out)), (2, vec![0.0, 0.01]));
+    // Seen at the read after the stop request, not a megabyte later.
+    assert_eq!(input.reads, 100);
+}
