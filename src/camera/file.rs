@@ -312,7 +312,7 @@ pub fn from_gyroflow(p: &Value) -> Result<Camera> {
         None | Some(Value::Null) => 1.0,
         Some(v) => num(v, "crop")?,
     };
-    if !(crop > 0.0) {
+    if crop.is_nan() || crop <= 0.0 {
         return Err(Error::invalid(
             "crop",
             format!("must be positive, got {crop}"),

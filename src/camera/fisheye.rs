@@ -61,7 +61,7 @@ pub fn limit(k: [f64; 4]) -> f64 {
 /// `tol` in `theta_d`. `None` when `rd` lies beyond the [`limit`] (no ray).
 pub fn solve(k: [f64; 4], rd: f64, tol: f64) -> Option<f64> {
     let top = turning_point(k);
-    if !(rd >= 0.0) || theta_d(k, top) < rd - tol {
+    if rd.is_nan() || rd < 0.0 || theta_d(k, top) < rd - tol {
         return None;
     }
     let (mut lo, mut hi) = (0.0, top);

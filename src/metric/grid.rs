@@ -120,7 +120,7 @@ impl GridRule {
             w.push(self.w[k]);
         }
         let total: f64 = w.iter().sum();
-        if points.is_empty() || !(total > 0.0) {
+        if points.is_empty() || total.is_nan() || total <= 0.0 {
             return Err(Error::invalid(
                 "distortion",
                 "every node of the rule lies beyond the lens's radial distortion limit",
