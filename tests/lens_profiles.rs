@@ -328,3 +328,36 @@ fn focal_sign_crop_and_unsupported_lenses() {
         assert!(e.contains(want) && e.contains("not supported"), "{e}");
     }
 }
+
+#[test]
+fn portrait_video_transposes_the_profile() {
+    use mmbm::camera::{CameraFile, CameraOverrides};
+    let path = write_tmp(
+        "land.json",
+        &profile(
+            1920,
+            1080,
+            [1500.0, 1480.0, 960.0, 540.0],
+            "opencv_fisheye",
+            "0.02",
+            "",
+        ),
+    );
+    let over = CameraOverrides {
+        keys: CameraFile::default(),
+        scale_to: Some((1080, 1920)),
+        light_e_per_s: None,
+    };
+    let c = Camera::resolve(Some(&path), &over).unwrap();
+    // Gyroflow's swap: fx and fy trade places (no stretch), so do cx and cy.
+    assert_eq!((c.width, c.height), (1080, 1920));
+    assert!((c.fx_px() - 1480.0).abs() < 1e-9 && (c.fy_px() - 1500.0).abs() < 1e-9);
+    assert_eq!((c.cx, c.cy), (540.0, 960.0));
+    // The same orientation is a plain scaling.
+    let over = CameraOverrides {
+        scale_to: Some((960, 540)),
+        ..over
+    };
+    let c = Camera::resolve(Some(&path), &over).unwrap();
+    assert!((c.fx_px() - 750.0).abs() < 1e-9 && (c.fy_px() - 740.0).abs() < 1e-9);
+}

@@ -221,8 +221,9 @@ pub struct CameraOverrides {
     /// Camera-file keys over the file's (or the thesis camera's): focal
     /// length, pitch, sensor size (principal point re-centred), readout.
     pub keys: CameraFile,
-    /// Then the camera scaled to this `(width, height)`, px
-    /// ([`Camera::scaled_to`]: the field of view stays).
+    /// Then the camera scaled to this `(width, height)`, px, transposed
+    /// first for the other orientation ([`Camera::fitted_to`]: the field of
+    /// view stays).
     pub scale_to: Option<(u32, u32)>,
     /// Then sensor noise at this light level (electrons per second of a
     /// white pixel), with the camera's other noise keys or their defaults.
@@ -255,7 +256,7 @@ impl Camera {
         };
         let mut c = over.keys.over(&base);
         if let Some((w, h)) = over.scale_to {
-            c = c.scaled_to(w, h);
+            c = c.fitted_to(w, h);
         }
         if let Some(phi) = over.light_e_per_s {
             c.noise = Some(Noise {

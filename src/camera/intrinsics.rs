@@ -133,6 +133,36 @@ impl Camera {
         }
     }
 
+    /// The camera turned to the other orientation, as Gyroflow's
+    /// `LensProfile::swapped` turns a landscape profile for a portrait video:
+    /// width and height, the pitches (so fx and fy) and the principal point's
+    /// coordinates swap; skew, distortion coefficients and the readout
+    /// direction are kept (as Gyroflow keeps them).
+    pub fn transposed(&self) -> Self {
+        Camera {
+            width: self.height,
+            height: self.width,
+            pitch_x_mm: self.pitch_y_mm,
+            pitch_y_mm: self.pitch_x_mm,
+            cx: self.cy,
+            cy: self.cx,
+            ..*self
+        }
+    }
+
+    /// [`Camera::scaled_to`] a `width x height` video, transposed first
+    /// ([`Camera::transposed`]) when the video is portrait and the camera
+    /// landscape or the other way round (Gyroflow's rule for a profile).
+    pub fn fitted_to(&self, width: u32, height: u32) -> Self {
+        let turned = (width > height && self.width < self.height)
+            || (width < height && self.width > self.height);
+        if turned {
+            self.transposed().scaled_to(width, height)
+        } else {
+            self.scaled_to(width, height)
+        }
+    }
+
     /// Same focal length and pixel pitch, a `width x height` sensor with the
     /// principal point at its centre (what `--resolution` does).
     pub fn with_resolution(&self, width: u32, height: u32) -> Self {
