@@ -3,6 +3,8 @@
 //! from Gyroflow's rules (`lens_profile.rs`, `distortion_models/`), each
 //! of which the previous reader got wrong (refused, or read differently).
 
+mod common;
+
 use mmbm::camera::{Distortion, Readout};
 use mmbm::model::flow::flow_distorted;
 use mmbm::{mmbm, Camera, Method, Scene, Twist};
@@ -158,6 +160,31 @@ fn beyond_the_radial_limit_is_masked_not_refused() {
     let brute = sum / n as f64;
     assert!((r - e).abs() < 2e-4 * e, "riemann {r} exact {e}");
     assert!((brute - e).abs() < 2e-3 * e, "brute {brute} exact {e}");
+    // `mmbm eval` reports the masked share.
+    let exe = common::bin();
+    let path = write_tmp(
+        "mask.json",
+        &profile(
+            2000,
+            1400,
+            [1000.0, 1000.0, 1000.0, 700.0],
+            "opencv_fisheye",
+            TURNING,
+            "",
+        ),
+    );
+    let out = std::process::Command::new(&exe)
+        .args(["eval", "--omega", "0.4,-0.3,0.7", "--json", "--camera"])
+        .arg(&path)
+        .output()
+        .unwrap_or_else(|e| panic!("{}: {e}", exe.display()));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["masked_fraction"].as_f64(), Some(c.masked_fraction()));
     // The GPU kernel does not mask: refused by name.
     let err = mmbm::field::Grid::new(&c, 0, 0).unwrap_err().to_string();
     assert!(err.contains("radial distortion limit"), "{err}");
