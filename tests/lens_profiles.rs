@@ -114,24 +114,44 @@ fn beyond_the_radial_limit_is_masked_not_refused() {
     )
     .unwrap();
     assert!((c.radial_limit_mm() / c.pitch_x_mm - 1200.0).abs() < 1e-6);
-    // The masked share against a count of 1/8-pixel cells beyond 1200 px.
-    let (mut beyond, mut all) = (0u64, 0u64);
-    for j in 0..1400 * 2 {
-        for i in 0..2000 * 2 {
-            let (x, y) = (
-                (i as f64 + 0.5) / 2.0 - 1000.0,
-                (j as f64 + 0.5) / 2.0 - 700.0,
-            );
-            beyond += (x.hypot(y) > 1200.0) as u64;
-            all += 1;
+    // The masked share against a count of quarter-pixel cells beyond 1200
+    // px, here and with the principal point off the centre (asymmetrical).
+    let counted = |cx: f64, cy: f64| {
+        let (mut beyond, mut all) = (0u64, 0u64);
+        for j in 0..1400 * 2 {
+            for i in 0..2000 * 2 {
+                let (x, y) = ((i as f64 + 0.5) / 2.0 - cx, (j as f64 + 0.5) / 2.0 - cy);
+                beyond += (x.hypot(y) > 1200.0) as u64;
+                all += 1;
+            }
         }
-    }
-    let counted = beyond as f64 / all as f64;
-    assert!(counted > 0.0);
+        beyond as f64 / all as f64
+    };
+    let want = counted(1000.0, 700.0);
+    assert!(want > 0.0);
     assert!(
-        (c.masked_fraction() - counted).abs() < 2e-5,
-        "{} vs {counted}",
+        (c.masked_fraction() - want).abs() < 2e-5,
+        "{} vs {want}",
         c.masked_fraction()
+    );
+    let off = load(
+        "mask_off.json",
+        &profile(
+            2000,
+            1400,
+            [1000.0, 1000.0, 300.0, 200.0],
+            "opencv_fisheye",
+            TURNING,
+            r#""asymmetrical": true,"#,
+        ),
+    )
+    .unwrap();
+    let want = counted(300.0, 200.0);
+    assert!(want > 0.2, "{want}");
+    assert!(
+        (off.masked_fraction() - want).abs() < 2e-5,
+        "{} vs {want}",
+        off.masked_fraction()
     );
     assert!(round_trips(&c) < 41 * 41);
     // MMBM over the unmasked sensor: riemann and exact agree, and equal the
