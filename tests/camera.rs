@@ -75,7 +75,9 @@ fn gyroflow_profile_is_a_camera_file() {
     assert_eq!((c.width, c.height), (4000, 3000));
     assert!((c.focal_mm - 1.8).abs() < 1e-15);
     assert!((c.fx_px() - 1800.0).abs() < 1e-9 && (c.fy_px() - 1795.0).abs() < 1e-9);
-    assert_eq!((c.cx, c.cy, c.skew), (2010.0, 1490.0, 0.0));
+    // Not `asymmetrical`: Gyroflow's principal point is the image centre
+    // (the matrix says 2010, 1490).
+    assert_eq!((c.cx, c.cy, c.skew), (2000.0, 1500.0, 0.0));
     assert!((c.shutter.readout_s - 0.0155).abs() < 1e-15, "15.5 ms");
     assert_eq!(
         c.distortion,
@@ -89,7 +91,7 @@ fn gyroflow_profile_is_a_camera_file() {
     // Used for a 1920x1440 video: the matrix scales by 0.48.
     let s = c.scaled_to(1920, 1440);
     assert!((s.fx_px() - 864.0).abs() < 1e-9 && (s.fy_px() - 861.6).abs() < 1e-9);
-    assert!((s.cx - 964.8).abs() < 1e-9 && (s.cy - 715.2).abs() < 1e-9);
+    assert!((s.cx - 960.0).abs() < 1e-9 && (s.cy - 720.0).abs() < 1e-9);
     assert_eq!(s.focal_mm, c.focal_mm, "the field of view is unchanged");
     // The same ray lands on the same relative position.
     let (a, b) = (c.mm_to_pixel(0.3, -0.2), s.mm_to_pixel(0.3, -0.2));

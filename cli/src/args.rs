@@ -79,7 +79,8 @@ pub struct CameraArgs {
     #[arg(long, value_name = "WxH", value_parser = parse_resolution)]
     pub sensor: Option<(u32, u32)>,
     /// Scale the camera to a WxH image (focal length in px, principal point and skew
-    /// scale; the field of view stays): a lens profile calibrated at 4K used for 1080p.
+    /// scale; the field of view stays): a lens profile calibrated at 4K used for 1080p; a
+    /// portrait WxH on a landscape camera transposes it first, as Gyroflow does.
     #[arg(long, value_name = "WxH", value_parser = parse_resolution, conflicts_with = "sensor")]
     pub scale_to: Option<(u32, u32)>,
     /// Rolling-shutter readout, s: delay between the first and last line's

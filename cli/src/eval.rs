@@ -61,6 +61,9 @@ pub fn run(a: EvalArgs) -> Result<()> {
         Some(te) => Some((te, checked_blur_px(m.mm_s, te, scene.camera.pitch_x_mm)?)),
         None => None,
     };
+    // The share of the sensor beyond the lens's radial distortion limit,
+    // excluded from the mean (given only where there is one).
+    let masked = scene.camera.masked_fraction();
     if a.json {
         let mut o = serde_json::json!({
             "mmbm_mm_s": m.mm_s,
@@ -70,6 +73,9 @@ pub fn run(a: EvalArgs) -> Result<()> {
         });
         if let Some(e) = m.error_estimate {
             o["error_estimate"] = serde_json::json!(e);
+        }
+        if masked > 0.0 {
+            o["masked_fraction"] = serde_json::json!(masked);
         }
         if let Some((te, b)) = blur {
             o["exposure_s"] = serde_json::json!(te);
@@ -82,6 +88,12 @@ pub fn run(a: EvalArgs) -> Result<()> {
             print!(", error estimate {e:.2e} mm/s");
         }
         println!(")");
+        if masked > 0.0 {
+            println!(
+                "masked: {:.4} % of the sensor (beyond the lens's radial distortion limit)",
+                100.0 * masked
+            );
+        }
         if let Some((te, b)) = blur {
             println!("blur over {te} s: {b:.4} px");
         }

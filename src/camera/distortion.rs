@@ -45,6 +45,15 @@ pub enum Distortion {
         #[serde(default)]
         k3: f64,
     },
+    /// OpenCV's standard model with all 12 coefficients of Gyroflow's
+    /// `opencv_standard`, `[k1, k2, p1, p2, k3, k4, k5, k6, s1, s2, s3, s4]`
+    /// (rational radial and thin prism terms, `super::opencv`). The CPU
+    /// methods and the renderer take it; the GPU kernel does not.
+    #[serde(rename = "opencv_standard")]
+    OpencvStandard {
+        /// The 12 coefficients in OpenCV's order.
+        k: [f64; 12],
+    },
     /// OpenCV's fisheye model (Kannala-Brandt), equidistant with a polynomial in `theta`.
     Fisheye {
         /// Coefficient of `theta^3`.
@@ -79,6 +88,23 @@ impl Distortion {
         k3: -0.008,
     };
 
+    /// Gyroflow's `opencv_standard` from its 12 coefficients: the
+    /// five-coefficient [`Distortion::Opencv`] when `k4..s4` are zero (the GPU
+    /// kernel takes that one), else [`Distortion::OpencvStandard`].
+    pub fn opencv_standard(k: [f64; 12]) -> Self {
+        if k[5..].iter().all(|&c| c == 0.0) {
+            Distortion::Opencv {
+                k1: k[0],
+                k2: k[1],
+                p1: k[2],
+                p2: k[3],
+                k3: k[4],
+            }
+        } else {
+            Distortion::OpencvStandard { k }
+        }
+    }
+
     /// True for the ideal pinhole.
     pub fn is_none(&self) -> bool {
         matches!(self, Distortion::None)
@@ -86,18 +112,29 @@ impl Distortion {
 
     /// The model's coefficients in a fixed order (`[k1, k2, p1, p2, k3]` or
     /// `[k1, k2, k3, k4, 0]`) and a model code (0 none, 1 opencv, 2 fisheye),
-    /// the form the GPU kernel takes.
-    pub fn coefficients(&self) -> (u32, [f64; 5]) {
-        match *self {
+    /// the form the GPU kernel takes; `None` for a model the kernel does not
+    /// have ([`Distortion::OpencvStandard`]).
+    pub fn coefficients(&self) -> Option<(u32, [f64; 5])> {
+        Some(match *self {
             Distortion::None => (0, [0.0; 5]),
             Distortion::Opencv { k1, k2, p1, p2, k3 } => (1, [k1, k2, p1, p2, k3]),
             Distortion::Fisheye { k1, k2, k3, k4 } => (2, [k1, k2, k3, k4, 0.0]),
-        }
+            Distortion::OpencvStandard { .. } => return None,
+        })
     }
 
     /// Rejects non-finite coefficients, naming the key.
     pub fn validate(&self) -> Result<()> {
-        let (model, c) = self.coefficients();
+        if let Distortion::OpencvStandard { k } = self {
+            if let Some(i) = k.iter().position(|v| !v.is_finite()) {
+                return Err(Error::invalid(
+                    format!("distortion.k[{i}]"),
+                    format!("must be a finite number, got {}", k[i]),
+                ));
+            }
+            return Ok(());
+        }
+        let (model, c) = self.coefficients().unwrap_or((0, [0.0; 5]));
         let names: &[&str] = match model {
             1 => &["k1", "k2", "p1", "p2", "k3"],
             2 => &["k1", "k2", "k3", "k4"],
@@ -126,10 +163,29 @@ impl Distortion {
                     y * radial + p1 * (r2 + 2.0 * y * y) + 2.0 * p2 * x * y,
                 )
             }
+            Distortion::OpencvStandard { k } => super::opencv::distort(&k, x, y),
             Distortion::Fisheye { .. } => {
                 let s = self.fisheye_scale(x, y).0;
                 (s * x, s * y)
             }
+        }
+    }
+
+    /// The fisheye's `[k1, k2, k3, k4]` (zeros for the other models).
+    pub fn fisheye_k(&self) -> [f64; 4] {
+        match *self {
+            Distortion::Fisheye { k1, k2, k3, k4 } => [k1, k2, k3, k4],
+            _ => [0.0; 4],
+        }
+    }
+
+    /// The radial distortion limit (normalised distorted radius) beyond
+    /// which no pinhole ray is seen, Gyroflow's `radial_distortion_limit`:
+    /// the fisheye's [`super::fisheye::limit`]; infinite for the other models.
+    pub fn radial_limit(&self) -> f64 {
+        match self {
+            Distortion::Fisheye { .. } => super::fisheye::limit(self.fisheye_k()),
+            _ => f64::INFINITY,
         }
     }
 
@@ -142,10 +198,14 @@ impl Distortion {
         if r2 < 1e-6 {
             // Near the axis the closed form cancels; its series instead:
             // theta = r - r^3/3 + r^5/5, theta_d = theta + k1 theta^3 + k2 theta^5 + ...,
-            // so s = 1 + c r^2 + e r^4 + O(r^6).
+            // so s = 1 + c r^2 + e r^4 + h r^6 + O(r^8) (k4 enters at r^8).
             let c = k1 - 1.0 / 3.0;
             let e = 0.2 - k1 + k2;
-            return (1.0 + r2 * (c + r2 * e), 2.0 * c + 4.0 * e * r2);
+            let h = -1.0 / 7.0 + 14.0 / 15.0 * k1 - 5.0 / 3.0 * k2 + k3;
+            return (
+                1.0 + r2 * (c + r2 * (e + r2 * h)),
+                2.0 * c + r2 * (4.0 * e + 6.0 * h * r2),
+            );
         }
         let r = r2.sqrt();
         let th = r.atan();
@@ -177,6 +237,7 @@ impl Distortion {
                     ],
                 ]
             }
+            Distortion::OpencvStandard { k } => super::opencv::jacobian(&k, x, y),
             Distortion::Fisheye { .. } => {
                 let (s, g) = self.fisheye_scale(x, y);
                 [[s + g * x * x, g * x * y], [g * x * y, s + g * y * y]]
@@ -191,26 +252,13 @@ impl Distortion {
         if self.is_none() {
             return Some((xd, yd));
         }
-        if let Distortion::Fisheye { k1, k2, k3, k4 } = *self {
-            // Radial: solve theta_d(theta) = r_d for theta in [0, pi/2).
+        if let Distortion::Fisheye { .. } = *self {
+            // Radial: solve theta_d(theta) = r_d for theta on [0, the turning point].
             let rd = (xd * xd + yd * yd).sqrt();
             if rd == 0.0 {
                 return Some((0.0, 0.0));
             }
-            let mut th = rd.min(1.5);
-            for _ in 0..MAX_ITER {
-                let t2 = th * th;
-                let f = th * (1.0 + t2 * (k1 + t2 * (k2 + t2 * (k3 + t2 * k4)))) - rd;
-                let df = 1.0 + t2 * (3.0 * k1 + t2 * (5.0 * k2 + t2 * (7.0 * k3 + t2 * 9.0 * k4)));
-                if df <= 0.0 {
-                    return None;
-                }
-                let step = f / df;
-                th = (th - step).clamp(0.0, std::f64::consts::FRAC_PI_2 - 1e-9);
-                if step.abs() < UNDISTORT_TOL * 1e-2 {
-                    break;
-                }
-            }
+            let th = super::fisheye::solve(self.fisheye_k(), rd, UNDISTORT_TOL * 1e-2)?;
             let r = th.tan();
             let (x, y) = (xd * r / rd, yd * r / rd);
             return self.converged(x, y, xd, yd);
@@ -333,6 +381,22 @@ mod tests {
         let (s, g) = d.fisheye_scale(r, 0.0);
         assert!((s - s_ref).abs() < 1e-14, "s: {s} vs {s_ref}");
         assert!((g - g_ref).abs() < 1e-6, "(ds/dr)/r: {g} vs {g_ref}");
+    }
+
+    #[test]
+    fn fisheye_near_axis_series_keeps_k3() {
+        // A large k3 makes its r^4 term of (ds/dr)/r visible just inside the
+        // series branch: 6 k3 r^4 = 6e-8 at r = 1e-3, k3 = 1e4.
+        let (k1, k2, k3, k4) = (0.02, -0.01, 1e4, 0.0);
+        let d = Distortion::Fisheye { k1, k2, k3, k4 };
+        let r: f64 = 0.999e-3;
+        let th = r.atan();
+        let t2 = th * th;
+        let thd = th * (1.0 + t2 * (k1 + t2 * (k2 + t2 * (k3 + t2 * k4))));
+        let dthd = 1.0 + t2 * (3.0 * k1 + t2 * (5.0 * k2 + t2 * (7.0 * k3 + t2 * 9.0 * k4)));
+        let g_ref = (dthd / (1.0 + r * r) - thd / r) / (r * r);
+        let (_, g) = d.fisheye_scale(r, 0.0);
+        assert!((g - g_ref).abs() < 5e-9, "(ds/dr)/r: {g} vs {g_ref}");
     }
 
     #[test]

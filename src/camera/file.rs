@@ -226,8 +226,9 @@ pub struct CameraOverrides {
     /// Camera-file keys over the file's (or the thesis camera's): focal
     /// length, pitch, sensor size (principal point re-centred), readout.
     pub keys: CameraFile,
-    /// Then the camera scaled to this `(width, height)`, px
-    /// ([`Camera::scaled_to`]: the field of view stays).
+    /// Then the camera scaled to this `(width, height)`, px, transposed
+    /// first for the other orientation ([`Camera::fitted_to`]: the field of
+    /// view stays).
     pub scale_to: Option<(u32, u32)>,
     /// Then sensor noise at this light level (electrons per second of a
     /// white pixel), with the camera's other noise keys or their defaults.
@@ -260,7 +261,7 @@ impl Camera {
         };
         let mut c = over.keys.over(&base);
         if let Some((w, h)) = over.scale_to {
-            c = c.scaled_to(w, h);
+            c = c.fitted_to(w, h);
         }
         if let Some(phi) = over.light_e_per_s {
             c.noise = Some(Noise {
@@ -311,11 +312,35 @@ pub fn from_gyroflow(p: &Value) -> Result<Camera> {
             k[r][c] = num(v, &format!("fisheye_params.camera_matrix[{r}][{c}]"))?;
         }
     }
-    let (fx, fy) = (k[0][0], k[1][1]);
+    // Gyroflow divides the focal lengths by `crop` and takes their size
+    // (a negative fx or fy is a mirrored calibration; the speed is the same).
+    let crop = match p.get("crop") {
+        None | Some(Value::Null) => 1.0,
+        Some(v) => num(v, "crop")?,
+    };
+    if crop.is_nan() || crop <= 0.0 {
+        return Err(Error::invalid(
+            "crop",
+            format!("must be positive, got {crop}"),
+        ));
+    }
+    let (fx, fy) = ((k[0][0] / crop).abs(), (k[1][1] / crop).abs());
     if !(fx > 0.0 && fy > 0.0) {
         return Err(Error::invalid(
             "fisheye_params.camera_matrix",
-            format!("focal lengths must be positive, got fx = {fx}, fy = {fy}"),
+            format!(
+                "focal lengths must be non-zero, got fx = {}, fy = {}",
+                k[0][0], k[1][1]
+            ),
+        ));
+    }
+    if let Some(lens) = p.get("digital_lens").filter(|v| !v.is_null()) {
+        return Err(Error::invalid(
+            "digital_lens",
+            format!(
+                "{lens} is not supported (mmbm reads optical lens models only; a digital \
+                 lens warp such as gopro_superview is not applied)"
+            ),
         ));
     }
     let coeffs: Vec<f64> = match fp.get("distortion_coeffs") {
@@ -332,7 +357,6 @@ pub fn from_gyroflow(p: &Value) -> Result<Camera> {
             ))
         }
     };
-    let c = |i: usize| coeffs.get(i).copied().unwrap_or(0.0);
     let model = match p.get("distortion_model").and_then(Value::as_str) {
         Some(s) => s.to_string(),
         None if p.get("use_opencv_standard").and_then(Value::as_bool) == Some(true) => {
@@ -340,41 +364,31 @@ pub fn from_gyroflow(p: &Value) -> Result<Camera> {
         }
         None => "opencv_fisheye".into(),
     };
-    let distortion = match model.as_str() {
-        "opencv_fisheye" => Distortion::Fisheye {
-            k1: c(0),
-            k2: c(1),
-            k3: c(2),
-            k4: c(3),
-        },
-        "opencv_standard" => Distortion::Opencv {
-            k1: c(0),
-            k2: c(1),
-            p1: c(2),
-            p2: c(3),
-            k3: c(4),
-        },
-        other => {
-            return Err(Error::invalid(
-                "distortion_model",
-                format!(
-                    "'{other}' is not supported (mmbm reads opencv_fisheye and opencv_standard)"
-                ),
-            ))
-        }
-    };
+    let distortion = gyroflow_distortion(&model, &coeffs)?;
     let focal_mm = match p.get("focal_length").and_then(Value::as_f64) {
         Some(f) if f > 0.0 && f.is_finite() => f,
         _ => fx * NOMINAL_PITCH_MM,
     };
-    let readout_s = match p.get("frame_readout_time") {
+    let readout_ms = match p.get("frame_readout_time") {
         None | Some(Value::Null) => 0.0,
-        Some(v) => num(v, "frame_readout_time")? / 1000.0,
+        Some(v) => num(v, "frame_readout_time")?,
     };
-    let direction = match p.get("frame_readout_direction") {
+    let mut direction = match p.get("frame_readout_direction") {
         None | Some(Value::Null) => Readout::TopToBottom,
         Some(Value::String(s)) => gyroflow_direction(s)?,
         Some(v) => gyroflow_direction(&v.to_string())?,
+    };
+    // Gyroflow: a negative readout time is the opposite direction.
+    if readout_ms < 0.0 {
+        direction = direction.reversed();
+    }
+    // The principal point is the image centre unless the profile says
+    // `asymmetrical: true` (Gyroflow's `get_camera_matrix`).
+    let asymmetrical = p.get("asymmetrical").and_then(Value::as_bool) == Some(true);
+    let (cx, cy) = if asymmetrical {
+        (k[0][2], k[1][2])
+    } else {
+        (w as f64 / 2.0, h as f64 / 2.0)
     };
     Ok(Camera {
         focal_mm,
@@ -382,16 +396,61 @@ pub fn from_gyroflow(p: &Value) -> Result<Camera> {
         pitch_y_mm: focal_mm / fy,
         width: w,
         height: h,
-        cx: k[0][2],
-        cy: k[1][2],
+        cx,
+        cy,
         skew: k[0][1],
         distortion,
         shutter: Shutter {
-            readout_s,
+            readout_s: readout_ms.abs() / 1000.0,
             direction,
         },
         noise: None,
         lens: None,
+    })
+}
+
+/// The distortion of a Gyroflow profile's `distortion_model` and
+/// `distortion_coeffs` (missing coefficients are 0). Coefficients that are
+/// all zero (or none) are the plain pinhole, as in Gyroflow; a model mmbm
+/// does not implement is refused by name, and so is an `opencv_fisheye`
+/// with more than its 4 coefficients or an `opencv_standard` with more than
+/// its 12 (none is dropped silently).
+fn gyroflow_distortion(model: &str, coeffs: &[f64]) -> Result<Distortion> {
+    let c = |i: usize| coeffs.get(i).copied().unwrap_or(0.0);
+    let most = match model {
+        "opencv_fisheye" => 4,
+        "opencv_standard" => 12,
+        other => {
+            return Err(Error::invalid(
+                "distortion_model",
+                format!(
+                    "'{other}' is not supported (mmbm reads opencv_fisheye and opencv_standard; \
+                     Gyroflow's poly3, poly5, ptlens, insta360 and sony models are not implemented)"
+                ),
+            ))
+        }
+    };
+    if let Some(i) = (most..coeffs.len()).find(|&i| coeffs[i] != 0.0) {
+        return Err(Error::invalid(
+            format!("fisheye_params.distortion_coeffs[{i}]"),
+            format!(
+                "{model} has {most} coefficients, this profile gives a non-zero {}th",
+                i + 1
+            ),
+        ));
+    }
+    if coeffs.iter().all(|&x| x == 0.0) {
+        return Ok(Distortion::None);
+    }
+    Ok(if model == "opencv_fisheye" {
+        Distortion::Fisheye {
+            k1: c(0),
+            k2: c(1),
+            k3: c(2),
+            k4: c(3),
+        }
+    } else {
+        Distortion::opencv_standard(std::array::from_fn(c))
     })
 }
 

@@ -133,6 +133,36 @@ impl Camera {
         }
     }
 
+    /// The camera turned to the other orientation, as Gyroflow's
+    /// `LensProfile::swapped` turns a landscape profile for a portrait video:
+    /// width and height, the pitches (so fx and fy) and the principal point's
+    /// coordinates swap; skew, distortion coefficients and the readout
+    /// direction are kept (as Gyroflow keeps them).
+    pub fn transposed(&self) -> Self {
+        Camera {
+            width: self.height,
+            height: self.width,
+            pitch_x_mm: self.pitch_y_mm,
+            pitch_y_mm: self.pitch_x_mm,
+            cx: self.cy,
+            cy: self.cx,
+            ..*self
+        }
+    }
+
+    /// [`Camera::scaled_to`] a `width x height` video, transposed first
+    /// ([`Camera::transposed`]) when the video is portrait and the camera
+    /// landscape or the other way round (Gyroflow's rule for a profile).
+    pub fn fitted_to(&self, width: u32, height: u32) -> Self {
+        let turned = (width > height && self.width < self.height)
+            || (width < height && self.width > self.height);
+        if turned {
+            self.transposed().scaled_to(width, height)
+        } else {
+            self.scaled_to(width, height)
+        }
+    }
+
     /// Same focal length and pixel pitch, a `width x height` sensor with the
     /// principal point at its centre (what `--resolution` does).
     pub fn with_resolution(&self, width: u32, height: u32) -> Self {
@@ -206,10 +236,11 @@ impl Camera {
         Ok(())
     }
 
-    /// Checks that the distortion is one-to-one over the sensor: every point
-    /// of a 33 x 33 grid over the sensor (edges included) undistorts, the
-    /// Jacobian keeps a positive determinant there, and along every ray from
-    /// the principal point to a grid point the distorted radius grows.
+    /// Checks that the distortion is one-to-one over the sensor's unmasked
+    /// part: every point of a 33 x 33 grid over the sensor (edges included)
+    /// within the radial distortion limit ([`Camera::is_masked_mm`])
+    /// undistorts, and the Jacobian keeps a positive determinant along the
+    /// ray from the principal point to it. A sensor masked whole is refused.
     fn check_distortion_invertible(&self) -> Result<()> {
         const N: u32 = 32;
         let fold = |x: f64, y: f64, why: &str| {
@@ -221,6 +252,16 @@ impl Camera {
                 ),
             ))
         };
+        if self.valid_fraction() <= 0.0 {
+            return Err(Error::invalid(
+                "distortion",
+                format!(
+                    "the whole sensor lies beyond the lens's radial distortion limit ({:.4} mm \
+                     from the principal point): no pixel sees a ray",
+                    self.radial_limit_mm()
+                ),
+            ));
+        }
         for j in 0..=N {
             for i in 0..=N {
                 let (px, py) = (
@@ -228,6 +269,9 @@ impl Camera {
                     self.height as f64 * j as f64 / N as f64,
                 );
                 let (ud, vd) = self.pixel_to_mm(px, py);
+                if self.is_masked_mm(ud, vd) {
+                    continue;
+                }
                 let Some((u, v)) = self.undistort_mm(ud, vd) else {
                     return fold(px, py, "undistortion does not converge");
                 };
@@ -243,6 +287,50 @@ impl Camera {
             }
         }
         Ok(())
+    }
+
+    /// The radial distortion limit on the sensor, mm from the principal
+    /// point: beyond it the lens model has no ray (past its turning point or
+    /// 90 degrees; [`Distortion::radial_limit`]). Infinite for models without one.
+    pub fn radial_limit_mm(&self) -> f64 {
+        self.distortion.radial_limit() * self.focal_mm
+    }
+
+    /// True for a distorted sensor point `(ud, vd)` mm beyond the radial
+    /// distortion limit: masked, excluded from the metric's mean.
+    #[inline]
+    pub fn is_masked_mm(&self, ud: f64, vd: f64) -> bool {
+        ud.hypot(vd) > self.radial_limit_mm()
+    }
+
+    /// The share of the sensor's area within the radial distortion limit
+    /// (exact: the area of the rectangle within the disc of that radius,
+    /// over the rectangle's); 1 without a limit.
+    pub fn valid_fraction(&self) -> f64 {
+        let rl = self.radial_limit_mm();
+        let r = self.sensor_rect();
+        if !rl.is_finite() {
+            return 1.0;
+        }
+        // Area of the disc within [0, a] x [0, b], a, b >= 0.
+        let quadrant = |a: f64, b: f64| -> f64 {
+            let prim =
+                |x: f64| 0.5 * (x * (rl * rl - x * x).max(0.0).sqrt() + rl * rl * (x / rl).asin());
+            let x0 = (rl * rl - b * b).max(0.0).sqrt().min(a);
+            let x1 = a.min(rl);
+            b * x0 + (prim(x1) - prim(x0)).max(0.0)
+        };
+        // Signed inclusion-exclusion over the four corners (the disc is symmetric).
+        let signed = |u: f64, v: f64| quadrant(u.abs(), v.abs()) * u.signum() * v.signum();
+        let inside =
+            signed(r.u1, r.v1) - signed(r.u0, r.v1) - signed(r.u1, r.v0) + signed(r.u0, r.v0);
+        (inside / r.area()).clamp(0.0, 1.0)
+    }
+
+    /// The share of the sensor's area beyond the radial distortion limit
+    /// (masked: excluded from the metric), `1 - valid_fraction`.
+    pub fn masked_fraction(&self) -> f64 {
+        1.0 - self.valid_fraction()
     }
 
     /// Pixel coordinates of the ray `(x, y, 1)` (normalised pinhole

@@ -10,9 +10,11 @@
 pub(crate) mod blur;
 pub(crate) mod distortion;
 pub(crate) mod file;
+pub(crate) mod fisheye;
 pub(crate) mod intrinsics;
 pub(crate) mod lens;
 pub(crate) mod noise;
+pub(crate) mod opencv;
 pub(crate) mod shutter;
 
 pub use blur::{blur_px, checked_blur_px, checked_px_s, exposure_for_blur};

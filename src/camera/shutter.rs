@@ -55,6 +55,16 @@ impl Readout {
         }
     }
 
+    /// The opposite direction (what a negative Gyroflow `frame_readout_time` means).
+    pub fn reversed(self) -> Self {
+        match self {
+            Readout::TopToBottom => Readout::BottomToTop,
+            Readout::BottomToTop => Readout::TopToBottom,
+            Readout::LeftToRight => Readout::RightToLeft,
+            Readout::RightToLeft => Readout::LeftToRight,
+        }
+    }
+
     /// True when the lines are rows (top-to-bottom or bottom-to-top).
     pub fn is_rows(self) -> bool {
         matches!(self, Readout::TopToBottom | Readout::BottomToTop)

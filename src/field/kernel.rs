@@ -121,6 +121,23 @@ impl Grid {
     /// Rejects a half-zero size and grids of 2^32 samples or more.
     pub fn new(camera: &Camera, width: u32, height: u32) -> Result<Self> {
         camera.validate()?;
+        if camera.distortion.coefficients().is_none() {
+            return Err(Error::invalid(
+                "distortion",
+                "the 12-coefficient opencv_standard model (rational k4..k6, thin prism \
+                 s1..s4) is not in the GPU kernel: use a CPU method (riemann, gauss, exact)",
+            ));
+        }
+        if camera.masked_fraction() > 0.0 {
+            return Err(Error::invalid(
+                "distortion",
+                format!(
+                    "{:.3} % of the sensor lies beyond the lens's radial distortion limit; the \
+                     GPU kernel does not mask: use a CPU method (riemann, gauss, exact)",
+                    100.0 * camera.masked_fraction()
+                ),
+            ));
+        }
         let (w, h) = match (width, height) {
             (0, 0) => (camera.width, camera.height),
             (0, _) | (_, 0) => {
@@ -173,7 +190,7 @@ impl Grid {
         let c = &self.camera;
         let (sx, sy) = self.step();
         let tiles = self.tiles();
-        let (model, k) = c.distortion.coefficients();
+        let (model, k) = c.distortion.coefficients().unwrap_or((0, [0.0; 5]));
         FlowParams {
             f_mm: c.focal_mm as f32,
             pitch_x: c.pitch_x_mm as f32,

@@ -92,15 +92,22 @@ impl GridRule {
     }
 
     /// This rule's nodes seen through `cam`'s lens distortion (unchanged
-    /// without distortion). Errors when a node does not undistort.
+    /// without distortion). Nodes beyond the radial distortion limit are
+    /// masked: dropped, the others' weights rescaled to sum to 1 (the mean
+    /// over the unmasked sensor). Errors when an unmasked node does not
+    /// undistort, or every node is masked.
     pub fn distorted(self, cam: &Camera) -> Result<Self> {
         if cam.distortion.is_none() {
             return Ok(self);
         }
         let mut points = Vec::with_capacity(self.len);
         let mut jac = Vec::with_capacity(self.len);
+        let mut w = Vec::with_capacity(self.len);
         for k in 0..self.len {
             let (ud, vd) = (self.m[0][k], self.m[1][k]);
+            if cam.is_masked_mm(ud, vd) {
+                continue;
+            }
             let (u, v) = cam.undistort_mm(ud, vd).ok_or_else(|| {
                 Error::invalid(
                     "distortion",
@@ -110,8 +117,17 @@ impl GridRule {
             let j = cam.distortion_jacobian(u, v);
             points.push((u, v));
             jac.push([j[0][0], j[0][1], j[1][0], j[1][1]]);
+            w.push(self.w[k]);
         }
-        let mut rule = Self::from_points(&points, &self.w[..self.len]);
+        let total: f64 = w.iter().sum();
+        if points.is_empty() || total.is_nan() || total <= 0.0 {
+            return Err(Error::invalid(
+                "distortion",
+                "every node of the rule lies beyond the lens's radial distortion limit",
+            ));
+        }
+        w.iter_mut().for_each(|x| *x /= total);
+        let mut rule = Self::from_points(&points, &w);
         rule.jac = Some(jac);
         Ok(rule)
     }

@@ -325,7 +325,7 @@ pub fn mmbm_poly(cam: &Camera, poly: &FlowPoly, method: Method) -> Result<Mmbm> 
             let r = if pinhole {
                 exact(poly, &rect, tol)
             } else {
-                exact_with(|u, v| distorted_speed(cam, poly, u, v), &rect, tol)
+                masked_exact(cam, poly, tol)
             };
             (r.value, Some(r.error), r.evaluations)
         }
@@ -368,6 +368,24 @@ fn distorted_speed(cam: &Camera, poly: &FlowPoly, ud: f64, vd: f64) -> f64 {
     }
 }
 
+/// The exact mean through the distortion over the sensor's unmasked part:
+/// the speed is 0 beyond the radial distortion limit and the integral is
+/// divided by the unmasked share of the area ([`Camera::valid_fraction`]).
+fn masked_exact(cam: &Camera, poly: &FlowPoly, tol: f64) -> ExactResult {
+    let valid = cam.valid_fraction();
+    let speed = |u: f64, v: f64| {
+        if cam.is_masked_mm(u, v) {
+            0.0
+        } else {
+            distorted_speed(cam, poly, u, v)
+        }
+    };
+    let mut r = exact_with(speed, &cam.sensor_rect(), tol);
+    r.value /= valid;
+    r.error /= valid;
+    r
+}
+
 /// A prepared CPU method for many evaluations with one camera: the grid rules
 /// are built once (structure-of-arrays, vectorised), which is what `series`
 /// and the trigger policies use per gyro sample.
@@ -403,10 +421,7 @@ impl Evaluator {
             (None, Method::Exact { tol }) if self.camera.distortion.is_none() => {
                 exact(poly, &self.camera.sensor_rect(), tol).value
             }
-            (None, Method::Exact { tol }) => {
-                let c = &self.camera;
-                exact_with(|u, v| distorted_speed(c, poly, u, v), &c.sensor_rect(), tol).value
-            }
+            (None, Method::Exact { tol }) => masked_exact(&self.camera, poly, tol).value,
             _ => unreachable!("Evaluator::new accepts only CPU methods"),
         }
     }

@@ -1,0 +1,126 @@
+//! OpenCV's fisheye model (Kannala-Brandt) in the radial form Gyroflow's
+//! `opencv_fisheye` uses: `theta_d = theta (1 + k1 theta^2 + k2 theta^4 +
+//! k3 theta^6 + k4 theta^8)`, `theta` the ray's angle to the axis (rad),
+//! `theta_d` the distorted radius in normalised units.
+//!
+//! The model is one-to-one only up to its turning point (the first angle
+//! where `d theta_d / d theta = 0`) and, as a pinhole ray `(x, y, 1)`, below
+//! 90 degrees: [`limit`] is the distorted radius there, Gyroflow's radial
+//! distortion limit. Pixels beyond it have no ray ([`solve`] gives `None`).
+
+/// The largest angle a pinhole ray `(x, y, 1)` can have, rad (just under 90 degrees).
+pub const THETA_MAX: f64 = std::f64::consts::FRAC_PI_2 - 1e-9;
+
+/// `theta_d(theta)`, normalised units.
+#[inline]
+pub fn theta_d(k: [f64; 4], th: f64) -> f64 {
+    let t2 = th * th;
+    th * (1.0 + t2 * (k[0] + t2 * (k[1] + t2 * (k[2] + t2 * k[3]))))
+}
+
+/// `d theta_d / d theta` (dimensionless).
+#[inline]
+pub fn slope(k: [f64; 4], th: f64) -> f64 {
+    let t2 = th * th;
+    1.0 + t2 * (3.0 * k[0] + t2 * (5.0 * k[1] + t2 * (7.0 * k[2] + t2 * 9.0 * k[3])))
+}
+
+/// The angle (rad) up to which `theta_d` grows: the first zero of its slope
+/// in `(0, THETA_MAX]` (a scan of 64 steps, then bisection to 1e-15 rad),
+/// or `THETA_MAX` when the slope stays positive.
+pub fn turning_point(k: [f64; 4]) -> f64 {
+    const STEPS: u32 = 64;
+    let mut lo = 0.0;
+    for i in 1..=STEPS {
+        let hi = THETA_MAX * i as f64 / STEPS as f64;
+        if slope(k, hi) <= 0.0 || slope(k, hi).is_nan() {
+            let mut hi = hi;
+            while hi - lo > 1e-15 {
+                let mid = 0.5 * (lo + hi);
+                if slope(k, mid) > 0.0 {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
+            }
+            return lo;
+        }
+        lo = hi;
+    }
+    THETA_MAX
+}
+
+/// The radial distortion limit: the largest distorted radius (normalised
+/// units) with a ray, `theta_d` at the [`turning_point`].
+pub fn limit(k: [f64; 4]) -> f64 {
+    theta_d(k, turning_point(k))
+}
+
+/// The angle `theta` (rad) with `theta_d(theta) = rd` on `[0, turning
+/// point]`: Newton's method safeguarded by bisection on that bracket, to
+/// `tol` in `theta_d`. `None` when `rd` lies beyond the [`limit`] (no ray).
+pub fn solve(k: [f64; 4], rd: f64, tol: f64) -> Option<f64> {
+    let top = turning_point(k);
+    if rd.is_nan() || rd < 0.0 || theta_d(k, top) < rd - tol {
+        return None;
+    }
+    let (mut lo, mut hi) = (0.0, top);
+    let mut th = rd.clamp(lo, hi);
+    // The last step's size: a Newton step must at least halve it, else bisect
+    // (Newton alone can ping-pong across a bracket that barely shrinks).
+    let mut last = hi - lo;
+    for _ in 0..200 {
+        let f = theta_d(k, th) - rd;
+        if f.abs() <= tol {
+            return Some(th);
+        }
+        if f < 0.0 {
+            lo = th;
+        } else {
+            hi = th;
+        }
+        let df = slope(k, th);
+        let next = th - f / df;
+        let newton = df > 0.0 && next > lo && next < hi && 2.0 * (f / df).abs() <= last;
+        let prev = th;
+        th = if newton { next } else { 0.5 * (lo + hi) };
+        last = (th - prev).abs();
+        if hi - lo <= f64::EPSILON * hi {
+            return Some(th);
+        }
+    }
+    Some(th)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn turning_point_is_where_the_slope_vanishes() {
+        // theta_d = theta - theta^3 / 3: slope 1 - theta^2, zero at 1 rad.
+        let k = [-1.0 / 3.0, 0.0, 0.0, 0.0];
+        assert!((turning_point(k) - 1.0).abs() < 1e-12);
+        assert!((limit(k) - 2.0 / 3.0).abs() < 1e-12);
+        assert_eq!(turning_point([0.0; 4]), THETA_MAX);
+    }
+
+    #[test]
+    fn solve_finds_the_first_branch_and_refuses_beyond_the_limit() {
+        let k = [-1.0 / 3.0, 0.0, 0.0, 0.0];
+        for &rd in &[1e-6, 0.1, 0.5, 0.66, 2.0 / 3.0 - 1e-9] {
+            let th = solve(k, rd, 1e-14).expect("has a preimage");
+            assert!(
+                th <= 1.0 && (theta_d(k, th) - rd).abs() <= 1e-14,
+                "{rd}: {th}"
+            );
+        }
+        assert_eq!(solve(k, 0.7, 1e-14), None);
+        // theta + theta^3 - 0.8 theta^5 (turning point 1 rad): plain Newton from
+        // r_d ping-pongs across the bracket here.
+        let k = [1.0, -0.8, 0.0, 0.0];
+        let rd = 0.7075f64.hypot(0.6725);
+        let th = solve(k, rd, 1e-14).unwrap();
+        assert!((theta_d(k, th) - rd).abs() <= 1e-14 && th < 1.0);
+    }
+}
