@@ -181,7 +181,7 @@ impl Distortion {
 
     /// The radial distortion limit (normalised distorted radius) beyond
     /// which no pinhole ray is seen, Gyroflow's `radial_distortion_limit`:
-    /// the fisheye's [`super::fisheye::limit`]; infinite for the other models.
+    /// the fisheye's `fisheye::limit`; infinite for the other models.
     pub fn radial_limit(&self) -> f64 {
         match self {
             Distortion::Fisheye { .. } => super::fisheye::limit(self.fisheye_k()),
