@@ -12,7 +12,8 @@
 //! With `k4 = k5 = k6 = s1..s4 = 0` this is the five-coefficient
 //! Brown-Conrady model (`Distortion::Opencv`).
 
-use super::distortion::Jac;
+/// A 2x2 Jacobian, row-major (the same type as `distortion::Jac`, which uses this file).
+type Jac = [[f64; 2]; 2];
 
 /// The distorted point `(x_d, y_d)` of the pinhole point `(x, y)`.
 #[inline]

@@ -8,7 +8,7 @@
 //! maximum gain is the camera's business, not the policy's: the experiment
 //! caps `K_ref * gain` there (see `experiment::map`).
 
-use super::parse::parse_pos;
+use super::numbers::parse_pos;
 use super::policy::{LogView, Observation, Policy};
 use super::rules::Fixed;
 use super::timing::CameraTiming;

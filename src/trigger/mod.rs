@@ -64,6 +64,7 @@ mod baselines;
 mod exposure;
 mod latency;
 mod live;
+mod numbers;
 mod pace;
 mod parse;
 mod phase;

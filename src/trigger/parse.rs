@@ -5,36 +5,12 @@
 
 use super::baselines::{parse_ae, split_exposure, AeParams, AutoExposure, FixedExposure};
 use super::exposure::Exposure;
+use super::numbers::{parse_num, parse_pos};
 use super::phase::Phase;
 use super::policy::{Level, Policy};
 use super::predict::{Forecast, Oracle};
 use super::rules::{Adaptive, Deadline, Fixed, Gate, Threshold};
 use crate::error::{Error, Result};
-
-pub(crate) fn parse_num(s: &str, what: &str, spec: &str) -> Result<f64> {
-    let x: f64 = s
-        .trim()
-        .parse()
-        .map_err(|_| Error::invalid("policy", format!("'{spec}': {what} '{s}' is not a number")))?;
-    if !x.is_finite() {
-        return Err(Error::invalid(
-            "policy",
-            format!("'{spec}': {what} must be finite"),
-        ));
-    }
-    Ok(x)
-}
-
-pub(crate) fn parse_pos(s: &str, what: &str, spec: &str) -> Result<f64> {
-    let x = parse_num(s, what, spec)?;
-    if x <= 0.0 {
-        return Err(Error::invalid(
-            "policy",
-            format!("'{spec}': {what} must be > 0, got {x}"),
-        ));
-    }
-    Ok(x)
-}
 
 /// Highest frame rate a policy accepts, frames/s.
 pub const MAX_FPS: f64 = 1000.0;
