@@ -261,3 +261,39 @@ fn tables_print_all_and_json_parses() {
     assert_eq!(v["tables"].as_array().unwrap().len(), 5);
     assert_eq!(v["grid_error"].as_array().unwrap().len(), 14);
 }
+
+/// Issue #22: `render` had both `--sensor` and its own `--resolution`; they
+/// are one flag now (`--resolution` its alias), so giving both is a usage
+/// error, and either gives the same image.
+#[test]
+fn render_resolution_is_the_sensor_flag() {
+    let d = tempfile::tempdir().unwrap();
+    let base =
+        "render --omega 0.2,0.1,0 --exposure 0.02 --target checker:0.05 --distance 1 --backend cpu";
+    let run = |extra: &str| {
+        let args: Vec<String> = format!("{base} {extra}")
+            .split_whitespace()
+            .map(String::from)
+            .collect();
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        common::mmbm_in(d.path(), &args)
+    };
+    let both = run("--sensor 32x24 --resolution 32x24 --out both.png");
+    assert_eq!(
+        both.status.code(),
+        Some(2),
+        "{}",
+        String::from_utf8_lossy(&both.stderr)
+    );
+    for (flag, out) in [("--sensor", "s.png"), ("--resolution", "r.png")] {
+        let o = run(&format!("{flag} 32x24 --out {out}"));
+        assert!(
+            o.status.success(),
+            "{flag}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+    }
+    let s = std::fs::read(d.path().join("s.png")).unwrap();
+    assert_eq!(s, std::fs::read(d.path().join("r.png")).unwrap());
+    assert_eq!(image::load_from_memory(&s).unwrap().width(), 32);
+}

@@ -75,8 +75,10 @@ pub struct CameraArgs {
     /// Square pixel pitch, mm (thesis: 0.00465).
     #[arg(allow_negative_numbers = true, long, value_name = "MM")]
     pub pitch: Option<f64>,
-    /// Sensor resolution WxH, principal point at the centre (thesis: 640x480).
-    #[arg(long, value_name = "WxH", value_parser = parse_resolution)]
+    /// Sensor resolution WxH (focal length and pixel pitch kept), principal point at the
+    /// centre (thesis: 640x480); `--resolution` is the same flag (renders: at most 2^26
+    /// pixels, 2^40 pixel-samples per frame).
+    #[arg(long, visible_alias = "resolution", value_name = "WxH", value_parser = parse_resolution)]
     pub sensor: Option<(u32, u32)>,
     /// Scale the camera to a WxH image (focal length in px, principal point and skew
     /// scale; the field of view stays): a lens profile calibrated at 4K used for 1080p; a

@@ -84,10 +84,6 @@ pub struct RenderOpts {
     /// Background linear RGB where rays miss the target.
     #[arg(allow_hyphen_values = true, long, value_name = "R,G,B", value_parser = parse_vec3)]
     pub background: Option<DVec3>,
-    /// Output resolution WxH (keeps focal length and pixel pitch; principal point at the centre).
-    /// Limits: 2^26 pixels, 2^40 pixel-samples per frame.
-    #[arg(long, value_name = "WxH", value_parser = super::args::parse_resolution)]
-    pub resolution: Option<(u32, u32)>,
     /// Output image: .exr (linear float R,G,B) or .png (sRGB 8-bit).
     #[arg(long, value_name = "FILE")]
     pub out: PathBuf,
@@ -174,9 +170,6 @@ pub fn run(args: RenderArgs) -> Result<()> {
     }
     check_outputs(&outputs)?;
     let mut camera = a.camera.camera()?;
-    if let Some((w, h)) = a.resolution {
-        camera = camera.with_resolution(w, h);
-    }
     let log = match &a.gyro {
         Some(g) => {
             let log = mmbm::io::gyro::read_log(g, a.gyro_opts.options()?)?;
