@@ -2,12 +2,12 @@
 //! judged (blob extraction) at every light level with the sensor noise of
 //! that light and the gain a camera would set there (SPEC section 10).
 
-use super::measure::blob_metrics;
+use super::measure::{blob_metrics, bulk_job, frame_motion};
 use super::walk::Walk;
 use crate::camera::{Camera, Noise};
 use crate::error::Result;
 use crate::io::images::to_rgb8;
-use crate::render::{self, Backend, Quality, RenderJob, Target, Trajectory};
+use crate::render::{self, Quality, Target};
 use crate::trigger::Frame;
 
 /// The window judged at each light: the blob grid padded by this many blob pitches.
@@ -72,25 +72,11 @@ pub fn blobs_at_lights(
     lights: &[Light],
 ) -> Result<Vec<bool>> {
     let cam = Camera { noise: None, ..cam };
-    let i = walk
-        .samples
-        .partition_point(|s| s.t < frame.exposure_start)
-        .min(walk.samples.len() - 1);
-    let distance = walk.distance[i];
-    let use_velocity = walk.samples[i].velocity.is_some();
     let rolling = cam.shutter.readout_s;
     let exposure = frame.exposure_s();
-    let traj = Trajectory::from_imu_log(
-        &walk.samples,
-        frame.exposure_start,
-        exposure + rolling,
-        use_velocity,
-    )?;
+    let (distance, traj) = frame_motion(walk, frame, rolling)?;
     let target = Target::parse(target, distance)?;
-    let mut job = RenderJob::new(cam, exposure, traj.clone(), target.clone());
-    job.quality = quality;
-    job.backend = Backend::Bulk;
-    job.seed = seed;
+    let mut job = bulk_job(cam, exposure, &traj, &target, quality, seed);
     job.with_maps = false;
     let out = render::render_frame(&job)?;
     // True blob centres at mid-exposure, as the experiment's measure.

@@ -197,6 +197,46 @@ pub struct Rendered {
     pub rgb: Vec<f32>,
 }
 
+/// The walk at `frame`: the distance to the target at exposure start (m)
+/// and the camera's trajectory from the log. A rolling shutter exposes each
+/// line over its own window, so the motion spans `readout_s` plus the
+/// exposure.
+pub(crate) fn frame_motion(
+    walk: &Walk,
+    frame: &Frame,
+    readout_s: f64,
+) -> Result<(f64, Trajectory)> {
+    let i = walk
+        .samples
+        .partition_point(|s| s.t < frame.exposure_start)
+        .min(walk.samples.len() - 1);
+    let use_velocity = walk.samples[i].velocity.is_some();
+    let traj = Trajectory::from_imu_log(
+        &walk.samples,
+        frame.exposure_start,
+        frame.exposure_s() + readout_s,
+        use_velocity,
+    )?;
+    Ok((walk.distance[i], traj))
+}
+
+/// The experiment's render of one frame: many frames, so a hardware GPU,
+/// else the CPU twin (see `Backend::Bulk`); `seed` seeds the sampling.
+pub(crate) fn bulk_job(
+    cam: Camera,
+    exposure_s: f64,
+    traj: &Trajectory,
+    target: &Target,
+    quality: Quality,
+    seed: u32,
+) -> RenderJob {
+    let mut job = RenderJob::new(cam, exposure_s, traj.clone(), target.clone());
+    job.quality = quality;
+    job.backend = Backend::Bulk;
+    job.seed = seed;
+    job
+}
+
 /// Renders and measures one frame.
 pub fn render_and_measure(
     cfg: &ExperimentConfig,
@@ -206,22 +246,9 @@ pub fn render_and_measure(
     quality: Quality,
     seed: u32,
 ) -> Result<Rendered> {
-    let i = walk
-        .samples
-        .partition_point(|s| s.t < frame.exposure_start)
-        .min(walk.samples.len() - 1);
-    let distance = walk.distance[i];
-    let use_velocity = walk.samples[i].velocity.is_some();
-    // A rolling shutter exposes each line over its own window: the motion
-    // spans the readout plus the exposure.
     let rolling = cam.shutter.readout_s;
     let exposure = frame.exposure_s();
-    let traj = Trajectory::from_imu_log(
-        &walk.samples,
-        frame.exposure_start,
-        exposure + rolling,
-        use_velocity,
-    )?;
+    let (distance, traj) = frame_motion(walk, frame, rolling)?;
     // Exposure control raised the gain: the system gain K scales with it
     // (the same DN from fewer electrons).
     let mut cam = cam;
@@ -231,11 +258,7 @@ pub fn render_and_measure(
         }
     }
     let target = Target::parse(&cfg.target, distance)?;
-    let mut job = RenderJob::new(cam, exposure, traj.clone(), target.clone());
-    job.quality = quality;
-    // Many frames: a hardware GPU, else the CPU twin (see `Backend::Bulk`).
-    job.backend = Backend::Bulk;
-    job.seed = seed;
+    let job = bulk_job(cam, exposure, &traj, &target, quality, seed);
     let t0 = Instant::now();
     let out = render::render_frame(&job)?;
     let render_ms = t0.elapsed().as_secs_f64() * 1e3;
