@@ -21,6 +21,38 @@ use rand::{Rng, SeedableRng};
 
 /// Block length, s.
 pub const BLOCK_S: f64 = 2.0;
+
+/// A walk cut into [`BLOCK_S`]-second blocks from its first sample to its
+/// last (the last block may be shorter; a walk has at least one).
+pub(crate) struct WalkBlocks {
+    /// The walk's first sample time, s.
+    t0: f64,
+    /// Each block's length, s.
+    pub seconds: Vec<f64>,
+}
+
+impl WalkBlocks {
+    /// The blocks of `w`.
+    pub(crate) fn of(w: &Walk) -> Self {
+        let (t0, t1) = (
+            w.samples.first().map_or(0.0, |s| s.t),
+            w.samples.last().map_or(0.0, |s| s.t),
+        );
+        let n = (((t1 - t0) / BLOCK_S).ceil() as usize).max(1);
+        let seconds = (0..n)
+            .map(|b| {
+                let a = t0 + b as f64 * BLOCK_S;
+                (t1.min(a + BLOCK_S) - a).max(0.0)
+            })
+            .collect();
+        WalkBlocks { t0, seconds }
+    }
+
+    /// The block that time `t` (s) falls in (times past the end: the last).
+    pub(crate) fn index(&self, t: f64) -> usize {
+        (((t - self.t0) / BLOCK_S) as usize).min(self.seconds.len() - 1)
+    }
+}
 /// Bootstrap resamples.
 pub const RESAMPLES: usize = 2000;
 /// Seed of the bootstrap's random numbers.
@@ -109,16 +141,11 @@ pub fn headlines(
         let ws: Vec<&Walk> = walks.iter().filter(|w| w.gait == gait).collect();
         let mut blocks = Vec::new();
         for w in &ws {
-            let (t0, t1) = (
-                w.samples.first().map_or(0.0, |s| s.t),
-                w.samples.last().map_or(0.0, |s| s.t),
-            );
-            let n = (((t1 - t0) / BLOCK_S).ceil() as usize).max(1);
+            let wb = WalkBlocks::of(w);
             let first = blocks.len();
-            for b in 0..n {
-                let a = t0 + b as f64 * BLOCK_S;
+            for &seconds in &wb.seconds {
                 blocks.push(Block {
-                    seconds: (t1.min(a + BLOCK_S) - a).max(0.0),
+                    seconds,
                     per_policy: vec![(0.0, 0.0, 0.0); policies.len()],
                 });
             }
@@ -132,7 +159,7 @@ pub fn headlines(
                 if !r.frame.kept {
                     continue;
                 }
-                let b = (((r.frame.trigger_t - t0) / BLOCK_S) as usize).min(n - 1);
+                let b = wb.index(r.frame.trigger_t);
                 let c = &mut blocks[first + b].per_policy[pi];
                 c.0 += f64::from(u8::from(m.blobs_ok));
                 c.1 += m.blur_px;

@@ -5,7 +5,7 @@
 //! the best fixed exposure in hindsight (`oracle`, over the grid), against
 //! auto-exposure and against the thesis's fixed rate, each ratio paired over
 //! the 2-s blocks of the walks with a 95 % percentile bootstrap over the
-//! blocks of all seeds (the headline's [`BLOCK_S`], [`RESAMPLES`] and
+//! blocks of all seeds (the headline's [`BLOCK_S`](super::benefit::BLOCK_S), [`RESAMPLES`] and
 //! [`BOOTSTRAP_SEED`]).
 //!
 //! The trigger times and exposures do not depend on the light (the
@@ -15,7 +15,7 @@
 //! ([`super::map_render`]). The best policies of a cell are chosen on all
 //! its blocks (point estimates) and then held fixed in the resamples.
 
-use super::benefit::{Estimate, BLOCK_S, BOOTSTRAP_SEED, RESAMPLES};
+use super::benefit::{Estimate, WalkBlocks, BOOTSTRAP_SEED, RESAMPLES};
 use super::config::ExperimentConfig;
 use super::map_render::{blobs_at_lights, Light};
 use super::walk::{make_walk, Walk};
@@ -213,16 +213,11 @@ pub fn benefit_map(
             // Per light and policy: frames, sharp, exposure sum, capped.
             let mut tally = vec![(0usize, 0usize, 0.0f64, 0usize); nl * np];
             for (_, w) in walks.iter().filter(|(wg, _)| *wg == gi) {
-                let (t0, t1) = (
-                    w.samples.first().map_or(0.0, |s| s.t),
-                    w.samples.last().map_or(0.0, |s| s.t),
-                );
-                let n = (((t1 - t0) / BLOCK_S).ceil() as usize).max(1);
+                let wb = WalkBlocks::of(w);
                 let first = blocks.len();
-                for b in 0..n {
-                    let a = t0 + b as f64 * BLOCK_S;
+                for &seconds in &wb.seconds {
                     blocks.push(Block {
-                        seconds: (t1.min(a + BLOCK_S) - a).max(0.0),
+                        seconds,
                         sharp: vec![0.0; nl * np],
                     });
                 }
@@ -233,7 +228,7 @@ pub fn benefit_map(
                             blobs_at_lights(board, w, f, cam, quality, renders as u32, &lights)?;
                         renders += 1;
                         bar.advance(1);
-                        let b = (((f.trigger_t - t0) / BLOCK_S) as usize).min(n - 1);
+                        let b = wb.index(f.trigger_t);
                         for (li, &sharp) in ok.iter().enumerate() {
                             let k = li * np + pi;
                             blocks[first + b].sharp[k] += f64::from(u8::from(sharp));
