@@ -200,9 +200,17 @@ pub fn check_ext(p: &Path, allowed: &[&str], what: &str) -> Result<String> {
     }
 }
 
-/// The trigger timing options besides the exposure (`trigger`, `live`).
+/// The trigger timing options (`trigger`, `live`).
 #[derive(Args, Debug, Clone)]
 pub struct TimingArgs {
+    /// Exposure t_e, s (thesis: 0.05, 0.07).
+    #[arg(
+        allow_negative_numbers = true,
+        long,
+        value_name = "S",
+        default_value_t = CameraTiming::DEFAULT_EXPOSURE_S
+    )]
+    pub exposure: f64,
     /// Trigger delay t_d, s.
     #[arg(
         allow_negative_numbers = true,
@@ -230,12 +238,12 @@ pub struct TimingArgs {
 }
 
 impl TimingArgs {
-    /// The camera timing with exposure `exposure` (s); the pixel pitch is
-    /// the default until a [`mmbm::trigger::Session`] takes the camera's.
-    pub fn timing(&self, exposure: f64) -> CameraTiming {
+    /// The camera timing; the pixel pitch is the default until a
+    /// [`mmbm::trigger::Session`] takes the camera's.
+    pub fn timing(&self) -> CameraTiming {
         CameraTiming {
             delay: self.delay,
-            exposure,
+            exposure: self.exposure,
             readout: self.readout,
             min_interval: self.min_interval,
             ..CameraTiming::default()

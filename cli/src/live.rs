@@ -38,14 +38,6 @@ pub struct LiveArgs {
     /// Policy (repeat for several; each line's `policy` is the string given).
     #[arg(long, required = true)]
     pub policy: Vec<PolicySpec>,
-    /// Exposure t_e, s.
-    #[arg(
-        allow_negative_numbers = true,
-        long,
-        value_name = "S",
-        default_value_t = mmbm::trigger::CameraTiming::DEFAULT_EXPOSURE_S
-    )]
-    pub exposure: f64,
     #[command(flatten)]
     pub timing: TimingArgs,
     /// CPU metric: riemann[:NUxNV], gauss[:N] or exact[:TOL].
@@ -110,7 +102,7 @@ pub fn run(a: LiveArgs, control: &StreamControl) -> Result<i32> {
         SessionConfig {
             camera: a.camera.camera()?,
             plane: a.scene.plane()?,
-            timing: a.timing.timing(a.exposure),
+            timing: a.timing.timing(),
             method: a.method,
             use_velocity: a.use_velocity,
             policies: a.policy.clone(),

@@ -39,14 +39,6 @@ pub struct TriggerArgs {
     /// Policy (repeat for several; each row's `policy` column is the string given).
     #[arg(long, required = true)]
     pub policy: Vec<PolicySpec>,
-    /// Exposure t_e, s (thesis: 0.05, 0.07).
-    #[arg(
-        allow_negative_numbers = true,
-        long,
-        value_name = "S",
-        default_value_t = mmbm::trigger::CameraTiming::DEFAULT_EXPOSURE_S
-    )]
-    pub exposure: f64,
     #[command(flatten)]
     pub timing: TimingArgs,
     /// Output CSV of frames (default: stdout, unless --summary).
@@ -120,7 +112,7 @@ pub fn run(a: TriggerArgs) -> Result<()> {
         SessionConfig {
             camera,
             plane: a.scene.plane()?,
-            timing: a.timing.timing(a.exposure),
+            timing: a.timing.timing(),
             method: a.method,
             use_velocity: a.use_velocity,
             policies: a.policy.clone(),
