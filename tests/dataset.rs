@@ -4,6 +4,8 @@
 
 mod common;
 
+use common::tree;
+
 use common::mmbm_in;
 use mmbm::dataset::item::{make, FILES};
 use mmbm::dataset::{self, DatasetConfig, ManifestLine, Shard, Sources};
@@ -26,24 +28,6 @@ fn small(count: u64) -> DatasetConfig {
         resolution: [48, 36],
         ..DatasetConfig::default()
     }
-}
-
-/// Every file under `dir` (relative path -> bytes).
-fn tree(dir: &Path) -> BTreeMap<String, Vec<u8>> {
-    let mut out = BTreeMap::new();
-    let mut stack = vec![dir.to_path_buf()];
-    while let Some(d) = stack.pop() {
-        for e in std::fs::read_dir(&d).unwrap() {
-            let p = e.unwrap().path();
-            if p.is_dir() {
-                stack.push(p);
-            } else {
-                let rel = p.strip_prefix(dir).unwrap().to_string_lossy().into_owned();
-                out.insert(rel, std::fs::read(&p).unwrap());
-            }
-        }
-    }
-    out
 }
 
 fn items_and_manifest(dir: &Path) -> BTreeMap<String, Vec<u8>> {

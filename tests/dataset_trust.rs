@@ -6,28 +6,11 @@
 
 mod common;
 
+use common::tree;
+
 use common::mmbm_in;
 use mmbm::dataset::{self, DatasetConfig, Shard, Sources};
-use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-
-/// Every file under `dir` (relative path -> bytes).
-fn tree(dir: &Path) -> BTreeMap<String, Vec<u8>> {
-    let mut out = BTreeMap::new();
-    let mut stack = vec![dir.to_path_buf()];
-    while let Some(d) = stack.pop() {
-        for e in std::fs::read_dir(&d).unwrap() {
-            let p = e.unwrap().path();
-            if p.is_dir() {
-                stack.push(p);
-            } else {
-                let rel = p.strip_prefix(dir).unwrap().to_string_lossy().into_owned();
-                out.insert(rel, std::fs::read(&p).unwrap());
-            }
-        }
-    }
-    out
-}
 
 /// A config of tiny items (quick to make), `count` of them, seed `seed`.
 fn tiny(count: u64, seed: u64) -> DatasetConfig {
