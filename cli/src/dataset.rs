@@ -22,11 +22,20 @@ SLURM_ARRAY_TASK_COUNT, SLURM_ARRAY_TASK_MIN) or a Kubernetes Indexed Job
 (JOB_COMPLETION_INDEX, with --shard-count N) picks the shard; otherwise the whole set is made
 and DIR/manifest.jsonl written. --merge joins the parts into DIR/manifest.jsonl.
 
+WebDataset: --format webdataset also packs the verified set into DIR/webdataset/mmbm-NNNNNN.tar
+(at most --shard-bytes each, ~1 GB by default; one sample per item, its members keyed by the
+8-digit index: KEY.json, KEY.blurred.exr, KEY.blurred.png, KEY.sharp.exr, KEY.sharp.png,
+KEY.flow.exr, KEY.maps.exr) and DIR/webdataset/index.json (each shard's items, size, SHA-256).
+The tar bytes depend only on the items, so a sharded run packed at --merge gives the same tars as
+a single run; a rerun keeps complete shards.
+
 Examples:
   mmbm dataset --print-config > ds.toml
   mmbm dataset --config ds.toml --out data/
   mmbm dataset --config ds.toml --out data/ --shard 2/8
   mmbm dataset --merge --out data/ && mmbm dataset --verify --out data/
+  mmbm dataset --config ds.toml --out data/ --format webdataset
+  mmbm dataset --merge --format webdataset --out data/   (after a sharded run)
   sbatch --array=1-8 examples/dataset.sbatch     (see examples/dataset-job.yaml for Kubernetes)"
 )]
 pub struct DatasetArgs {
@@ -52,9 +61,43 @@ pub struct DatasetArgs {
     /// Print the default configuration as TOML and exit.
     #[arg(long)]
     pub print_config: bool,
+    /// Output form: `folder` (DIR/items/NNNNNNNN/) or `webdataset` (also the folder packed into
+    /// DIR/webdataset/mmbm-NNNNNN.tar shards; a sharded run packs at --merge).
+    #[arg(long, value_enum, default_value_t = Format::Folder)]
+    pub format: Format,
+    /// Most bytes per WebDataset tar shard (with --format webdataset).
+    #[arg(long, value_name = "BYTES", default_value_t = dataset::DEFAULT_SHARD_BYTES)]
+    pub shard_bytes: u64,
     /// No progress bar.
     #[arg(long)]
     pub quiet: bool,
+}
+
+/// `--format`.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Format {
+    /// Item folders only.
+    Folder,
+    /// Item folders and WebDataset tar shards.
+    Webdataset,
+}
+
+/// Packs `out` into tar shards when `--format webdataset`.
+fn pack(a: &DatasetArgs, out: &std::path::Path) -> Result<()> {
+    if a.format != Format::Webdataset {
+        return Ok(());
+    }
+    let p = dataset::pack(out, a.shard_bytes, !a.quiet)?;
+    eprintln!(
+        "packed {} items into {} WebDataset shard(s) ({} written, {} kept; {:.1} MB) in {}",
+        p.items,
+        p.shards,
+        p.written,
+        p.shards - p.written,
+        p.bytes as f64 / 1e6,
+        out.join("webdataset").display()
+    );
+    Ok(())
 }
 
 /// The shard from `--shard`, else from a scheduler's environment, else all.
@@ -120,7 +163,7 @@ pub fn run(a: DatasetArgs) -> Result<()> {
             "merged {n} items into {}",
             out.join("manifest.jsonl").display()
         );
-        return Ok(());
+        return pack(&a, &out);
     }
     if a.verify {
         let n = dataset::verify(&out)?;
@@ -128,6 +171,12 @@ pub fn run(a: DatasetArgs) -> Result<()> {
             "{}: {n} items, every file present and matching",
             out.display()
         );
+        if let Some(k) = dataset::verify_tars(&out)? {
+            eprintln!(
+                "{}: {k} WebDataset shard(s), each matching its index",
+                out.display()
+            );
+        }
         return Ok(());
     }
     let cfg = match &a.config {
@@ -147,5 +196,15 @@ pub fn run(a: DatasetArgs) -> Result<()> {
         if s.seconds > 0.0 { s.made as f64 / s.seconds * 60.0 } else { 0.0 },
         out.join(sh.manifest_name()).display()
     );
-    Ok(())
+    if sh.n > 1 {
+        if a.format == Format::Webdataset {
+            eprintln!(
+                "WebDataset shards are packed from the whole set: when every shard is done, run \
+                 mmbm dataset --merge --format webdataset --out {}",
+                out.display()
+            );
+        }
+        return Ok(());
+    }
+    pack(&a, &out)
 }

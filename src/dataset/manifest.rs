@@ -75,7 +75,7 @@ pub(crate) fn write_manifest(path: &Path, lines: &[ManifestLine]) -> Result<()> 
 /// Calls `f` with each line (1-based number, parsed) of the manifest
 /// `path`, blank lines skipped; more than `max` lines, or one longer than
 /// [`MAX_LINE_BYTES`], is an error. Returns the number of lines.
-fn each_line(
+pub(crate) fn each_line(
     path: &Path,
     max: u64,
     mut f: impl FnMut(u64, ManifestLine) -> Result<()>,

@@ -13,6 +13,8 @@
 //!   its manifest (which is input: every path it names is confined).
 //! - `guard`: the configuration's fingerprint (`DIR/dataset.json`) and the
 //!   lock that keeps each shard to one writer.
+//! - `webdataset`: the directory packed into WebDataset tar shards
+//!   (`--format webdataset`).
 
 pub(crate) mod config;
 pub(crate) mod guard;
@@ -20,6 +22,7 @@ pub mod item;
 pub(crate) mod manifest;
 pub(crate) mod run;
 pub(crate) mod shard;
+pub(crate) mod webdataset;
 
 pub use config::DatasetConfig;
 pub use guard::{Record, RunLock};
@@ -27,3 +30,6 @@ pub use item::{ItemParams, Sources};
 pub use manifest::{merge, verify, ManifestLine};
 pub use run::{run, RunSummary};
 pub use shard::{Shard, MAX_SHARDS};
+pub use webdataset::{
+    pack, verify_tars, PackSummary, TarIndex, TarShard, DEFAULT_SHARD_BYTES, MIN_SHARD_BYTES,
+};

@@ -1,0 +1,475 @@
+//! WebDataset output: a verified dataset directory packed into tar shards
+//! that stream (the `webdataset` Python package, the Hugging Face hub's
+//! WebDataset loader).
+//!
+//! Layout of `DIR/webdataset/`: `mmbm-000000.tar`, `mmbm-000001.tar`, ...
+//! and `index.json` (the fingerprint, the shard size and per shard its
+//! first item, item count, bytes and SHA-256). One sample is one item: its
+//! members share the key `NNNNNNNN` (the item index, 8 digits) and are
+//! `KEY.json` (the item's manifest line, `item.json`) then the item files
+//! (`KEY.blurred.exr`, `KEY.blurred.png`, `KEY.sharp.exr`, `KEY.sharp.png`,
+//! `KEY.flow.exr`, `KEY.maps.exr`), the WebDataset convention (the key is
+//! the name up to its first dot). Items go in index order; a shard is
+//! closed before the item that would take it past the shard size (an item
+//! larger than that gets a shard of its own).
+//!
+//! Deterministic: the tar headers carry no time, owner or host (mtime 0,
+//! uid/gid 0, mode 0444, ustar), so the same dataset gives the same bytes,
+//! and since a sharded run's directory equals a single run's, so do its
+//! tar shards. Trust nothing: the directory is verified against its
+//! manifest first (`manifest::verify`), and each file's bytes are hashed
+//! again as they are packed. Resumable: each tar is written under a
+//! temporary name and renamed, `index.json` is rewritten after each shard,
+//! and a rerun keeps a shard whose file still has the listed size and
+//! SHA-256.
+
+use super::guard::{read_json_file, Record};
+use super::item::FILES;
+use super::manifest::{each_line, item_dir, verify, ManifestLine};
+use crate::error::{show_path, Error, Result};
+use crate::io::atomic::write_atomic;
+use serde::{Deserialize, Serialize};
+use sha2::{Digest, Sha256};
+use std::io::{Read, Write};
+use std::path::{Path, PathBuf};
+
+/// Default shard size, bytes (about 1 GB, WebDataset's usual size).
+pub const DEFAULT_SHARD_BYTES: u64 = 1_000_000_000;
+/// The smallest shard size accepted, bytes.
+pub const MIN_SHARD_BYTES: u64 = 1 << 16;
+/// The folder, under the dataset directory.
+pub const FOLDER: &str = "webdataset";
+/// The `format` of `index.json`.
+const INDEX_FORMAT: &str = "mmbm-webdataset-1";
+/// Tar block, bytes.
+const BLOCK: u64 = 512;
+
+/// One tar shard, as `index.json` lists it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TarShard {
+    /// File name in `DIR/webdataset/`.
+    pub name: String,
+    /// Index of its first item.
+    pub first: u64,
+    /// Items in it (consecutive indices).
+    pub items: u64,
+    /// File size, bytes.
+    pub bytes: u64,
+    /// SHA-256 of the file, hex.
+    pub sha256: String,
+}
+
+/// `DIR/webdataset/index.json`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TarIndex {
+    /// `mmbm-webdataset-1`.
+    pub format: String,
+    /// The dataset's fingerprint (`dataset.json`).
+    pub fingerprint: String,
+    /// The shard size the shards were cut at, bytes.
+    pub shard_bytes: u64,
+    /// Items in the dataset.
+    pub count: u64,
+    /// The shards made so far, in order.
+    pub shards: Vec<TarShard>,
+    /// True once every item is in a shard.
+    pub complete: bool,
+}
+
+/// What [`pack`] did.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PackSummary {
+    /// Tar shards of the dataset.
+    pub shards: usize,
+    /// Of which written now (the rest were complete and kept).
+    pub written: usize,
+    /// Items packed.
+    pub items: u64,
+    /// Bytes of all the shards.
+    pub bytes: u64,
+}
+
+/// The tar member name of item file `file` (e.g. `blurred.exr`) of item `i`.
+pub fn member_name(i: u64, file: &str) -> String {
+    format!("{i:08}.{file}")
+}
+
+/// The name of tar shard `s` (0-based).
+pub fn shard_name(s: usize) -> String {
+    format!("mmbm-{s:06}.tar")
+}
+
+/// Bytes a member of `n` bytes takes in a tar (header and padding).
+fn member_bytes(n: u64) -> u64 {
+    BLOCK + n.div_ceil(BLOCK) * BLOCK
+}
+
+/// The item's members: `KEY.json` (from `item.json`) then [`FILES`], each
+/// with its path in `DIR` and its expected size and SHA-256 (`None` for
+/// `item.json`, checked by `verify` against the line).
+fn members(out: &Path, l: &ManifestLine) -> Result<Vec<(String, PathBuf, Option<(u64, String)>)>> {
+    let dir = out.join(item_dir(l.index));
+    let mut m = vec![(member_name(l.index, "json"), dir.join("item.json"), None)];
+    for f in FILES {
+        let sum = l.files.get(f).ok_or_else(|| {
+            Error::invalid(
+                show_path(&out.join("manifest.jsonl")),
+                format!("item {} lists no {f}", l.index),
+            )
+        })?;
+        m.push((
+            member_name(l.index, f),
+            dir.join(f),
+            Some((sum.bytes, sum.sha256.clone())),
+        ));
+    }
+    Ok(m)
+}
+
+/// Cuts the items into shards of at most `shard_bytes` (an item larger
+/// than that alone); returns per shard (first item, items).
+fn plan(sizes: &[(u64, u64)], shard_bytes: u64) -> Vec<(u64, u64)> {
+    let mut out = Vec::new();
+    let (mut first, mut n, mut bytes) = (0u64, 0u64, 0u64);
+    for &(i, b) in sizes {
+        if n > 0 && bytes + b > shard_bytes.saturating_sub(2 * BLOCK) {
+            out.push((first, n));
+            (n, bytes) = (0, 0);
+        }
+        if n == 0 {
+            first = i;
+        }
+        n += 1;
+        bytes += b;
+    }
+    if n > 0 {
+        out.push((first, n));
+    }
+    out
+}
+
+/// A header with nothing of the machine or the time in it.
+fn header(name: &str, size: u64) -> Result<tar::Header> {
+    let mut h = tar::Header::new_ustar();
+    h.set_path(name)
+        .map_err(|e| Error::invalid("webdataset", format!("member name {name}: {e}")))?;
+    h.set_size(size);
+    h.set_mode(0o444);
+    h.set_mtime(0);
+    h.set_uid(0);
+    h.set_gid(0);
+    h.set_entry_type(tar::EntryType::Regular);
+    h.set_cksum();
+    Ok(h)
+}
+
+/// Reads file `p` whole (its size first checked against `want`), checking
+/// its SHA-256.
+fn read_checked(p: &Path, want: Option<&(u64, String)>) -> Result<Vec<u8>> {
+    let cap = want.map_or(crate::io::input::MAX_TEXT_BYTES, |w| w.0);
+    let mut buf = Vec::new();
+    crate::io::input::open_file(p)?
+        .take(cap + 1)
+        .read_to_end(&mut buf)
+        .map_err(|e| Error::io(p, e))?;
+    if let Some((bytes, sha)) = want {
+        let got = format!("{:x}", Sha256::digest(&buf));
+        if buf.len() as u64 != *bytes || got != *sha {
+            return Err(Error::invalid(
+                show_path(p),
+                format!(
+                    "changed since the manifest was checked ({} bytes, SHA-256 {}, where the manifest \
+                     lists {bytes} bytes, {}): run --verify",
+                    buf.len(),
+                    &got[..12],
+                    &sha[..sha.len().min(12)]
+                ),
+            ));
+        }
+    } else if buf.len() as u64 > cap {
+        return Err(Error::invalid(
+            show_path(p),
+            format!("longer than {cap} bytes, the most read"),
+        ));
+    }
+    Ok(buf)
+}
+
+/// Writes the tar shard of `lines` to `path` (atomically); returns its size
+/// and SHA-256.
+fn write_shard(out: &Path, lines: &[ManifestLine], path: &Path) -> Result<(u64, String)> {
+    struct Hashing<'a> {
+        w: &'a mut dyn Write,
+        h: Sha256,
+        n: u64,
+    }
+    impl Write for Hashing<'_> {
+        fn write(&mut self, b: &[u8]) -> std::io::Result<usize> {
+            let k = self.w.write(b)?;
+            self.h.update(&b[..k]);
+            self.n += k as u64;
+            Ok(k)
+        }
+        fn flush(&mut self) -> std::io::Result<()> {
+            self.w.flush()
+        }
+    }
+    let mut sum = (0, String::new());
+    write_atomic(path, |w| {
+        let mut hw = Hashing {
+            w,
+            h: Sha256::new(),
+            n: 0,
+        };
+        {
+            let mut b = tar::Builder::new(&mut hw);
+            for l in lines {
+                crate::cancel::check()?;
+                for (name, file, want) in members(out, l)? {
+                    let data = read_checked(&file, want.as_ref())?;
+                    let mut h = header(&name, data.len() as u64)?;
+                    b.append_data(&mut h, &name, data.as_slice())
+                        .map_err(|e| Error::io(path, e))?;
+                }
+            }
+            b.finish().map_err(|e| Error::io(path, e))?;
+        }
+        sum = (hw.n, format!("{:x}", hw.h.finalize()));
+        Ok(())
+    })?;
+    Ok(sum)
+}
+
+/// Size and SHA-256 of an existing shard file, `None` when there is none.
+fn existing(path: &Path) -> Result<Option<(u64, String)>> {
+    if !path.is_file() {
+        return Ok(None);
+    }
+    let mut f = crate::io::input::open_file(path)?;
+    super::guard::sha256_of(&mut f, path).map(Some)
+}
+
+/// Reads `index.json` if it exists and is for this dataset and shard size.
+fn previous(index: &Path, rec: &Record, shard_bytes: u64) -> Result<Option<TarIndex>> {
+    if !index.exists() {
+        return Ok(None);
+    }
+    let text = read_json_file(index)?;
+    let ix: TarIndex = serde_json::from_str(&text).map_err(|e| Error::Config {
+        path: index.into(),
+        message: crate::error::clip(&e.to_string(), crate::error::MAX_MESSAGE),
+    })?;
+    if ix.format != INDEX_FORMAT || ix.fingerprint != rec.fingerprint {
+        return Err(Error::invalid(
+            show_path(index),
+            format!(
+                "made from another dataset (format {}, fingerprint {}): remove {} first",
+                ix.format,
+                super::guard::short(&ix.fingerprint),
+                show_path(index.parent().unwrap_or(index))
+            ),
+        ));
+    }
+    Ok((ix.shard_bytes == shard_bytes).then_some(ix))
+}
+
+/// Packs the dataset directory `out` (complete and merged: it is verified
+/// first) into WebDataset tar shards of at most `shard_bytes` in
+/// `out/webdataset/`, keeping shards a previous run completed.
+pub fn pack(out: &Path, shard_bytes: u64, progress: bool) -> Result<PackSummary> {
+    if shard_bytes < MIN_SHARD_BYTES {
+        return Err(Error::invalid(
+            "--shard-bytes",
+            format!("{shard_bytes}: at least {MIN_SHARD_BYTES} bytes"),
+        ));
+    }
+    let n_items = verify(out)?;
+    let rec = Record::read(out)?;
+    let mut lines = Vec::with_capacity(n_items);
+    each_line(&out.join("manifest.jsonl"), rec.count, |_, l| {
+        lines.push(l);
+        Ok(())
+    })?;
+    let mut sizes = Vec::with_capacity(lines.len());
+    for l in &lines {
+        let json = out.join(item_dir(l.index)).join("item.json");
+        let json_bytes = std::fs::metadata(&json)
+            .map_err(|e| Error::io(&json, e))?
+            .len();
+        let b =
+            member_bytes(json_bytes) + l.files.values().map(|f| member_bytes(f.bytes)).sum::<u64>();
+        sizes.push((l.index, b));
+    }
+    let cuts = plan(&sizes, shard_bytes);
+    let dir = out.join(FOLDER);
+    std::fs::create_dir_all(&dir).map_err(|e| Error::io(&dir, e))?;
+    let index_path = dir.join("index.json");
+    let before = previous(&index_path, &rec, shard_bytes)?;
+    let mut ix = TarIndex {
+        format: INDEX_FORMAT.into(),
+        fingerprint: rec.fingerprint.clone(),
+        shard_bytes,
+        count: rec.count,
+        shards: Vec::new(),
+        complete: false,
+    };
+    let bar = crate::diagnostics::progress(progress, "shards", cuts.len() as u64);
+    let (mut written, mut total) = (0, 0);
+    let mut at = 0usize;
+    for (s, &(first, n)) in cuts.iter().enumerate() {
+        let name = shard_name(s);
+        let path = dir.join(&name);
+        let listed = before
+            .as_ref()
+            .and_then(|b| b.shards.iter().find(|t| t.name == name))
+            .filter(|t| t.first == first && t.items == n);
+        let kept = match listed {
+            Some(t) => existing(&path)?
+                .filter(|(b, sha)| *b == t.bytes && *sha == t.sha256)
+                .map(|_| t.clone()),
+            None => None,
+        };
+        let entry = match kept {
+            Some(t) => t,
+            None => {
+                let (bytes, sha256) = write_shard(out, &lines[at..at + n as usize], &path)?;
+                written += 1;
+                TarShard {
+                    name,
+                    first,
+                    items: n,
+                    bytes,
+                    sha256,
+                }
+            }
+        };
+        at += n as usize;
+        total += entry.bytes;
+        ix.shards.push(entry);
+        ix.complete = s + 1 == cuts.len();
+        write_index(&index_path, &ix)?;
+        bar.advance(1);
+    }
+    drop(bar);
+    // Shards of an earlier, longer plan are not this dataset's.
+    for s in cuts.len().. {
+        let p = dir.join(shard_name(s));
+        if !p.exists() {
+            break;
+        }
+        std::fs::remove_file(&p).map_err(|e| Error::io(&p, e))?;
+    }
+    Ok(PackSummary {
+        shards: cuts.len(),
+        written,
+        items: lines.len() as u64,
+        bytes: total,
+    })
+}
+
+/// Checks `out/webdataset/` against its `index.json` (each listed shard
+/// present with its size and SHA-256, the index for this dataset and
+/// complete); returns the number of shards, `None` when there is no index.
+pub fn verify_tars(out: &Path) -> Result<Option<usize>> {
+    let index = out.join(FOLDER).join("index.json");
+    if !index.exists() {
+        return Ok(None);
+    }
+    let rec = Record::read(out)?;
+    let text = read_json_file(&index)?;
+    let ix: TarIndex = serde_json::from_str(&text).map_err(|e| Error::Config {
+        path: index.clone(),
+        message: crate::error::clip(&e.to_string(), crate::error::MAX_MESSAGE),
+    })?;
+    let bad = |m: String| Err(Error::invalid(show_path(&index), m));
+    if ix.format != INDEX_FORMAT || ix.fingerprint != rec.fingerprint {
+        return bad(format!(
+            "made from another dataset (fingerprint {})",
+            super::guard::short(&ix.fingerprint)
+        ));
+    }
+    if !ix.complete {
+        return bad(
+            "incomplete (a packing run was stopped): rerun with --format webdataset".into(),
+        );
+    }
+    let mut next = 0u64;
+    for (s, t) in ix.shards.iter().enumerate() {
+        if t.name != shard_name(s) || t.first != next || t.items == 0 {
+            return bad(format!(
+                "shard {s} listed as {} from item {}",
+                t.name, t.first
+            ));
+        }
+        next += t.items;
+        let p = out.join(FOLDER).join(&t.name);
+        match existing(&p)? {
+            Some((b, sha)) if b == t.bytes && sha == t.sha256 => {}
+            Some((b, sha)) => {
+                return bad(format!(
+                    "{}: {b} bytes, SHA-256 {}, where the index lists {} bytes, {}",
+                    t.name,
+                    &sha[..12],
+                    t.bytes,
+                    super::guard::short(&t.sha256)
+                ))
+            }
+            None => return bad(format!("{} is missing", t.name)),
+        }
+    }
+    if next != rec.count {
+        return bad(format!(
+            "the shards hold {next} items where the dataset has {}",
+            rec.count
+        ));
+    }
+    Ok(Some(ix.shards.len()))
+}
+
+fn write_index(path: &Path, ix: &TarIndex) -> Result<()> {
+    let text = serde_json::to_string_pretty(ix)
+        .map_err(|e| Error::invalid("webdataset index", e.to_string()))?;
+    write_atomic(path, |w| {
+        writeln!(w, "{text}").map_err(|e| Error::io(path, e))
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn plan_cuts_before_the_item_that_overflows() {
+        let sizes: Vec<(u64, u64)> = (0..5).map(|i| (i, 400)).collect();
+        // The archive's two closing blocks (1024 bytes) count.
+        assert_eq!(plan(&sizes, 1024 + 1200), vec![(0, 3), (3, 2)]);
+        assert_eq!(plan(&sizes, 1024 + 1199), vec![(0, 2), (2, 2), (4, 1)]);
+        assert_eq!(plan(&sizes, 1 << 20), vec![(0, 5)]);
+        // An item larger than the shard size gets a shard of its own.
+        assert_eq!(
+            plan(&[(0, 10), (1, 5000), (2, 10)], 2000),
+            vec![(0, 1), (1, 1), (2, 1)]
+        );
+        assert!(plan(&[], 2000).is_empty());
+    }
+
+    #[test]
+    fn members_are_padded_to_blocks() {
+        assert_eq!(member_bytes(0), 512);
+        assert_eq!(member_bytes(1), 1024);
+        assert_eq!(member_bytes(512), 1024);
+        assert_eq!(member_bytes(513), 1536);
+    }
+
+    #[test]
+    fn headers_carry_no_machine_or_time() {
+        let h = header("00000001.blurred.png", 77).unwrap();
+        assert_eq!(h.mtime().unwrap(), 0);
+        assert_eq!(h.uid().unwrap(), 0);
+        assert_eq!(h.mode().unwrap(), 0o444);
+        assert_eq!(h.size().unwrap(), 77);
+        assert_eq!(h.path().unwrap().to_str(), Some("00000001.blurred.png"));
+    }
+}
