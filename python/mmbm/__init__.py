@@ -38,6 +38,7 @@ __all__ = [
     "simulate",
     "trigger",
     "read_exr",
+    "BlurDataset",
 ]
 
 PathLike = Union[str, "os.PathLike[str]"]
@@ -365,3 +366,12 @@ def trigger(
 def read_exr(path: PathLike) -> Dict[str, np.ndarray]:
     """Reads a float EXR (mmbm's outputs): ``{channel: (H, W) float32}``."""
     return _mmbm.read_exr(os.fspath(path))
+
+
+def __getattr__(name: str) -> Any:
+    # ``mmbm.BlurDataset`` without importing torch at ``import mmbm``.
+    if name == "BlurDataset":
+        from .dataset import BlurDataset
+
+        return BlurDataset
+    raise AttributeError(f"module 'mmbm' has no attribute {name!r}")

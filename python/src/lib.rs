@@ -5,6 +5,7 @@
 //! become `OSError` (files) or `ValueError` (everything else).
 
 mod camera;
+mod dataset;
 
 use camera::{camera, camera_json};
 use glam::DVec3;
@@ -532,6 +533,7 @@ fn _mmbm(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(simulate, m)?)?;
     m.add_function(wrap_pyfunction!(trigger, m)?)?;
     m.add_function(wrap_pyfunction!(read_exr, m)?)?;
+    m.add_class::<dataset::DatasetMaker>()?;
     // The camera timing's defaults, from their one place in the library.
     m.add("DEFAULT_DELAY_S", CameraTiming::DEFAULT_DELAY_S)?;
     m.add("DEFAULT_EXPOSURE_S", CameraTiming::DEFAULT_EXPOSURE_S)?;

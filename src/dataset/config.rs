@@ -77,14 +77,20 @@ impl DatasetConfig {
     /// file and the key.
     pub fn load(path: &Path) -> Result<Self> {
         let text = crate::io::input::read_text(path)?;
-        let cfg: DatasetConfig = toml::from_str(&text).map_err(|e| {
+        Self::from_toml(&text, &path.display().to_string())
+    }
+
+    /// Parses TOML text (`origin` names it in errors); missing keys take the
+    /// defaults. Relative paths are relative to the working directory.
+    pub fn from_toml(text: &str, origin: &str) -> Result<Self> {
+        let cfg: DatasetConfig = toml::from_str(text).map_err(|e| {
             Error::invalid(
-                path.display().to_string(),
+                origin,
                 crate::error::clip(&e.to_string(), crate::error::MAX_MESSAGE),
             )
         })?;
         cfg.validate()
-            .map_err(|e| Error::invalid(path.display().to_string(), e.to_string()))?;
+            .map_err(|e| Error::invalid(origin, e.to_string()))?;
         Ok(cfg)
     }
 

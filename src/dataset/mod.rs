@@ -28,7 +28,7 @@ pub use config::DatasetConfig;
 pub use guard::{Record, RunLock};
 pub use item::{ItemParams, Sources};
 pub use manifest::{merge, verify, ManifestLine};
-pub use run::{run, RunSummary};
+pub use run::{make_item, run, RunSummary};
 pub use shard::{Shard, MAX_SHARDS};
 pub use webdataset::{
     pack, verify_tars, PackSummary, TarIndex, TarShard, DEFAULT_SHARD_BYTES, MIN_SHARD_BYTES,

@@ -59,33 +59,47 @@ fn ensure_item(
     }
     // Registered: an interrupt (SIGINT, SIGTERM, SIGHUP) removes it.
     let _guard = PendingDir::create(&partial)?;
-    let result = (|| {
-        let params = plan(cfg, src, i)?;
-        let measures = make(&params, src, &partial)?;
-        let mut files = BTreeMap::new();
-        for f in FILES {
-            files.insert(f.to_string(), sum_file(&partial.join(f))?);
-        }
-        let line = ManifestLine {
-            index: i,
-            dir: rel.clone(),
-            fingerprint: rec.fingerprint.clone(),
-            params,
-            measures,
-            files,
-        };
-        let text =
-            serde_json::to_string(&line).map_err(|e| Error::invalid("manifest", e.to_string()))?;
-        write_atomic(&partial.join("item.json"), |w| {
-            writeln!(w, "{text}").map_err(|e| Error::io("item.json", e))
-        })?;
+    let result = make_item(cfg, src, rec, i, &partial).and_then(|line| {
         std::fs::rename(&partial, &fin).map_err(|e| Error::io(&fin, e))?;
         Ok(line)
-    })();
+    });
     if result.is_err() {
         let _ = std::fs::remove_dir_all(&partial);
     }
     result
+}
+
+/// Makes item `i` of the dataset into the existing directory `dir`: its
+/// [`FILES`] and `item.json` (its manifest line, which it returns), the
+/// same bytes `run` gives the item (the Python `BlurDataset` makes items
+/// with it).
+pub fn make_item(
+    cfg: &DatasetConfig,
+    src: &Sources,
+    rec: &Record,
+    i: u64,
+    dir: &Path,
+) -> Result<ManifestLine> {
+    let params = plan(cfg, src, i)?;
+    let measures = make(&params, src, dir)?;
+    let mut files = BTreeMap::new();
+    for f in FILES {
+        files.insert(f.to_string(), sum_file(&dir.join(f))?);
+    }
+    let line = ManifestLine {
+        index: i,
+        dir: item_dir(i),
+        fingerprint: rec.fingerprint.clone(),
+        params,
+        measures,
+        files,
+    };
+    let text =
+        serde_json::to_string(&line).map_err(|e| Error::invalid("manifest", e.to_string()))?;
+    write_atomic(&dir.join("item.json"), |w| {
+        writeln!(w, "{text}").map_err(|e| Error::io("item.json", e))
+    })?;
+    Ok(line)
 }
 
 /// What a run did.
