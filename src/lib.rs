@@ -30,6 +30,7 @@
 #![warn(missing_docs)]
 
 pub mod assess;
+pub mod augment;
 pub mod board;
 pub mod bounded;
 pub mod camera;

@@ -19,7 +19,7 @@
 
 pub(crate) mod cpu;
 pub(crate) mod gpu;
-mod homography;
+pub(crate) mod homography;
 pub(crate) mod kernel;
 mod layout;
 pub mod maps;

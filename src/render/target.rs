@@ -140,6 +140,19 @@ impl Target {
         }
     }
 
+    /// An image texture `width_m` wide, fronto-parallel at `distance` m
+    /// (from memory: its `path` is `<array>`).
+    pub fn from_texture(texture: MipTexture, width_m: f64, distance: f64) -> Self {
+        Target {
+            kind: TargetKind::Image {
+                path: PathBuf::from("<array>"),
+                width_m,
+                texture: Arc::new(texture),
+            },
+            ..Self::checker(1.0, distance)
+        }
+    }
+
     /// The thesis blob board (scale 1 or 0.5) at `distance` m.
     pub fn blobs(scale: f64, distance: f64) -> Self {
         Target {
