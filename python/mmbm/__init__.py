@@ -38,6 +38,8 @@ __all__ = [
     "simulate",
     "trigger",
     "read_exr",
+    "augment",
+    "augment_batch",
     "BlurDataset",
 ]
 
@@ -366,6 +368,133 @@ def trigger(
 def read_exr(path: PathLike) -> Dict[str, np.ndarray]:
     """Reads a float EXR (mmbm's outputs): ``{channel: (H, W) float32}``."""
     return _mmbm.read_exr(os.fspath(path))
+
+
+def _srgb_to_linear(x: np.ndarray) -> np.ndarray:
+    return np.where(x <= 0.04045, x / 12.92, ((x + 0.055) / 1.055) ** 2.4)
+
+
+def _linear_to_srgb(x: np.ndarray) -> np.ndarray:
+    x = np.clip(x, 0.0, 1.0)
+    return np.where(x <= 0.0031308, 12.92 * x, 1.055 * x ** (1 / 2.4) - 0.055)
+
+
+def augment(
+    image: ArrayLike,
+    motion: Union[str, Dict[str, Any]] = "shake",
+    exposure: float = 0.03,
+    camera: Optional[Camera] = None,
+    seed: int = 0,
+    centre: bool = False,
+    zoom: float = 1.0,
+    distance: float = 2.0,
+    at: Optional[float] = None,
+    srgb: Optional[bool] = None,
+    quality: str = "default",
+    background: Sequence[float] = (0.0, 0.0, 0.0),
+    use_velocity: bool = True,
+) -> Dict[str, Any]:
+    """Motion blur of ``image`` along a real or simulated camera motion.
+
+    The image is a plane filling the view (``zoom`` times the view's width)
+    ``distance`` m away; the camera moves during ``exposure`` s:
+    ``motion="shake"`` (a walk of a gait drawn from ``seed``, from a start
+    drawn from ``seed``), ``"sim:slow"``, ``"sim:moderate"``, ``"sim:fast"``
+    (a simulated walk), ``{"omega": [wx, wy, wz], "velocity": [vx, vy, vz]}``
+    (a constant twist, rad/s and m/s, camera frame) or a ``read_gyro`` dict
+    with ``at`` (a window of a real log starting at ``at`` s). ``centre``:
+    the reference pose at mid-exposure, so the blur has no net shift.
+    ``camera``: default the thesis focal length and pitch at the image's
+    size (a given camera must have that size; lens distortion is refused).
+
+    ``image``: (H, W, 3) or (H, W); uint8 (sRGB, ``srgb`` default True) or
+    float (linear, ``srgb`` default False). Returns ``{"image"`` (same shape
+    and dtype), ``"maps"`` (``path_px``, ``disp_px``, ``speed_px_s``, (H, W)
+    float32), ``"homographies"`` ((3, 3, 3) float64: image pixel coordinates
+    to the blurred frame's at exposure start, middle and end; pixel
+    coordinates with (0, 0) the top-left corner), ``"motion"`` (what was
+    drawn, e.g. ``sim:moderate@2.7141s``)``}``.
+
+    >>> out = augment(np.zeros((24, 32, 3), np.uint8), motion="sim:fast", exposure=0.02)
+    >>> out["image"].shape, out["homographies"].shape
+    ((24, 32, 3), (3, 3, 3))
+    """
+    a = np.asarray(image)
+    gray = a.ndim == 2
+    if a.ndim not in (2, 3) or (a.ndim == 3 and a.shape[2] != 3):
+        raise ValueError(f"image: (H, W) or (H, W, 3) expected, got shape {a.shape}")
+    u8 = a.dtype == np.uint8
+    if not (u8 or np.issubdtype(a.dtype, np.floating)):
+        raise ValueError(f"image: uint8 or float expected, got {a.dtype}")
+    x = a.astype(np.float64) / (255.0 if u8 else 1.0)
+    if gray:
+        x = np.repeat(x[:, :, None], 3, axis=2)
+    use_srgb = u8 if srgb is None else bool(srgb)
+    if use_srgb:
+        x = _srgb_to_linear(x)
+    omega, velocity, gyro, kind = [0.0] * 3, [0.0] * 3, None, None
+    if isinstance(motion, str):
+        kind = motion
+    elif isinstance(motion, dict) and "t" in motion:
+        kind = "log"
+        gyro = {k: np.asarray(motion[k], dtype=np.float64) for k in ("t", "omega", "velocity") if k in motion}
+    elif isinstance(motion, dict) and "omega" in motion:
+        kind = "twist"
+        omega = [float(v) for v in np.asarray(motion["omega"], dtype=np.float64).ravel()]
+        velocity = [float(v) for v in np.asarray(motion.get("velocity", (0, 0, 0)), dtype=np.float64).ravel()]
+    else:
+        raise ValueError("motion: 'shake', 'sim:GAIT', {'omega': ..., 'velocity': ...} or a read_gyro dict")
+    img, maps, hs, drawn = _mmbm.augment(
+        np.ascontiguousarray(x, dtype=np.float32),
+        kind,
+        omega,
+        velocity,
+        gyro,
+        None if at is None else float(at),
+        float(exposure),
+        None if camera is None else camera._spec(),
+        float(distance),
+        float(zoom),
+        bool(centre),
+        int(seed),
+        quality,
+        [float(v) for v in background],
+        bool(use_velocity),
+    )
+    y = np.asarray(img, dtype=np.float64)
+    if use_srgb:
+        y = _linear_to_srgb(y)
+    if gray:
+        y = y[:, :, 1]
+    if u8:
+        y = np.clip(np.round(y * 255.0), 0, 255).astype(np.uint8)
+    else:
+        y = y.astype(a.dtype)
+    return {"image": y, "maps": maps, "homographies": hs, "motion": drawn}
+
+
+def augment_batch(
+    images: ArrayLike, seeds: Optional[Sequence[int]] = None, **kwargs: Any
+) -> Dict[str, Any]:
+    """``augment`` over a batch ((N, H, W[, 3]) or a list of images), each
+    with its own seed (default ``seed + k`` for image ``k``, ``seed`` from
+    ``kwargs``, default 0): each image its own motion. Returns the same keys
+    with a leading batch axis where the images share a shape (``"motion"``
+    a list), else lists."""
+    imgs = list(images)
+    base = int(kwargs.pop("seed", 0))
+    seeds = [base + k for k in range(len(imgs))] if seeds is None else [int(s) for s in seeds]
+    if len(seeds) != len(imgs):
+        raise ValueError(f"seeds: {len(seeds)} for {len(imgs)} images")
+    outs = [augment(im, seed=s, **kwargs) for im, s in zip(imgs, seeds)]
+    same = len({o["image"].shape for o in outs}) <= 1
+    join = (lambda xs: np.stack(xs)) if same and outs else (lambda xs: xs)
+    return {
+        "image": join([o["image"] for o in outs]),
+        "maps": {k: join([o["maps"][k] for o in outs]) for k in ("path_px", "disp_px", "speed_px_s")} if outs else {},
+        "homographies": join([o["homographies"] for o in outs]),
+        "motion": [o["motion"] for o in outs],
+    }
 
 
 def __getattr__(name: str) -> Any:

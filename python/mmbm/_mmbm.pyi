@@ -70,3 +70,20 @@ class DatasetMaker:
     @property
     def fingerprint(self) -> str: ...
     def make(self, index: int, dir: str) -> str: ...
+def augment(
+    image: F32,
+    motion: str,
+    omega: Sequence[float],
+    velocity: Sequence[float],
+    gyro: Optional[Dict[str, F64]],
+    at: Optional[float],
+    exposure: float,
+    cam: Optional[Dict[str, Any]],
+    distance: float,
+    zoom: float,
+    centre: bool,
+    seed: int,
+    quality: str,
+    background: Sequence[float],
+    use_velocity: bool,
+) -> Tuple[F32, Dict[str, F32], F64, str]: ...

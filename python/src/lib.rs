@@ -4,6 +4,7 @@
 //! library with the GIL released, and returns NumPy arrays. Library errors
 //! become `OSError` (files) or `ValueError` (everything else).
 
+mod augment;
 mod camera;
 mod dataset;
 
@@ -409,7 +410,7 @@ fn render<'py>(
 }
 
 /// Samples from a `{t, omega[, velocity][, depth]}` dict of arrays.
-fn dict_samples(g: &Bound<'_, PyDict>) -> PyResult<Vec<GyroSample>> {
+pub(crate) fn dict_samples(g: &Bound<'_, PyDict>) -> PyResult<Vec<GyroSample>> {
     let get = |k: &str| g.get_item(k);
     let t: Vec<f64> = get("t")?
         .ok_or_else(|| PyValueError::new_err("gyro: missing 't'"))?
@@ -534,6 +535,7 @@ fn _mmbm(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(trigger, m)?)?;
     m.add_function(wrap_pyfunction!(read_exr, m)?)?;
     m.add_class::<dataset::DatasetMaker>()?;
+    m.add_function(wrap_pyfunction!(augment::augment, m)?)?;
     // The camera timing's defaults, from their one place in the library.
     m.add("DEFAULT_DELAY_S", CameraTiming::DEFAULT_DELAY_S)?;
     m.add("DEFAULT_EXPOSURE_S", CameraTiming::DEFAULT_EXPOSURE_S)?;
