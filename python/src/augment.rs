@@ -65,9 +65,11 @@ pub fn augment<'py>(
         }
         s => match s.strip_prefix("sim:") {
             Some(g) => Motion::Gait(g.parse().map_err(err)?),
-            None => return Err(PyValueError::new_err(format!(
+            None => {
+                return Err(PyValueError::new_err(format!(
                 "motion '{s}': expected 'shake', 'sim:slow|moderate|fast', a twist or a gyro log"
-            ))),
+            )))
+            }
         },
     };
     let mut job = Augment::new(m, exposure);
