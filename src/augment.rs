@@ -205,7 +205,7 @@ pub fn augment(w: u32, h: u32, rgb: &[f32], a: &Augment) -> Result<Augmented> {
         ));
     }
     let cam = match &a.camera {
-        Some(c) => c.clone(),
+        Some(c) => *c,
         None => crate::camera::CameraFile::default().thesis_at([w, h]),
     };
     cam.validate()?;

@@ -14,6 +14,14 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
+/// The image, the maps, the homographies and the motion drawn.
+type Out<'py> = (
+    Bound<'py, PyAny>,
+    Bound<'py, PyDict>,
+    Bound<'py, PyAny>,
+    String,
+);
+
 /// Blurs `image` ((H, W, 3) float32, linear). `motion`: `shake`,
 /// `sim:GAIT`, `twist` (with `omega`, `velocity`) or `log` (with `gyro`,
 /// `at`). Returns (image, maps, homographies (3, 3, 3), motion drawn).
@@ -38,12 +46,7 @@ pub fn augment<'py>(
     quality: &str,
     background: [f32; 3],
     use_velocity: bool,
-) -> PyResult<(
-    Bound<'py, PyAny>,
-    Bound<'py, PyDict>,
-    Bound<'py, PyAny>,
-    String,
-)> {
+) -> PyResult<Out<'py>> {
     let a = image.as_array();
     let (h, w, c) = a.dim();
     if c != 3 {

@@ -106,10 +106,14 @@ fn member_bytes(n: u64) -> u64 {
     BLOCK + n.div_ceil(BLOCK) * BLOCK
 }
 
+/// A tar member: its name, the file it is read from, and the file's
+/// expected size and SHA-256 (`None`: checked otherwise).
+type Member = (String, PathBuf, Option<(u64, String)>);
+
 /// The item's members: `KEY.json` (from `item.json`) then [`FILES`], each
 /// with its path in `DIR` and its expected size and SHA-256 (`None` for
 /// `item.json`, checked by `verify` against the line).
-fn members(out: &Path, l: &ManifestLine) -> Result<Vec<(String, PathBuf, Option<(u64, String)>)>> {
+fn members(out: &Path, l: &ManifestLine) -> Result<Vec<Member>> {
     let dir = out.join(item_dir(l.index));
     let mut m = vec![(member_name(l.index, "json"), dir.join("item.json"), None)];
     for f in FILES {
