@@ -378,3 +378,62 @@ fn a_camera_section_makes_another_dataset() {
             || std::fs::read_dir(p.join("bad/items")).unwrap().count() == 0
     );
 }
+
+#[test]
+fn a_sensor_section_runs_the_camera_pipeline_on_the_pngs() {
+    use mmbm::dataset::SensorPipeline;
+    let mut cfg = small(2);
+    cfg.camera.noise = Some(mmbm::camera::Noise::at_light(20_000.0));
+    cfg.sensor = Some(SensorPipeline {
+        response: "gamma:2.2".into(),
+        bayer: "rggb".into(),
+        jpeg_quality: 80,
+        ..SensorPipeline::default()
+    });
+    let a = tempfile::tempdir().unwrap();
+    dataset::run(&cfg, a.path(), Shard::ALL, false).unwrap();
+    assert_eq!(dataset::verify(a.path()).unwrap(), 2);
+    // Deterministic: a second run gives the same bytes.
+    let b = tempfile::tempdir().unwrap();
+    dataset::run(&cfg, b.path(), Shard::ALL, false).unwrap();
+    assert_eq!(items_and_manifest(a.path()), items_and_manifest(b.path()));
+    let line: ManifestLine =
+        serde_json::from_slice(&std::fs::read(a.path().join("items/00000000/item.json")).unwrap())
+            .unwrap();
+    assert_eq!(line.params.sensor, cfg.sensor);
+    // The sharp PNG is the pipeline applied to the noise-free sharp EXR.
+    let (w, h, ch) =
+        mmbm::io::images::read_exr(&a.path().join("items/00000000/sharp.exr")).unwrap();
+    let get = |n: &str| &ch.iter().find(|c| c.0 == n).unwrap().1;
+    let (r, g, bl) = (get("R"), get("G"), get("B"));
+    let rgb: Vec<f32> = (0..w * h).flat_map(|i| [r[i], g[i], bl[i]]).collect();
+    let want = cfg
+        .sensor
+        .as_ref()
+        .unwrap()
+        .encode(w as u32, h as u32, &rgb)
+        .unwrap();
+    let png = image::open(a.path().join("items/00000000/sharp.png"))
+        .unwrap()
+        .to_rgb8()
+        .into_raw();
+    assert_eq!(png, want);
+    // Without the section: no `sensor` key anywhere, and other PNG bytes.
+    let plain = tempfile::tempdir().unwrap();
+    let mut c2 = cfg.clone();
+    c2.sensor = None;
+    dataset::run(&c2, plain.path(), Shard::ALL, false).unwrap();
+    let text = std::fs::read_to_string(plain.path().join("manifest.jsonl")).unwrap();
+    assert!(!text.contains("sensor"));
+    assert_ne!(
+        std::fs::read(plain.path().join("items/00000000/blurred.png")).unwrap(),
+        std::fs::read(a.path().join("items/00000000/blurred.png")).unwrap()
+    );
+    // Bad keys are clear errors.
+    let mut bad = cfg.clone();
+    bad.sensor.as_mut().unwrap().bayer = "rgb".into();
+    let e = dataset::run(&bad, tempfile::tempdir().unwrap().path(), Shard::ALL, false)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("bayer") && e.contains("rggb"), "{e}");
+}

@@ -1,5 +1,6 @@
 //! The dataset configuration (TOML): what items are drawn from.
 
+use super::sensor::SensorPipeline;
 use crate::camera::{Camera, CameraFile};
 use crate::error::{Error, Result};
 use crate::render::Quality;
@@ -43,6 +44,12 @@ pub struct DatasetConfig {
     /// serialises (and fingerprints) as it always did.
     #[serde(skip_serializing_if = "is_empty")]
     pub camera: CameraFile,
+    /// The `[sensor]` section: the camera pipeline applied to the PNG files
+    /// ([`SensorPipeline`]: noise seeded per item, saturation, Bayer mosaic
+    /// and demosaicing, response curve, JPEG). Left out when absent, so a
+    /// configuration without it gives the items it always gave.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sensor: Option<SensorPipeline>,
 }
 
 /// True for a `[camera]` section with no keys.
@@ -65,6 +72,7 @@ impl Default for DatasetConfig {
             quality: "default".into(),
             use_velocity: true,
             camera: CameraFile::default(),
+            sensor: None,
         }
     }
 }
@@ -109,6 +117,9 @@ impl DatasetConfig {
     /// Checks every value (not the files: see [`super::Sources::open`]).
     pub fn validate(&self) -> Result<()> {
         let key = |k: &str, m: String| Error::invalid(k, m);
+        if let Some(s) = &self.sensor {
+            s.validate()?;
+        }
         if self.count == 0 || self.count > MAX_COUNT {
             return Err(key(
                 "count",

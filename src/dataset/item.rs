@@ -2,6 +2,7 @@
 //! item's own seed) and the files made from them.
 
 use super::config::{DatasetConfig, MotionSource};
+use super::sensor::SensorPipeline;
 use crate::camera::{Camera, CameraFile};
 use crate::error::{Error, Result};
 use crate::field::flow_field;
@@ -55,6 +56,9 @@ pub struct ItemParams {
     /// `resolution` (absent when there are none).
     #[serde(default, skip_serializing_if = "super::config::is_empty")]
     pub camera: CameraFile,
+    /// The configuration's `[sensor]` pipeline (absent when there is none).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sensor: Option<SensorPipeline>,
 }
 
 /// The seed of item `i` (SplitMix64 of the master seed and `i`).
@@ -231,6 +235,7 @@ pub fn plan(cfg: &DatasetConfig, src: &Sources, i: u64) -> Result<ItemParams> {
         quality: cfg.quality.clone(),
         use_velocity: cfg.use_velocity && has_velocity,
         camera: cfg.camera.clone(),
+        sensor: cfg.sensor.clone(),
     })
 }
 
@@ -303,16 +308,38 @@ pub const FILES: [&str; 6] = [
     "maps.exr",
 ];
 
-fn write_rgb(dir: &Path, stem: &str, o: &RenderOutput) -> Result<()> {
+/// `STEM.exr` (linear) and `STEM.png` (sRGB, or the `[sensor]` pipeline's output).
+fn write_rgb(
+    dir: &Path,
+    stem: &str,
+    o: &RenderOutput,
+    sensor: Option<&SensorPipeline>,
+) -> Result<()> {
     o.write_image(&dir.join(format!("{stem}.exr")))?;
-    o.write_image(&dir.join(format!("{stem}.png")))
+    let png = dir.join(format!("{stem}.png"));
+    match sensor {
+        None => o.write_image(&png),
+        Some(s) => {
+            let bytes = s.encode(o.width, o.height, &o.rgb)?;
+            let img = image::RgbImage::from_raw(o.width, o.height, bytes).ok_or_else(|| {
+                Error::invalid("item", "the sensor pipeline's image has the wrong size")
+            })?;
+            crate::io::images::save_rgb8(&png, &img)
+        }
+    }
 }
 
 /// Makes item `p` into `dir` (which must exist): the [`FILES`]. Rendered on
 /// the CPU twin: deterministic per pixel, so the same build gives the same
 /// bytes on machines of the same architecture and C library.
 pub fn make(p: &ItemParams, src: &Sources, dir: &Path) -> Result<ItemMeasures> {
-    let cam = camera(p)?;
+    let mut cam = camera(p)?;
+    if p.sensor.is_some() {
+        // With a sensor pipeline, each item's noise has its own seed.
+        if let Some(n) = cam.noise.as_mut() {
+            n.seed = p.seed;
+        }
+    }
     let s = samples(p, cam.shutter.readout_s, src)?;
     // The motion spans the readout (none for a global shutter) plus the exposure.
     let span = cam.shutter.readout_s + p.exposure_s;
@@ -327,7 +354,15 @@ pub fn make(p: &ItemParams, src: &Sources, dir: &Path) -> Result<ItemMeasures> {
     job.seed = p.seed as u32;
     job.with_maps = true;
     let blurred = render::render_frame(&job)?;
-    let sharp = render::render_sharp(&job)?;
+    let sharp = match &p.sensor {
+        // The sharp frame without noise, unless asked.
+        Some(s) if !s.sharp_noise => {
+            let mut quiet = job.clone();
+            quiet.camera.noise = None;
+            render::render_sharp(&quiet)?
+        }
+        _ => render::render_sharp(&job)?,
+    };
     let maps = blurred
         .maps
         .as_ref()
@@ -343,8 +378,8 @@ pub fn make(p: &ItemParams, src: &Sources, dir: &Path) -> Result<ItemMeasures> {
     let tw = twist_at(&s, p.start_s, p.use_velocity);
     let flow = flow_field(&scene, &tw, 0, 0, Backend::Cpu { threads: None })?;
     let start = mmbm(&scene, &tw, "exact:1e-9".parse::<Method>()?)?;
-    write_rgb(dir, "blurred", &blurred)?;
-    write_rgb(dir, "sharp", &sharp)?;
+    write_rgb(dir, "blurred", &blurred, p.sensor.as_ref())?;
+    write_rgb(dir, "sharp", &sharp, p.sensor.as_ref())?;
     let (w, h) = (flow.width as usize, flow.height as usize);
     write_exr(
         &dir.join("flow.exr"),

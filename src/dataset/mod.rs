@@ -13,6 +13,7 @@
 //!   its manifest (which is input: every path it names is confined).
 //! - `guard`: the configuration's fingerprint (`DIR/dataset.json`) and the
 //!   lock that keeps each shard to one writer.
+//! - `sensor`: the camera pipeline of the PNG files (`[sensor]`).
 //! - `webdataset`: the directory packed into WebDataset tar shards
 //!   (`--format webdataset`).
 
@@ -21,6 +22,7 @@ pub(crate) mod guard;
 pub mod item;
 pub(crate) mod manifest;
 pub(crate) mod run;
+pub(crate) mod sensor;
 pub(crate) mod shard;
 pub(crate) mod webdataset;
 
@@ -29,6 +31,7 @@ pub use guard::{Record, RunLock};
 pub use item::{ItemParams, Sources};
 pub use manifest::{merge, verify, ManifestLine};
 pub use run::{make_item, run, RunSummary};
+pub use sensor::SensorPipeline;
 pub use shard::{Shard, MAX_SHARDS};
 pub use webdataset::{
     pack, verify_tars, PackSummary, TarIndex, TarShard, DEFAULT_SHARD_BYTES, MIN_SHARD_BYTES,
