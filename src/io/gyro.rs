@@ -160,13 +160,47 @@ pub fn parse_rotation(s: &str) -> Result<DMat3> {
         .iter()
         .map(|x| x.abs())
         .fold(0.0, f64::max);
-    if err > 1e-6 || (m.determinant() - 1.0).abs() > 1e-6 {
+    let det = m.determinant();
+    if err > 1e-6 {
         return Err(Error::invalid(
             "rotation",
-            format!("'{s}' is not a rotation matrix (orthonormal, det +1)"),
+            format!(
+                "'{s}' is not a rotation matrix (orthonormal, det +1): its rows are not \
+                 orthonormal (largest entry of R R^T - I: {err:.3e}; determinant {det})"
+            ),
+        ));
+    }
+    if (det - 1.0).abs() > 1e-6 {
+        let (row, proper) = proper_rotation(&v);
+        let list: Vec<String> = proper.iter().map(|x| x.to_string()).collect();
+        return Err(Error::invalid(
+            "rotation",
+            format!(
+                "'{s}' is not a rotation matrix (orthonormal, det +1): its determinant is {det}, \
+                 an axis swap or reflection (a left-handed frame). Negating one axis makes it a \
+                 proper rotation: with row {row} negated it is '{}' (negating any other one row \
+                 is a rotation too; which is right depends on the axis the calibration flips)",
+                list.join(",")
+            ),
         ));
     }
     Ok(m)
+}
+
+/// For an orthonormal row-major matrix `v` with determinant -1: the row
+/// (1-based) to negate and the proper rotation that gives. The row chosen
+/// makes the smallest rotation (the largest trace; the lowest row on a tie).
+fn proper_rotation(v: &[f64]) -> (usize, [f64; 9]) {
+    // Negating row i changes the trace by -2 v[i][i].
+    let row = (0..3)
+        .min_by(|&a, &b| v[4 * a].total_cmp(&v[4 * b]).then(a.cmp(&b)))
+        .unwrap_or(2);
+    let mut out = [0.0; 9];
+    for (k, o) in out.iter_mut().enumerate() {
+        // `0.0 - x` keeps a zero unsigned.
+        *o = if k / 3 == row { 0.0 - v[k] } else { v[k] };
+    }
+    (row + 1, out)
 }
 
 /// Where a [`GyroReader`]'s samples come from.
