@@ -156,10 +156,41 @@ impl<R: Read> LineCap<R> {
     }
 }
 
+impl<R: Read> LineCap<R> {
+    /// Adds `k` bytes to the current line; the error once it is over the cap.
+    fn grow(&mut self, k: usize) -> std::io::Result<()> {
+        self.run += k;
+        if self.run > self.cap {
+            let e = line_too_long(&self.path, self.line, self.cap);
+            let text = e.to_string();
+            self.error = Some(e);
+            return Err(std::io::Error::other(text));
+        }
+        Ok(())
+    }
+}
+
 impl<R: Read> Read for LineCap<R> {
     fn read(&mut self, dst: &mut [u8]) -> std::io::Result<usize> {
         let n = self.inner.read(dst)?;
-        for &b in &dst[..n] {
+        let buf = &dst[..n];
+        let mut i = 0;
+        // Only line breaks and quotes change the state (and `#` first on a
+        // line): the bytes between them are counted in one step.
+        while i < n {
+            if self.start {
+                self.start = false;
+                if buf[i] == b'#' && !self.quoted {
+                    self.comment = true;
+                }
+            }
+            let Some(j) = memchr::memchr2(b'\n', b'"', &buf[i..]) else {
+                self.grow(n - i)?;
+                break;
+            };
+            self.grow(j)?;
+            let b = buf[i + j];
+            i += j + 1;
             if b == b'\n' && !self.quoted {
                 self.run = 0;
                 self.line += 1;
@@ -170,20 +201,10 @@ impl<R: Read> Read for LineCap<R> {
             if b == b'\n' {
                 self.line += 1;
             }
-            if self.start && b == b'#' && !self.quoted {
-                self.comment = true;
-            }
-            self.start = false;
             if b == b'"' && !self.comment {
                 self.quoted = !self.quoted;
             }
-            self.run += 1;
-            if self.run > self.cap {
-                let e = line_too_long(&self.path, self.line, self.cap);
-                let text = e.to_string();
-                self.error = Some(e);
-                return Err(std::io::Error::other(text));
-            }
+            self.grow(1)?;
         }
         Ok(n)
     }
