@@ -4,7 +4,7 @@ use super::args::{CameraArgs, SceneArgs};
 use super::series::GyroArgs;
 use clap::Args;
 use mmbm::error::{Error, Result};
-use mmbm::io::frames::read_frames;
+use mmbm::io::frames::read_frame_table;
 use mmbm::io::gyro::read_log;
 use mmbm::series::frames::frame_mmbm;
 use mmbm::series::SeriesOptions;
@@ -29,13 +29,19 @@ Examples:
       --worst --worst-list blurry.txt --worst-ffmpeg-select blurry.select"
 )]
 pub struct FramesArgs {
-    /// Gyro log (CSV, Gyroflow .gcsv or ROS 2 .mcap), on the same clock as FRAMES.
+    /// Gyro log (CSV, Gyroflow .gcsv, ROS 2 .mcap, or a phone's IMU rows
+    /// timestamp_ns,type,x,y,z), on the clock of FRAMES (else --time-offset).
     #[arg(long, value_name = "FILE")]
     pub gyro: PathBuf,
     /// Frame table: CSV with t_start (first line's exposure start, s), exposure_s
     /// and optionally readout_s (else the camera's readout); '#' lines are comments.
+    /// Also a phone's image list (timestamp_ns,exposure_ns) or the output of
+    /// ffprobe -show_frames -of csv (presentation times; give --exposure).
     #[arg(long, value_name = "FRAMES.csv")]
     pub frames: PathBuf,
+    /// Exposure of every frame, s, for a table of times only (ffprobe's).
+    #[arg(long, value_name = "S")]
+    pub exposure: Option<f64>,
     /// riemann[:NUxNV], gauss[:N] or exact[:TOL] (gpu is not available here).
     #[arg(long, default_value = "riemann:8x6")]
     pub method: AnyMethod,
@@ -68,7 +74,7 @@ pub fn run(a: FramesArgs) -> Result<()> {
         }
     };
     let camera = a.camera.camera()?;
-    let frames = read_frames(&a.frames)?;
+    let frames = read_frame_table(&a.frames, a.exposure)?;
     let samples = read_log(&a.gyro, a.gyro_opts.options()?)?;
     let camera = super::args::with_log_readout(camera, samples.readout(), &a.gyro)?;
     let opts = SeriesOptions {

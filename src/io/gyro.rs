@@ -2,7 +2,9 @@
 //! (seconds by default), `wx, wy, wz` (rad/s by default), optional `vx, vy, vz`
 //! (m/s) and `depth` (m). Lines starting with `#` are comments. A ROS 2 MCAP
 //! file (`mcap`) or a Gyroflow `.gcsv` log ([`super::gcsv`]) is read
-//! by its own reader, which yields the samples directly (no text in between).
+//! by its own reader, which yields the samples directly (no text in between);
+//! so is a phone's CSV of IMU rows with a sensor-type column
+//! ([`super::phone`]: nanoseconds, gyro rows only), known by its header.
 //!
 //! [`GyroReader`] streams the file in constant memory and validates every
 //! field, the same way for every format; errors name the file, line and
@@ -13,6 +15,7 @@ mod plain;
 use super::gcsv::GcsvReader;
 use super::input::check_increasing;
 use super::mcap::ImuStream;
+use super::phone::ImuRows;
 use crate::error::{Error, Result};
 pub use crate::model::log::GyroSample;
 use crate::model::log::{is_gap, ImuLog, LogReadout};
@@ -211,6 +214,8 @@ enum Source {
     Gcsv(GcsvReader),
     /// A ROS 2 MCAP log (line numbers: message number + 1).
     Mcap(ImuStream),
+    /// A phone's IMU rows (sensor-type column, nanoseconds), gyro rows only.
+    Phone(ImuRows),
 }
 
 /// Streaming, validating reader of a gyro log (CSV, `.gcsv` or MCAP): each
@@ -261,6 +266,14 @@ impl GyroReader {
                 direction: h.readout_direction,
             });
             (Source::Gcsv(rows), path)
+        } else if super::phone::is_imu_rows(path) {
+            if opts.time_unit != TimeUnit::S {
+                return Err(Error::invalid(
+                    path.display().to_string(),
+                    "IMU rows (a sensor-type column) carry nanosecond timestamps: leave --time-unit at its default",
+                ));
+            }
+            (Source::Phone(ImuRows::open(path)?), path)
         } else {
             let file = super::input::open_stream(path)?;
             (Source::Csv(CsvSource::open(Box::new(file), path)?), path)
@@ -322,6 +335,13 @@ impl GyroReader {
                 v: None,
                 depth: None,
             })),
+            Source::Phone(p) => Ok(p.next_row()?.map(|r| Raw {
+                line: r.line,
+                t: r.t,
+                w: r.omega,
+                v: None,
+                depth: None,
+            })),
             Source::Mcap(m) => match m.next().transpose()? {
                 Some(msg) => Ok(Some(Raw {
                     line: m.messages_read() as u64 + 1,
@@ -340,6 +360,7 @@ impl GyroReader {
         match &self.source {
             Source::Csv(c) => c.time_column(),
             Source::Gcsv(g) => g.time_column(),
+            Source::Phone(p) => p.time_column(),
             Source::Mcap(_) => "t",
         }
     }
@@ -349,6 +370,7 @@ impl GyroReader {
         match &self.source {
             Source::Csv(c) => c.position_line(),
             Source::Gcsv(g) => g.lines_read() + 1,
+            Source::Phone(p) => p.lines_read() + 1,
             Source::Mcap(m) => m.messages_read() as u64 + 2,
         }
     }

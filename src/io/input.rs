@@ -210,6 +210,52 @@ impl<R: Read> Read for LineCap<R> {
     }
 }
 
+/// The lines of a text file (or pipe) one at a time, each at most
+/// [`MAX_LINE_BYTES`], without their line break (and `\r`): for the small
+/// hand-read tables (image lists, ffprobe output). Errors name the file and
+/// the line.
+pub struct TextLines {
+    src: std::io::BufReader<Box<dyn Read + Send>>,
+    path: PathBuf,
+    line: u64,
+    buf: Vec<u8>,
+}
+
+impl TextLines {
+    /// Opens `path` ([`open_stream`]).
+    pub fn open(path: &Path) -> Result<Self> {
+        let f: Box<dyn Read + Send> = Box::new(open_stream(path)?);
+        Ok(TextLines {
+            src: std::io::BufReader::with_capacity(1 << 16, f),
+            path: path.into(),
+            line: 0,
+            buf: Vec::new(),
+        })
+    }
+
+    /// The next line and its number (1-based), `None` at the end.
+    pub fn next_line(&mut self) -> Result<Option<(u64, String)>> {
+        let r = read_line(&mut self.src, &mut self.buf, MAX_LINE_BYTES)
+            .map_err(|e| Error::io(&self.path, e))?;
+        self.line += 1;
+        match r {
+            Line::Eof => Ok(None),
+            Line::TooLong => Err(line_too_long(&self.path, self.line, MAX_LINE_BYTES)),
+            Line::Read => {
+                let text = std::str::from_utf8(&self.buf).map_err(|_| Error::Parse {
+                    path: self.path.clone(),
+                    line: self.line,
+                    column: "-".into(),
+                    message: "the line is not UTF-8 text".into(),
+                })?;
+                let text = text.strip_suffix('\n').unwrap_or(text);
+                let text = text.strip_suffix('\r').unwrap_or(text);
+                Ok(Some((self.line, text.to_string())))
+            }
+        }
+    }
+}
+
 /// Checks that time `t` (s) of the sample on `line` comes after the previous
 /// sample's (`prev`: its time, s, and line); the error names the file, the
 /// line and the time column `column`.
