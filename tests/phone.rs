@@ -292,3 +292,93 @@ fn bad_rows_name_the_file_and_line() {
     assert_eq!(checked, 36);
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// The `mmbm` commands of `docs/frames.md`, continuation lines joined.
+fn doc_commands() -> Vec<Vec<String>> {
+    let doc =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/docs/frames.md")).unwrap();
+    let mut out = Vec::new();
+    let (mut fenced, mut cur) = (false, String::new());
+    for line in doc.lines() {
+        if line.trim_start().starts_with("```") {
+            fenced = !fenced;
+            continue;
+        }
+        if !fenced {
+            continue;
+        }
+        cur.push_str(line.trim_end_matches('\\'));
+        cur.push(' ');
+        if !line.ends_with('\\') {
+            if cur.trim_start().starts_with("mmbm ") {
+                out.push(cur.split_whitespace().skip(1).map(String::from).collect());
+            }
+            cur.clear();
+        }
+    }
+    out
+}
+
+#[test]
+fn the_worked_example_runs() {
+    let d = dir("doc");
+    write_logs(&d);
+    let mut list = String::from("timestamp_ns,exposure_ns\n");
+    let mut probe = String::new();
+    for (k, (ns, e)) in frame_times().into_iter().enumerate() {
+        list += &format!("{ns},{e}\n");
+        let pts = k as f64 * 0.033333333;
+        probe += &format!("frame,video,0,1,{k},{pts:.6},{k},{pts:.6},{k},{pts:.6},N/A,N/A\n");
+    }
+    std::fs::write(d.join("images.csv"), list).unwrap();
+    std::fs::write(d.join("probe.csv"), probe).unwrap();
+    std::fs::copy(
+        concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/examples/cameras/running_phone.toml"
+        ),
+        d.join("camera.toml"),
+    )
+    .unwrap();
+    let commands = doc_commands();
+    assert_eq!(commands.len(), 5, "{commands:?}");
+    let help = String::from_utf8(common::mmbm(&["frames", "--help"]).stdout).unwrap();
+    let mut ran = 0;
+    for args in &commands {
+        if args.iter().any(|a| a == "--maps") && !help.contains("--maps") {
+            common::skip(
+                "`frames --maps` is not in this build (the maps work): its line is not run",
+            );
+            continue;
+        }
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        common::mmbm_ok_in(&d, &args);
+        ran += 1;
+    }
+    assert!(ran >= 4);
+    for f in ["frames.csv", "frames_from_probe.csv", "sharp.csv"] {
+        let text = std::fs::read_to_string(d.join(f)).unwrap();
+        assert_eq!(
+            text.lines().count(),
+            if f == "sharp.csv" {
+                1 + std::fs::read_to_string(d.join("sharp.txt"))
+                    .unwrap()
+                    .lines()
+                    .count()
+            } else {
+                51
+            },
+            "{f}"
+        );
+    }
+    for f in ["sharp.txt", "sharp.select", "blurry.txt", "blurry.select"] {
+        assert!(
+            !std::fs::read_to_string(d.join(f))
+                .unwrap()
+                .trim()
+                .is_empty(),
+            "{f}"
+        );
+    }
+    let _ = std::fs::remove_dir_all(&d);
+}
