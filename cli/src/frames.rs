@@ -4,9 +4,9 @@ use super::args::{CameraArgs, SceneArgs};
 use super::series::GyroArgs;
 use clap::Args;
 use mmbm::error::{Error, Result};
-use mmbm::io::frames::read_frames;
+use mmbm::io::frames::read_frame_table;
 use mmbm::io::gyro::read_log;
-use mmbm::series::frames::{frame_mmbm, select_sharpest};
+use mmbm::series::frames::frame_mmbm;
 use mmbm::series::SeriesOptions;
 use mmbm::{AnyMethod, Scene};
 use std::io::Write;
@@ -24,28 +24,32 @@ Examples:
   mmbm frames --gyro ../shared/data/running_phone/gyro.csv --frames ../shared/data/running_phone/frames.csv \\
       --camera examples/cameras/running_phone.toml --out frames_mmbm.csv
   mmbm frames --gyro log.gcsv --frames frames.csv --camera lens_profile.json --scale-to 1920x1080 \\
-      --select 20 --gap 0.5 --out sharpest.csv"
+      --select 20 --gap 0.5 --out sharpest.csv
+  mmbm frames ... --select 200 --gap 0.2 --image-list sharp.txt --ffmpeg-select sharp.select \\
+      --worst --worst-list blurry.txt --worst-ffmpeg-select blurry.select"
 )]
 pub struct FramesArgs {
-    /// Gyro log (CSV, Gyroflow .gcsv or ROS 2 .mcap), on the same clock as FRAMES.
+    /// Gyro log (CSV, Gyroflow .gcsv, ROS 2 .mcap, or a phone's IMU rows
+    /// timestamp_ns,type,x,y,z), on the clock of FRAMES (else --time-offset).
     #[arg(long, value_name = "FILE")]
     pub gyro: PathBuf,
     /// Frame table: CSV with t_start (first line's exposure start, s), exposure_s
     /// and optionally readout_s (else the camera's readout); '#' lines are comments.
+    /// Also a phone's image list (timestamp_ns,exposure_ns) or the output of
+    /// ffprobe -show_frames -of csv (presentation times; give --exposure).
     #[arg(long, value_name = "FRAMES.csv")]
     pub frames: PathBuf,
+    /// Exposure of every frame, s, for a table of times only (ffprobe's).
+    #[arg(long, value_name = "S")]
+    pub exposure: Option<f64>,
     /// riemann[:NUxNV], gauss[:N] or exact[:TOL] (gpu is not available here).
     #[arg(long, default_value = "riemann:8x6")]
     pub method: AnyMethod,
     /// Output CSV (default: stdout).
     #[arg(long, value_name = "FILE")]
     pub out: Option<PathBuf>,
-    /// Keep only the N sharpest frames (least blur_px) at least --gap apart.
-    #[arg(long, value_name = "N")]
-    pub select: Option<usize>,
-    /// Smallest time between selected frames' starts, s.
-    #[arg(long, value_name = "S", default_value_t = 0.0, requires = "select")]
-    pub gap: f64,
+    #[command(flatten)]
+    pub choice: super::choose::ChoiceArgs,
     /// Include the log's vx,vy,vz (needs a depth column, --depth or --plane).
     #[arg(long)]
     pub use_velocity: bool,
@@ -59,9 +63,7 @@ pub struct FramesArgs {
 
 pub fn run(a: FramesArgs) -> Result<()> {
     // The output's place, checked before any work.
-    if let Some(p) = &a.out {
-        mmbm::io::atomic::check_output(p)?;
-    }
+    a.choice.check(a.out.as_deref())?;
     let method = match a.method {
         AnyMethod::Cpu(m) => m,
         AnyMethod::Gpu { .. } => {
@@ -72,8 +74,7 @@ pub fn run(a: FramesArgs) -> Result<()> {
         }
     };
     let camera = a.camera.camera()?;
-    mmbm::check::finite("--gap", a.gap)?;
-    let frames = read_frames(&a.frames)?;
+    let frames = read_frame_table(&a.frames, a.exposure)?;
     let samples = read_log(&a.gyro, a.gyro_opts.options()?)?;
     let camera = super::args::with_log_readout(camera, samples.readout(), &a.gyro)?;
     let opts = SeriesOptions {
@@ -94,10 +95,7 @@ pub fn run(a: FramesArgs) -> Result<()> {
             if outside.len() > 8 { ", ..." } else { "" }
         );
     }
-    let keep: Vec<usize> = match a.select {
-        Some(n) => select_sharpest(&rows, &camera, n, a.gap),
-        None => (0..rows.len()).collect(),
-    };
+    let keep = a.choice.keep(&rows, &camera)?;
     let write = |w: &mut dyn Write| -> Result<()> {
         let werr = |e: std::io::Error| mmbm::Error::io("<frames output>", e);
         writeln!(
@@ -124,10 +122,13 @@ pub fn run(a: FramesArgs) -> Result<()> {
         }
         Ok(())
     };
-    match &a.out {
-        Some(p) => mmbm::io::atomic::write_atomic(p, |w| write(w))?,
-        None => write(&mut std::io::stdout().lock())?,
-    }
+    mmbm::io::atomic::all_or_nothing(|| {
+        match &a.out {
+            Some(p) => mmbm::io::atomic::write_atomic(p, |w| write(w))?,
+            None => write(&mut std::io::stdout().lock())?,
+        }
+        a.choice.write(&rows, &camera, &keep)
+    })?;
     eprintln!(
         "{} frames ({} written), method {method}, camera readout {} s",
         rows.len(),

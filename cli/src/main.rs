@@ -7,6 +7,7 @@ mod progress;
 mod args;
 mod assess;
 mod blobs;
+mod choose;
 mod dataset;
 mod demo;
 mod eval;

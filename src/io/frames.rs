@@ -2,6 +2,11 @@
 //! lines and a header with `t_start` (exposure start of the first line, s, on
 //! the gyro log's clock), `exposure_s` and optionally `readout_s` (rolling
 //! shutter, s). Other columns are ignored. Errors name the file, line and column.
+//!
+//! [`read_frame_table`] also reads a phone's image list
+//! ([`super::phone::read_image_list`]: nanosecond timestamp and exposure)
+//! and ffprobe's frame output ([`super::ffprobe`]: presentation times, the
+//! exposure given), chosen by the first line.
 
 use crate::error::{Error, Result};
 use std::path::Path;
@@ -38,7 +43,96 @@ impl VideoFrame {
     }
 }
 
-/// Reads a frame table.
+/// The kinds of frame table [`read_frame_table`] reads.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum TableKind {
+    /// `t_start, exposure_s[, readout_s]` (s).
+    Plain,
+    /// A phone's image list: `timestamp_ns, exposure_ns`.
+    ImageList,
+    /// `ffprobe -show_frames` output: presentation times only.
+    Ffprobe,
+}
+
+/// The kind of the frame table at `path`, from its first non-blank line (a
+/// pipe, which cannot be read twice, is taken as a plain table).
+pub fn table_kind(path: &Path) -> TableKind {
+    if !super::input::is_regular_file(path) {
+        return TableKind::Plain;
+    }
+    let Ok(mut lines) = super::input::TextLines::open(path) else {
+        return TableKind::Plain;
+    };
+    while let Ok(Some((_, l))) = lines.next_line() {
+        if l.trim().is_empty() {
+            continue;
+        }
+        if super::phone::is_image_list_header(&l) {
+            return TableKind::ImageList;
+        }
+        if super::ffprobe::is_ffprobe_line(&l) {
+            return TableKind::Ffprobe;
+        }
+        if !l.trim_start().starts_with('#') {
+            break;
+        }
+    }
+    TableKind::Plain
+}
+
+/// Reads a frame table of any [`TableKind`]. `exposure_s` (s, > 0) is the
+/// exposure of every frame of a table without one (ffprobe's); a table
+/// with its own exposure refuses it. The readout is the camera's unless a
+/// plain table has `readout_s`.
+pub fn read_frame_table(path: &Path, exposure_s: Option<f64>) -> Result<Vec<VideoFrame>> {
+    let kind = table_kind(path);
+    if let Some(e) = exposure_s {
+        if !(e.is_finite() && e > 0.0) {
+            return Err(Error::invalid(
+                "--exposure",
+                format!("must be > 0 s, got {e}"),
+            ));
+        }
+        if kind != TableKind::Ffprobe {
+            return Err(Error::invalid(
+                "--exposure",
+                format!(
+                    "{} has its own exposure column; --exposure is for a table of times only (ffprobe's)",
+                    path.display()
+                ),
+            ));
+        }
+    }
+    match kind {
+        TableKind::Plain => read_frames(path),
+        TableKind::ImageList => Ok(super::phone::read_image_list(path)?
+            .into_iter()
+            .map(|(t_start, exposure_s)| VideoFrame {
+                t_start,
+                exposure_s,
+                readout_s: None,
+            })
+            .collect()),
+        TableKind::Ffprobe => {
+            let Some(exposure_s) = exposure_s else {
+                return Err(Error::invalid(
+                    path.display().to_string(),
+                    "an ffprobe frame table has presentation times only: give the exposure, --exposure S",
+                ));
+            };
+            Ok(super::ffprobe::read_ffprobe_times(path)?
+                .into_iter()
+                .map(|t_start| VideoFrame {
+                    t_start,
+                    exposure_s,
+                    readout_s: None,
+                })
+                .collect())
+        }
+    }
+}
+
+/// Reads a plain frame table.
 pub fn read_frames(path: &Path) -> Result<Vec<VideoFrame>> {
     use super::input::{open_stream, LineCap, MAX_LINE_BYTES};
     let file = LineCap::new(open_stream(path)?, path, MAX_LINE_BYTES);

@@ -2,7 +2,9 @@
 //! (seconds by default), `wx, wy, wz` (rad/s by default), optional `vx, vy, vz`
 //! (m/s) and `depth` (m). Lines starting with `#` are comments. A ROS 2 MCAP
 //! file (`mcap`) or a Gyroflow `.gcsv` log ([`super::gcsv`]) is read
-//! by its own reader, which yields the samples directly (no text in between).
+//! by its own reader, which yields the samples directly (no text in between);
+//! so is a phone's CSV of IMU rows with a sensor-type column
+//! ([`super::phone`]: nanoseconds, gyro rows only), known by its header.
 //!
 //! [`GyroReader`] streams the file in constant memory and validates every
 //! field, the same way for every format; errors name the file, line and
@@ -13,6 +15,7 @@ mod plain;
 use super::gcsv::GcsvReader;
 use super::input::check_increasing;
 use super::mcap::ImuStream;
+use super::phone::ImuRows;
 use crate::error::{Error, Result};
 pub use crate::model::log::GyroSample;
 use crate::model::log::{is_gap, ImuLog, LogReadout};
@@ -160,13 +163,47 @@ pub fn parse_rotation(s: &str) -> Result<DMat3> {
         .iter()
         .map(|x| x.abs())
         .fold(0.0, f64::max);
-    if err > 1e-6 || (m.determinant() - 1.0).abs() > 1e-6 {
+    let det = m.determinant();
+    if err > 1e-6 {
         return Err(Error::invalid(
             "rotation",
-            format!("'{s}' is not a rotation matrix (orthonormal, det +1)"),
+            format!(
+                "'{s}' is not a rotation matrix (orthonormal, det +1): its rows are not \
+                 orthonormal (largest entry of R R^T - I: {err:.3e}; determinant {det})"
+            ),
+        ));
+    }
+    if (det - 1.0).abs() > 1e-6 {
+        let (row, proper) = proper_rotation(&v);
+        let list: Vec<String> = proper.iter().map(|x| x.to_string()).collect();
+        return Err(Error::invalid(
+            "rotation",
+            format!(
+                "'{s}' is not a rotation matrix (orthonormal, det +1): its determinant is {det}, \
+                 an axis swap or reflection (a left-handed frame). Negating one axis makes it a \
+                 proper rotation: with row {row} negated it is '{}' (negating any other one row \
+                 is a rotation too; which is right depends on the axis the calibration flips)",
+                list.join(",")
+            ),
         ));
     }
     Ok(m)
+}
+
+/// For an orthonormal row-major matrix `v` with determinant -1: the row
+/// (1-based) to negate and the proper rotation that gives. The row chosen
+/// makes the smallest rotation (the largest trace; the lowest row on a tie).
+fn proper_rotation(v: &[f64]) -> (usize, [f64; 9]) {
+    // Negating row i changes the trace by -2 v[i][i].
+    let row = (0..3)
+        .min_by(|&a, &b| v[4 * a].total_cmp(&v[4 * b]).then(a.cmp(&b)))
+        .unwrap_or(2);
+    let mut out = [0.0; 9];
+    for (k, o) in out.iter_mut().enumerate() {
+        // `0.0 - x` keeps a zero unsigned.
+        *o = if k / 3 == row { 0.0 - v[k] } else { v[k] };
+    }
+    (row + 1, out)
 }
 
 /// Where a [`GyroReader`]'s samples come from.
@@ -177,6 +214,8 @@ enum Source {
     Gcsv(GcsvReader),
     /// A ROS 2 MCAP log (line numbers: message number + 1).
     Mcap(ImuStream),
+    /// A phone's IMU rows (sensor-type column, nanoseconds), gyro rows only.
+    Phone(ImuRows),
 }
 
 /// Streaming, validating reader of a gyro log (CSV, `.gcsv` or MCAP): each
@@ -227,6 +266,14 @@ impl GyroReader {
                 direction: h.readout_direction,
             });
             (Source::Gcsv(rows), path)
+        } else if super::phone::is_imu_rows(path) {
+            if opts.time_unit != TimeUnit::S {
+                return Err(Error::invalid(
+                    path.display().to_string(),
+                    "IMU rows (a sensor-type column) carry nanosecond timestamps: leave --time-unit at its default",
+                ));
+            }
+            (Source::Phone(ImuRows::open(path)?), path)
         } else {
             let file = super::input::open_stream(path)?;
             (Source::Csv(CsvSource::open(Box::new(file), path)?), path)
@@ -288,6 +335,13 @@ impl GyroReader {
                 v: None,
                 depth: None,
             })),
+            Source::Phone(p) => Ok(p.next_row()?.map(|r| Raw {
+                line: r.line,
+                t: r.t,
+                w: r.omega,
+                v: None,
+                depth: None,
+            })),
             Source::Mcap(m) => match m.next().transpose()? {
                 Some(msg) => Ok(Some(Raw {
                     line: m.messages_read() as u64 + 1,
@@ -306,6 +360,7 @@ impl GyroReader {
         match &self.source {
             Source::Csv(c) => c.time_column(),
             Source::Gcsv(g) => g.time_column(),
+            Source::Phone(p) => p.time_column(),
             Source::Mcap(_) => "t",
         }
     }
@@ -315,6 +370,7 @@ impl GyroReader {
         match &self.source {
             Source::Csv(c) => c.position_line(),
             Source::Gcsv(g) => g.lines_read() + 1,
+            Source::Phone(p) => p.lines_read() + 1,
             Source::Mcap(m) => m.messages_read() as u64 + 2,
         }
     }

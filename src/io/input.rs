@@ -156,10 +156,41 @@ impl<R: Read> LineCap<R> {
     }
 }
 
+impl<R: Read> LineCap<R> {
+    /// Adds `k` bytes to the current line; the error once it is over the cap.
+    fn grow(&mut self, k: usize) -> std::io::Result<()> {
+        self.run += k;
+        if self.run > self.cap {
+            let e = line_too_long(&self.path, self.line, self.cap);
+            let text = e.to_string();
+            self.error = Some(e);
+            return Err(std::io::Error::other(text));
+        }
+        Ok(())
+    }
+}
+
 impl<R: Read> Read for LineCap<R> {
     fn read(&mut self, dst: &mut [u8]) -> std::io::Result<usize> {
         let n = self.inner.read(dst)?;
-        for &b in &dst[..n] {
+        let buf = &dst[..n];
+        let mut i = 0;
+        // Only line breaks and quotes change the state (and `#` first on a
+        // line): the bytes between them are counted in one step.
+        while i < n {
+            if self.start {
+                self.start = false;
+                if buf[i] == b'#' && !self.quoted {
+                    self.comment = true;
+                }
+            }
+            let Some(j) = memchr::memchr2(b'\n', b'"', &buf[i..]) else {
+                self.grow(n - i)?;
+                break;
+            };
+            self.grow(j)?;
+            let b = buf[i + j];
+            i += j + 1;
             if b == b'\n' && !self.quoted {
                 self.run = 0;
                 self.line += 1;
@@ -170,22 +201,58 @@ impl<R: Read> Read for LineCap<R> {
             if b == b'\n' {
                 self.line += 1;
             }
-            if self.start && b == b'#' && !self.quoted {
-                self.comment = true;
-            }
-            self.start = false;
             if b == b'"' && !self.comment {
                 self.quoted = !self.quoted;
             }
-            self.run += 1;
-            if self.run > self.cap {
-                let e = line_too_long(&self.path, self.line, self.cap);
-                let text = e.to_string();
-                self.error = Some(e);
-                return Err(std::io::Error::other(text));
-            }
+            self.grow(1)?;
         }
         Ok(n)
+    }
+}
+
+/// The lines of a text file (or pipe) one at a time, each at most
+/// [`MAX_LINE_BYTES`], without their line break (and `\r`): for the small
+/// hand-read tables (image lists, ffprobe output). Errors name the file and
+/// the line.
+pub struct TextLines {
+    src: std::io::BufReader<Box<dyn Read + Send>>,
+    path: PathBuf,
+    line: u64,
+    buf: Vec<u8>,
+}
+
+impl TextLines {
+    /// Opens `path` ([`open_stream`]).
+    pub fn open(path: &Path) -> Result<Self> {
+        let f: Box<dyn Read + Send> = Box::new(open_stream(path)?);
+        Ok(TextLines {
+            src: std::io::BufReader::with_capacity(1 << 16, f),
+            path: path.into(),
+            line: 0,
+            buf: Vec::new(),
+        })
+    }
+
+    /// The next line and its number (1-based), `None` at the end.
+    pub fn next_line(&mut self) -> Result<Option<(u64, String)>> {
+        let r = read_line(&mut self.src, &mut self.buf, MAX_LINE_BYTES)
+            .map_err(|e| Error::io(&self.path, e))?;
+        self.line += 1;
+        match r {
+            Line::Eof => Ok(None),
+            Line::TooLong => Err(line_too_long(&self.path, self.line, MAX_LINE_BYTES)),
+            Line::Read => {
+                let text = std::str::from_utf8(&self.buf).map_err(|_| Error::Parse {
+                    path: self.path.clone(),
+                    line: self.line,
+                    column: "-".into(),
+                    message: "the line is not UTF-8 text".into(),
+                })?;
+                let text = text.strip_suffix('\n').unwrap_or(text);
+                let text = text.strip_suffix('\r').unwrap_or(text);
+                Ok(Some((self.line, text.to_string())))
+            }
+        }
     }
 }
 

@@ -2,11 +2,13 @@
 //! files ([`images`]: EXR, sRGB PNG, textures) and gyro log readers
 //! (`gyro`: CSV, ROS 2 MCAP through `mcap` and Gyroflow `.gcsv` through
 //! [`gcsv`]; [`lines`]: one line at a time, for live streams); video frame
-//! tables ([`frames`]); [`input`]: the kind and size checks every reader
+//! tables ([`frames`]; a phone's image list and IMU rows in [`phone`],
+//! ffprobe's frames in [`ffprobe`]); [`input`]: the kind and size checks every reader
 //! shares (regular files and pipes only, capped lines, headers and image
 //! sizes). This layer imports nothing above `error`.
 
 pub mod atomic;
+pub mod ffprobe;
 pub mod frames;
 pub mod gcsv;
 pub mod gyro;
@@ -14,3 +16,4 @@ pub mod images;
 pub mod input;
 pub mod lines;
 pub(crate) mod mcap;
+pub mod phone;

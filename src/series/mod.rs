@@ -9,6 +9,7 @@
 
 pub mod frames;
 pub mod gpu;
+pub mod select;
 
 use crate::error::{Error, Result};
 use crate::io::gyro::{GyroReader, GyroSample};
@@ -157,7 +158,7 @@ pub fn run<W: Write>(
     exposure_s: Option<f64>,
     out: W,
 ) -> Result<u64> {
-    let mut out = std::io::BufWriter::with_capacity(1 << 16, out);
+    let mut out = std::io::BufWriter::with_capacity(1 << 20, out);
     let werr = |e: std::io::Error| Error::io("<series output>", e);
     out.write_all(match exposure_s {
         Some(_) => b"t,mmbm_mm_s,mmbm_px_s,blur_px\n".as_slice(),
@@ -193,40 +194,63 @@ pub fn run<W: Write>(
             }
         });
         let mut n = 0;
-        let (mut a, mut b, mut c) = (ryu::Buffer::new(), ryu::Buffer::new(), ryu::Buffer::new());
-        let mut d = ryu::Buffer::new();
         for batch in rx {
             let batch = batch?;
             if batch.is_empty() {
                 break;
             }
             let vals = eval(&batch)?;
-            for (s, m) in batch.iter().zip(&vals) {
-                let at =
-                    |e: Error| Error::invalid(format!("sample at t = {} s", s.t), e.to_string());
-                let px = crate::camera::checked_px_s(*m, pitch_mm).map_err(at)?;
-                let blur = exposure_s
-                    .map(|te| crate::camera::checked_blur_px(*m, te, pitch_mm))
-                    .transpose()
-                    .map_err(at)?;
-                for (i, x) in [a.format(s.t), b.format(*m), c.format(px)]
-                    .iter()
-                    .enumerate()
-                {
-                    if i > 0 {
-                        out.write_all(b",").map_err(werr)?;
-                    }
-                    out.write_all(x.as_bytes()).map_err(werr)?;
-                }
-                if let Some(blur) = blur {
-                    out.write_all(b",").map_err(werr)?;
-                    out.write_all(d.format(blur).as_bytes()).map_err(werr)?;
-                }
-                out.write_all(b"\n").map_err(werr)?;
+            if vals.len() != batch.len() {
+                return Err(Error::invalid(
+                    "series",
+                    format!("{} values for {} samples", vals.len(), batch.len()),
+                ));
+            }
+            // Formatted in parallel, written in order (the first error is
+            // the first bad sample's).
+            let texts: Vec<Result<Vec<u8>>> = batch
+                .par_chunks(FORMAT_CHUNK)
+                .zip(vals.par_chunks(FORMAT_CHUNK))
+                .map(|(b, v)| format_rows(b, v, pitch_mm, exposure_s))
+                .collect();
+            for text in texts {
+                out.write_all(&text?).map_err(werr)?;
             }
             n += batch.len() as u64;
         }
         out.flush().map_err(werr)?;
         Ok(n)
     })
+}
+
+/// Rows formatted per parallel task by [`run`].
+const FORMAT_CHUNK: usize = 2048;
+
+/// The CSV rows of `batch` with its MMBM values `vals` (mm/s): `t`, mm/s,
+/// px/s and, with an exposure, the blur in px, shortest round-trip floats
+/// (`ryu`); an error names the first sample whose px value overflows.
+fn format_rows(
+    batch: &[GyroSample],
+    vals: &[f64],
+    pitch_mm: f64,
+    exposure_s: Option<f64>,
+) -> Result<Vec<u8>> {
+    let mut out = Vec::with_capacity(batch.len() * 72);
+    let mut r = ryu::Buffer::new();
+    for (s, m) in batch.iter().zip(vals) {
+        let at = |e: Error| Error::invalid(format!("sample at t = {} s", s.t), e.to_string());
+        let px = crate::camera::checked_px_s(*m, pitch_mm).map_err(at)?;
+        out.extend_from_slice(r.format(s.t).as_bytes());
+        out.push(b',');
+        out.extend_from_slice(r.format(*m).as_bytes());
+        out.push(b',');
+        out.extend_from_slice(r.format(px).as_bytes());
+        if let Some(te) = exposure_s {
+            let blur = crate::camera::checked_blur_px(*m, te, pitch_mm).map_err(at)?;
+            out.push(b',');
+            out.extend_from_slice(r.format(blur).as_bytes());
+        }
+        out.push(b'\n');
+    }
+    Ok(out)
 }

@@ -37,20 +37,21 @@ pub(super) struct CsvSource {
     idx_v: Option<[usize; 3]>,
     idx_depth: Option<usize>,
     names: Vec<String>,
-    record: csv::StringRecord,
+    record: csv::ByteRecord,
 }
 
 impl CsvSource {
     /// Reads and checks the header of `input`, named `path` in errors.
     pub fn open(input: Box<dyn Read + Send>, path: &Path) -> Result<Self> {
         let capped = LineCap::new(input, path, MAX_LINE_BYTES);
+        // Fields are trimmed where they are read (`field`, the header here):
+        // the reader's own trimming rebuilds every record (an allocation each).
         let mut reader = csv::ReaderBuilder::new()
             .comment(Some(b'#'))
-            .trim(csv::Trim::All)
             .flexible(false)
-            .from_reader(BufReader::with_capacity(1 << 16, capped));
+            .from_reader(BufReader::with_capacity(1 << 18, capped));
         let names: Vec<String> = match reader.headers() {
-            Ok(h) => h.iter().map(|s| s.to_string()).collect(),
+            Ok(h) => h.iter().map(|s| s.trim().to_string()).collect(),
             Err(e) => return Err(csv_error(&mut reader, path, e, "header")),
         };
         let columns = Columns::find(&names, path)?;
@@ -62,7 +63,7 @@ impl CsvSource {
             idx_v: columns.v,
             idx_depth: columns.depth,
             names,
-            record: csv::StringRecord::new(),
+            record: csv::ByteRecord::new(),
         })
     }
 
@@ -88,7 +89,7 @@ impl CsvSource {
 
     /// The next record (None at the end of the file).
     pub fn next_raw(&mut self) -> Result<Option<Raw>> {
-        let more = match self.reader.read_record(&mut self.record) {
+        let more = match self.reader.read_byte_record(&mut self.record) {
             Ok(more) => more,
             Err(e) => return Err(csv_error(&mut self.reader, &self.path, e, "record")),
         };
@@ -124,20 +125,28 @@ impl CsvSource {
     }
 
     fn field(&self, idx: usize, line: u64) -> Result<f64> {
-        let s = &self.record[idx];
+        let raw = &self.record[idx];
         let col = &self.names[idx];
-        let x: f64 = s.parse().map_err(|_| Error::Parse {
-            path: self.path.clone(),
-            line,
-            column: col.clone(),
-            message: format!("{} is not a number", quote(s)),
-        })?;
+        // Bytes: only the columns read need be text (and numbers).
+        let fast = std::str::from_utf8(raw.trim_ascii())
+            .ok()
+            .and_then(|s| s.parse::<f64>().ok());
+        let text = || String::from_utf8_lossy(raw);
+        let x: f64 = match fast {
+            Some(x) => x,
+            None => text().trim().parse().map_err(|_| Error::Parse {
+                path: self.path.clone(),
+                line,
+                column: col.clone(),
+                message: format!("{} is not a number", quote(text().trim())),
+            })?,
+        };
         if !x.is_finite() {
             return Err(Error::Parse {
                 path: self.path.clone(),
                 line,
                 column: col.clone(),
-                message: format!("{} is not finite", quote(s)),
+                message: format!("{} is not finite", quote(text().trim())),
             });
         }
         Ok(x)

@@ -84,3 +84,59 @@ fn rejects_non_rotations() {
     assert!(parse_rotation("1,0,0").is_err());
     assert!(parse_rotation("-1,0,0,0,1,0,0,0,1").is_err());
 }
+
+#[test]
+fn a_reflection_names_its_determinant_and_the_proper_rotation() {
+    // Not orthonormal: the determinant is named, no rotation suggested.
+    let e = parse_rotation("1,0,0,0,1,0,0,0,2").unwrap_err().to_string();
+    assert!(e.contains("determinant 2") && !e.contains("negated"), "{e}");
+    // A reflection of x: negating row 1 gives the identity (the smallest rotation).
+    let e = parse_rotation("-1,0,0,0,1,0,0,0,1")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("determinant is -1"), "{e}");
+    assert!(e.contains("row 1 negated it is '1,0,0,0,1,0,0,0,1'"), "{e}");
+    // An axis swap (x <-> y): rows 1 and 2 both give a 90 degree turn; row 1 is named.
+    let e = parse_rotation("0,1,0,1,0,0,0,0,1").unwrap_err().to_string();
+    assert!(
+        e.contains("row 1 negated it is '0,-1,0,1,0,0,0,0,1'"),
+        "{e}"
+    );
+    // Every suggestion is accepted, for every signed permutation with det -1.
+    let perms = [
+        [0, 1, 2],
+        [0, 2, 1],
+        [1, 0, 2],
+        [1, 2, 0],
+        [2, 0, 1],
+        [2, 1, 0],
+    ];
+    let mut reflections = 0;
+    for p in perms {
+        for signs in 0..8 {
+            let mut v = [0.0f64; 9];
+            for r in 0..3 {
+                v[3 * r + p[r]] = if signs >> r & 1 == 1 { -1.0 } else { 1.0 };
+            }
+            let text: Vec<String> = v.iter().map(|x| x.to_string()).collect();
+            let text = text.join(",");
+            let m = glam::DMat3::from_cols_array(&v).transpose();
+            if m.determinant() > 0.0 {
+                assert!(parse_rotation(&text).is_ok(), "{text}");
+                continue;
+            }
+            reflections += 1;
+            let e = parse_rotation(&text).unwrap_err().to_string();
+            let suggested = e.split("negated it is '").nth(1).unwrap();
+            let suggested = &suggested[..suggested.find('\'').unwrap()];
+            let r = parse_rotation(suggested).unwrap();
+            // Exactly one row differs, by its sign.
+            let diff = (0..3)
+                .filter(|&i| (r.row(i) - m.row(i)).length() > 1e-12)
+                .collect::<Vec<_>>();
+            assert_eq!(diff.len(), 1, "{text} -> {suggested}");
+            assert!((r.row(diff[0]) + m.row(diff[0])).length() < 1e-12);
+        }
+    }
+    assert_eq!(reflections, 24);
+}
