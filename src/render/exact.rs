@@ -289,7 +289,8 @@ mod tests {
             (&vals6[..2], 0.4, 0.8, 0.3),
             (&vals6[..1], 0.2, 0.6, 0.2),
         ] {
-            let (m0, cnt, w, inside) = axis_weights(x as f32, p as f32, q as f32, vals.len() as u32);
+            let (m0, cnt, w, inside) =
+                axis_weights(x as f32, p as f32, q as f32, vals.len() as u32);
             let got: f64 = (0..cnt as usize)
                 .map(|k| w[k] as f64 * vals[m0 as usize + k])
                 .sum();
