@@ -134,18 +134,23 @@ fn axis_weights(x: f32, p: f32, q: f32, n: u32) -> Axis {
         return a;
     }
     let count = min(u32(m1 - m0 + 1), MAX_NODES);
+    // r[k] = R(x - m0 + 1 - k): node m0 + k reads r[k], r[k + 1], r[k + 2].
+    var r: array<f32, 10>;
+    let t0 = x - f32(m0) + 1.0;
+    for (var k = 0u; k < count + 2u; k = k + 1u) {
+        r[k] = ramp(t0 - f32(k), p, q);
+    }
     for (var k = 0u; k < count; k = k + 1u) {
         let m = m0 + i32(k);
-        let t = x - f32(m);
         var wk: f32;
         if (n == 1u) {
             wk = inside;
         } else if (m == 0) {
-            wk = 1.0 - ramp(t, p, q) + ramp(t - 1.0, p, q) - out_lo;
+            wk = 1.0 - r[k + 1u] + r[k + 2u] - out_lo;
         } else if (m == i32(n) - 1) {
-            wk = ramp(t + 1.0, p, q) - ramp(t, p, q) - out_hi;
+            wk = r[k] - r[k + 1u] - out_hi;
         } else {
-            wk = ramp(t + 1.0, p, q) - 2.0 * ramp(t, p, q) + ramp(t - 1.0, p, q);
+            wk = r[k] - 2.0 * r[k + 1u] + r[k + 2u];
         }
         a.w[k] = wk;
     }

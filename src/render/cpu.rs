@@ -178,8 +178,8 @@ pub fn pixel_sum(
 }
 
 /// Renders the whole image on the CPU: linear RGB, interleaved, mean over the
-/// `N` samples (or instants, `analytic`; with a texture, `exact`) of each pixel. `threads = Some(1)`
-/// runs single-threaded.
+/// `N` samples (or instants, `analytic`; images: `exact`) of each pixel.
+/// `threads = Some(1)` runs single-threaded.
 pub fn render(
     p: &RenderParams,
     homs: &[GpuHomography],

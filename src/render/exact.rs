@@ -126,18 +126,23 @@ pub fn axis_weights(x: f32, p: f32, q: f32, n: u32) -> (u32, u32, [f32; MAX_NODE
         return (0, 0, w, 0.0);
     }
     let count = ((m1 - m0 + 1) as usize).min(MAX_NODES);
+    // r[k] = R(x - m0 + 1 - k): node m0 + k reads r[k], r[k + 1], r[k + 2].
+    let mut r = [0.0f32; MAX_NODES + 2];
+    let t0 = x - m0 as f32 + 1.0;
+    for (k, rk) in r.iter_mut().enumerate().take(count + 2) {
+        *rk = ramp(t0 - k as f32, p, q);
+    }
     for (k, wk) in w.iter_mut().enumerate().take(count) {
         let m = m0 + k as i64;
-        let t = x - m as f32;
         *wk = if n == 1 {
             inside
         } else if m == 0 {
             // 1 out to the border, then down to 0 at node 1.
-            1.0 - ramp(t, p, q) + ramp(t - 1.0, p, q) - out_lo
+            1.0 - r[k + 1] + r[k + 2] - out_lo
         } else if m == n as i64 - 1 {
-            ramp(t + 1.0, p, q) - ramp(t, p, q) - out_hi
+            r[k] - r[k + 1] - out_hi
         } else {
-            ramp(t + 1.0, p, q) - 2.0 * ramp(t, p, q) + ramp(t - 1.0, p, q)
+            r[k] - 2.0 * r[k + 1] + r[k + 2]
         };
     }
     (m0 as u32, count as u32, w, inside)
