@@ -99,9 +99,9 @@ pub struct RenderOpts {
     /// default, fast, or MIN_SAMPLES:SPACING_PX.
     #[arg(long, default_value = "default")]
     pub quality: Quality,
-    /// Area integration: auto (analytic for checker and blobs, lattice for
-    /// images), analytic (closed-form pixel area, one sample per instant) or
-    /// lattice (supersampled area and time).
+    /// Area integration: auto (analytic, or lattice with defocus), analytic
+    /// (closed-form pixel area, one sample per instant: checker, blobs and
+    /// images) or lattice (supersampled area and time; the reference).
     #[arg(long, default_value = "auto")]
     pub integrator: Integrator,
     /// auto (GPU if any, else CPU), gpu, cpu, or bulk (a hardware GPU, else CPU).

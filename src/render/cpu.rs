@@ -178,8 +178,8 @@ pub fn pixel_sum(
 }
 
 /// Renders the whole image on the CPU: linear RGB, interleaved, mean over the
-/// `N` samples (or instants, `analytic`) of each pixel. `threads = Some(1)`
-/// runs single-threaded.
+/// `N` samples (or instants, `analytic`; images: `exact`) of each pixel.
+/// `threads = Some(1)` runs single-threaded.
 pub fn render(
     p: &RenderParams,
     homs: &[GpuHomography],
@@ -199,7 +199,9 @@ pub fn render(
                 return;
             }
             let (i, j) = (idx as u32 % w, idx as u32 / w);
-            let s = if analytic {
+            let s = if let (true, Some(t)) = (analytic, tex) {
+                super::exact::pixel_sum(p, homs, t, line_base(p, i, j), i, j)
+            } else if analytic {
                 pixel_sum_analytic(p, homs, i, j)
             } else {
                 pixel_sum(p, homs, tex, i, j)

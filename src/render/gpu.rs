@@ -14,14 +14,20 @@ use std::sync::OnceLock;
 /// WGSL source of the kernel.
 pub const SHADER: &str = include_str!("../../shaders/render.wgsl");
 
+/// WGSL source of the `analytic` kernel for image textures (same bindings).
+pub const TEXTURE_SHADER: &str = include_str!("../../shaders/texture.wgsl");
+
 /// Upper bound of pixel-samples in one dispatch.
 pub const SAMPLES_PER_DISPATCH: u64 = 1 << 25;
 
-/// The compiled kernel: its bind group layout and pipelines (`main`, `analytic`).
+/// The compiled kernels: render.wgsl's bind group layout and pipelines
+/// (`main`, `analytic`), texture.wgsl's (`texture`; the same layout entries).
 struct Kernel {
     bgl: wgpu::BindGroupLayout,
     lattice: wgpu::ComputePipeline,
     analytic: wgpu::ComputePipeline,
+    tex_bgl: wgpu::BindGroupLayout,
+    texture: wgpu::ComputePipeline,
 }
 
 /// The kernel's buffers, reused between frames (grown when too small).
@@ -80,10 +86,23 @@ fn kernel(ctx: &GpuContext) -> Result<&'static Kernel> {
             let (Some(lattice), Some(analytic)) = (it.next(), it.next()) else {
                 return Err("render.wgsl: missing pipeline".to_string());
             };
+            let t = compute::build(
+                ctx,
+                "texture.wgsl",
+                TEXTURE_SHADER,
+                Some(&layout),
+                &["texture"],
+            )
+            .map_err(|e| e.to_string())?;
+            let Some(texture) = t.pipelines.into_iter().next() else {
+                return Err("texture.wgsl: missing pipeline".to_string());
+            };
             Ok(Kernel {
                 bgl: p.bgl,
                 lattice,
                 analytic,
+                tex_bgl: t.bgl,
+                texture,
             })
         })
         .as_ref()
@@ -100,7 +119,11 @@ pub fn render(
     analytic: bool,
 ) -> Result<Vec<f32>> {
     let k = kernel(ctx)?;
-    let pipe = if analytic { &k.analytic } else { &k.lattice };
+    let (pipe, bgl) = match (analytic, tex.is_some()) {
+        (true, true) => (&k.texture, &k.tex_bgl),
+        (true, false) => (&k.analytic, &k.bgl),
+        (false, _) => (&k.lattice, &k.bgl),
+    };
     let dev = &ctx.device;
     let (w, h, n) = (p.dims[0], p.dims[1], p.dims[3]);
     let npix = w as u64 * h as u64;
@@ -195,7 +218,7 @@ pub fn render(
     }
     let bg = dev.create_bind_group(&wgpu::BindGroupDescriptor {
         label: Some("render"),
-        layout: &k.bgl,
+        layout: bgl,
         entries: &[
             wgpu::BindGroupEntry {
                 binding: 0,
@@ -278,5 +301,12 @@ mod tests {
         )
         .validate(&m)
         .expect("render.wgsl validates");
+        let m = naga::front::wgsl::parse_str(super::TEXTURE_SHADER).expect("texture.wgsl parses");
+        naga::valid::Validator::new(
+            naga::valid::ValidationFlags::all(),
+            naga::valid::Capabilities::default(),
+        )
+        .validate(&m)
+        .expect("texture.wgsl validates");
     }
 }

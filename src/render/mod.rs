@@ -7,10 +7,11 @@
 //! coordinates (`kernel`); `N` is chosen from the trajectory so that
 //! consecutive instants are at most `quality.max_spacing_px()` apart on the
 //! image (from the largest image path length over the sensor). Area, per
-//! [`Integrator`]: `analytic` (checker, blob board; the default for them)
-//! averages the target over the pixel's footprint in closed form at each
-//! instant; `lattice` (any target; images) supersamples area and time with a
-//! rank-1 lattice and a per-pixel shift, at least `quality.min_samples()`.
+//! [`Integrator`]: `analytic` (the default without defocus) averages the
+//! target over the pixel's footprint in closed form at each instant (the
+//! checker and the blob board in `cpu`, images' bilinear interpolant in
+//! `exact`); `lattice` (any target; the reference) supersamples area and time
+//! with a rank-1 lattice and a per-pixel shift, at least `quality.min_samples()`.
 //!
 //! The GPU kernel is `shaders/render.wgsl` (`gpu`); its CPU twin (`cpu`) is
 //! used when no adapter exists (announced once on stderr). [`maps`] gives the
@@ -18,6 +19,7 @@
 //! point-spread function at a pixel.
 
 pub(crate) mod cpu;
+pub(crate) mod exact;
 pub(crate) mod gpu;
 pub(crate) mod homography;
 pub(crate) mod kernel;
@@ -188,11 +190,12 @@ impl fmt::Display for Quality {
 /// How a pixel's area is integrated.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Integrator {
-    /// `analytic` for the checker and the blob board, `lattice` for images.
+    /// `analytic`, or `lattice` with defocus (a camera `[lens]`).
     #[default]
     Auto,
-    /// One sample per instant at the pixel centre, the area in closed form
-    /// (procedural targets only; see `shaders/render.wgsl`).
+    /// One sample per instant at the pixel centre, the area in closed form:
+    /// the checker's and the blob board's (`shaders/render.wgsl`), an image's
+    /// bilinear interpolant (`shaders/texture.wgsl`).
     Analytic,
     /// Supersampling of area and time (a rank-1 lattice; any target).
     Lattice,
@@ -345,7 +348,6 @@ fn render_frame_stream(job: &RenderJob, stream: u64) -> Result<RenderOutput> {
     }
     check_timing(job)?;
     let lmax = maps::max_path_px(cam, &job.target, &job.trajectory);
-    let is_image = matches!(job.target.kind, TargetKind::Image { .. });
     let defocus = cam.lens.is_some();
     let analytic = match job.integrator {
         Integrator::Analytic if defocus => {
@@ -354,13 +356,7 @@ fn render_frame_stream(job: &RenderJob, stream: u64) -> Result<RenderOutput> {
                 "defocus ([lens] in the camera) samples the aperture: use lattice (or auto)",
             ))
         }
-        Integrator::Auto => !is_image && !defocus,
-        Integrator::Analytic if is_image => {
-            return Err(Error::invalid(
-                "integrator",
-                "analytic integrates the checker and the blob board; images need lattice",
-            ))
-        }
+        Integrator::Auto => !defocus,
         Integrator::Analytic => true,
         Integrator::Lattice => false,
     };
