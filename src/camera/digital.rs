@@ -170,10 +170,7 @@ fn gopro_warp(p: &[f64; 16], u: f64, v: f64) -> ((f64, f64), Jac) {
     (
         (wx / f, wy),
         [
-            [
-                (ix * dwx_dx + (1.0 - ix)) / f,
-                iy * dwx_dy / f,
-            ],
+            [(ix * dwx_dx + (1.0 - ix)) / f, iy * dwx_dy / f],
             [ix * dwy_dx, iy * dwy_dy + (1.0 - iy)],
         ],
     )
@@ -205,7 +202,7 @@ pub fn to_recorded(lens: Lens, p: &[f64; 16], w: (f64, f64)) -> (f64, f64) {
             return c;
         }
         let det = j[0][0] * j[1][1] - j[0][1] * j[1][0];
-        if !(det.abs() > 1e-300) {
+        if det.is_nan() || det.abs() <= 1e-300 {
             break;
         }
         c.0 -= (j[1][1] * ex - j[0][1] * ey) / det;
@@ -293,15 +290,24 @@ mod tests {
         for (lens, p) in lenses() {
             for &(x, y) in &[(0.1, -0.2), (-0.45, 0.3), (0.3, 0.45), (-0.2, -0.05)] {
                 let (_, j) = to_wide(lens, &p, (x, y));
-                let (a, b) = (to_wide(lens, &p, (x + h, y)).0, to_wide(lens, &p, (x - h, y)).0);
-                let (c, d) = (to_wide(lens, &p, (x, y + h)).0, to_wide(lens, &p, (x, y - h)).0);
+                let (a, b) = (
+                    to_wide(lens, &p, (x + h, y)).0,
+                    to_wide(lens, &p, (x - h, y)).0,
+                );
+                let (c, d) = (
+                    to_wide(lens, &p, (x, y + h)).0,
+                    to_wide(lens, &p, (x, y - h)).0,
+                );
                 let fd = [
                     [(a.0 - b.0) / (2.0 * h), (c.0 - d.0) / (2.0 * h)],
                     [(a.1 - b.1) / (2.0 * h), (c.1 - d.1) / (2.0 * h)],
                 ];
                 for r in 0..2 {
                     for q in 0..2 {
-                        assert!((j[r][q] - fd[r][q]).abs() < 1e-6, "{lens:?} ({x},{y}) [{r}][{q}]");
+                        assert!(
+                            (j[r][q] - fd[r][q]).abs() < 1e-6,
+                            "{lens:?} ({x},{y}) [{r}][{q}]"
+                        );
                     }
                 }
                 let w = to_wide(lens, &p, (x, y)).0;

@@ -218,7 +218,8 @@ impl CameraFile {
         }
         let value: Value = serde_json::from_str(text).map_err(|e| config(e.to_string()))?;
         if value.get("fisheye_params").is_some() {
-            return super::gyroflow::from_gyroflow(&value, choice).map_err(|e| config(e.to_string()));
+            return super::gyroflow::from_gyroflow(&value, choice)
+                .map_err(|e| config(e.to_string()));
         }
         let file: CameraFile = serde_json::from_value(value).map_err(|e| config(e.to_string()))?;
         file.camera().map_err(|e| config(e.to_string()))

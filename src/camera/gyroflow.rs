@@ -85,7 +85,11 @@ fn matching(p: &Value) -> Vec<Value> {
                     if let Some(m) = c["fisheye_params"]["camera_matrix"].as_array_mut() {
                         for (r, cols, ratio) in [(0, [0, 2], rw), (1, [1, 2], rh)] {
                             for col in cols {
-                                if let Some(v) = m.get(r).and_then(|row| row.get(col)).and_then(Value::as_f64) {
+                                if let Some(v) = m
+                                    .get(r)
+                                    .and_then(|row| row.get(col))
+                                    .and_then(Value::as_f64)
+                                {
                                     m[r][col] = (v * ratio).into();
                                 }
                             }
@@ -94,7 +98,13 @@ fn matching(p: &Value) -> Vec<Value> {
                 }
             }
         }
-        for key in ["frame_readout_time", "crop", "digital_lens", "focal_length", "interpolations"] {
+        for key in [
+            "frame_readout_time",
+            "crop",
+            "digital_lens",
+            "focal_length",
+            "interpolations",
+        ] {
             if let Some(v) = x.get(key) {
                 c[key] = v.clone();
             }
@@ -127,7 +137,11 @@ pub fn select(p: &Value, choice: &Choice) -> Result<Value> {
         // A portrait video on a landscape profile (or the other way): Gyroflow
         // turns the profile first; match in the profile's orientation.
         let turned = (vw > vh && w < h) || (vw < vh && w > h);
-        let (vw, vh) = if turned { (vh as u64, vw as u64) } else { (vw as u64, vh as u64) };
+        let (vw, vh) = if turned {
+            (vh as u64, vw as u64)
+        } else {
+            (vw as u64, vh as u64)
+        };
         let aspect = |w: u64, h: u64| (w as f64 * 100.0 / h.max(1) as f64).round() as u64;
         let by_size = all.iter().find(|c| dims(c) == Some((vw, vh)));
         let by_aspect = || {
@@ -139,7 +153,10 @@ pub fn select(p: &Value, choice: &Choice) -> Result<Value> {
         }
     }
     // Gyroflow's `adjust_lens_profile` of a digital lens.
-    if let (Some(lens), Some((w, h))) = (chosen.get("digital_lens").and_then(Value::as_str), dims(&chosen)) {
+    if let (Some(lens), Some((w, h))) = (
+        chosen.get("digital_lens").and_then(Value::as_str),
+        dims(&chosen),
+    ) {
         let aspect = (w as f64 / h as f64 * 100.0) as u64;
         let widen = match lens {
             "gopro_superview" | "gopro6_superview" if aspect == 133 => Some(1.3333333333333),
@@ -213,7 +230,10 @@ fn interpolated(p: &Value, f: f64) -> Result<Value> {
     let (first, last) = (entries[0].0, entries[entries.len() - 1].0);
     let lookup = key.min(last - 1).max(first + 1);
     let i1 = entries.iter().rposition(|e| e.0 <= lookup).unwrap_or(0);
-    let i2 = entries.iter().position(|e| e.0 >= lookup).unwrap_or(entries.len() - 1);
+    let i2 = entries
+        .iter()
+        .position(|e| e.0 >= lookup)
+        .unwrap_or(entries.len() - 1);
     let (p1, p2) = (&entries[i1], &entries[i2]);
     if p1.0 == lookup || p1.0 == p2.0 {
         return Ok(p1.1.clone());
@@ -251,7 +271,10 @@ fn interpolated(p: &Value, f: f64) -> Result<Value> {
     }
     let crop = |v: &Value| v.get("crop").and_then(Value::as_f64).unwrap_or(1.0);
     out["crop"] = lerp(crop(&p1.1), crop(&p2.1)).into();
-    if let (Some(a), Some(b)) = (get(&p1.1, &["focal_length"], &[]), get(&p2.1, &["focal_length"], &[])) {
+    if let (Some(a), Some(b)) = (
+        get(&p1.1, &["focal_length"], &[]),
+        get(&p2.1, &["focal_length"], &[]),
+    ) {
         out["focal_length"] = lerp(a, b).into();
     }
     Ok(out)
@@ -329,7 +352,12 @@ pub fn from_gyroflow(p: &Value, choice: &Choice) -> Result<Camera> {
                 ),
             )
         })?),
-        Some(v) => return Err(Error::invalid("digital_lens", format!("expected a name, got {v}"))),
+        Some(v) => {
+            return Err(Error::invalid(
+                "digital_lens",
+                format!("expected a name, got {v}"),
+            ))
+        }
     };
     let mut params = [0.0; 16];
     if let Some(a) = p.get("digital_lens_params").and_then(Value::as_array) {
@@ -467,4 +495,3 @@ fn gyroflow_direction(s: &str) -> Result<Readout> {
         )
     })
 }
-

@@ -1,8 +1,8 @@
 //! Radial lens models in the pinhole radius `r = |(x, y)|` (normalised
 //! units): the distorted point is `s(r) (x, y)`. Shared by Gyroflow's
 //! `poly3`, `poly5`, `ptlens`, `sony` and `generic_polynomial`
-//! (`super::poly3`, `super::poly5`, `super::ptlens`, `super::sony`), each of
-//! which gives its `s(r)` and `ds/dr` ([`Profile`]).
+//! (files `poly3.rs`, `poly5.rs`, `ptlens.rs`, `sony.rs`), each of which
+//! gives its `s(r)` and `ds/dr` ([`Profile`]).
 //!
 //! The model is one-to-one only up to its turning point, the first ray
 //! angle `theta = atan r` (rad) where `d(r s(r))/dr <= 0`, and below 90
@@ -144,7 +144,10 @@ mod tests {
         assert!((limit(&Cubic) - 2.0 / 3.0).abs() < 1e-12);
         for &t in &[1e-9, 0.1, 0.5, 0.66] {
             let r = solve(&Cubic, t, 1e-15).unwrap();
-            assert!(r <= 1.0 && (r - r * r * r / 3.0 - t).abs() < 1e-14, "{t}: {r}");
+            assert!(
+                r <= 1.0 && (r - r * r * r / 3.0 - t).abs() < 1e-14,
+                "{t}: {r}"
+            );
         }
         assert_eq!(solve(&Cubic, 0.7, 1e-15), None);
     }
