@@ -85,6 +85,10 @@ pub struct CameraArgs {
     /// portrait WxH on a landscape camera transposes it first, as Gyroflow does.
     #[arg(long, value_name = "WxH", value_parser = parse_resolution, conflicts_with = "sensor")]
     pub scale_to: Option<(u32, u32)>,
+    /// A Gyroflow zoom profile's focal length, mm: the profile's `interpolations` at
+    /// it (default: the profile as it is, as Gyroflow without lens metadata).
+    #[arg(long, value_name = "MM")]
+    pub lens_focal: Option<f64>,
     /// Rolling-shutter readout, s: delay between the first and last line's
     /// exposure start (0 = global shutter; overrides the camera file's readout_s).
     #[arg(long, value_name = "S")]
@@ -114,6 +118,7 @@ impl CameraArgs {
             },
             scale_to: self.scale_to,
             light_e_per_s: self.light,
+            lens_focal_mm: self.lens_focal,
         };
         Camera::resolve(self.camera.as_deref(), &over)
     }

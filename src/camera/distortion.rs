@@ -10,6 +10,14 @@
 //! definitions; tests compare it with finite differences) and an iterative
 //! inverse ([`Distortion::undistort`], Newton's method to [`UNDISTORT_TOL`]).
 
+use super::digital::Warp;
+use super::insta360;
+use super::models::Model;
+use super::poly3::Poly3;
+use super::poly5::Poly5;
+use super::ptlens::Ptlens;
+use super::radial::{self, Profile};
+use super::sony::ThetaPoly;
 use crate::error::{Error, Result};
 use serde::{Deserialize, Serialize};
 
@@ -69,6 +77,60 @@ pub enum Distortion {
         #[serde(default)]
         k4: f64,
     },
+    /// Gyroflow's `poly3`: `x (1 + k1 r^2)` (`super::poly3`).
+    Poly3 {
+        /// Coefficient of `r^2`.
+        #[serde(default)]
+        k1: f64,
+    },
+    /// Gyroflow's `poly5`: `x (1 + k1 r^2 + k2 r^4)` (`super::poly5`).
+    Poly5 {
+        /// Coefficient of `r^2`.
+        #[serde(default)]
+        k1: f64,
+        /// Coefficient of `r^4`.
+        #[serde(default)]
+        k2: f64,
+    },
+    /// Gyroflow's `ptlens`: `x (1 + c r + b r^2 + a r^3)` (`super::ptlens`).
+    Ptlens {
+        /// Coefficient of `r^3`.
+        #[serde(default)]
+        a: f64,
+        /// Coefficient of `r^2`.
+        #[serde(default)]
+        b: f64,
+        /// Coefficient of `r`.
+        #[serde(default)]
+        c: f64,
+    },
+    /// Gyroflow's `sony`: `theta_d = k0 theta + ... + k5 theta^6` (`super::sony`).
+    Sony {
+        /// The 6 coefficients.
+        k: [f64; 6],
+    },
+    /// Gyroflow's `generic_polynomial`: `theta_d = k0 theta + ... + k11 theta^12` (`super::sony`).
+    #[serde(rename = "generic_polynomial")]
+    GenericPolynomial {
+        /// The 12 coefficients.
+        k: [f64; 12],
+    },
+    /// Gyroflow's `insta360`: `[k1, k2, k3, p1, p2, xi]` (`super::insta360`).
+    Insta360 {
+        /// The 6 coefficients in Gyroflow's order.
+        k: [f64; 6],
+    },
+    /// An optical model under a digital lens's warp (Gyroflow's
+    /// `digital_lens`, `super::digital`): the recorded point is the warp of
+    /// the optical distorted point.
+    Digital {
+        /// The warp and the optical image's place in the video frame.
+        warp: Warp,
+        /// The optical model.
+        optical: Model,
+        /// Its coefficients (Gyroflow's order, zeros past its count).
+        k: [f64; 12],
+    },
 }
 
 /// A 2x2 Jacobian, row-major: `[[dxd/dx, dxd/dy], [dyd/dx, dyd/dy]]`.
@@ -119,12 +181,73 @@ impl Distortion {
             Distortion::None => (0, [0.0; 5]),
             Distortion::Opencv { k1, k2, p1, p2, k3 } => (1, [k1, k2, p1, p2, k3]),
             Distortion::Fisheye { k1, k2, k3, k4 } => (2, [k1, k2, k3, k4, 0.0]),
-            Distortion::OpencvStandard { .. } => return None,
+            _ => return None,
         })
+    }
+
+    /// The radial profile of the radial models of `super::radial`.
+    fn radial(&self) -> Option<Radial> {
+        Some(match *self {
+            Distortion::Poly3 { k1 } => Radial::P3(Poly3(k1)),
+            Distortion::Poly5 { k1, k2 } => Radial::P5(Poly5([k1, k2])),
+            Distortion::Ptlens { a, b, c } => Radial::Pt(Ptlens([a, b, c])),
+            Distortion::Sony { k } => {
+                let mut t = [0.0; 12];
+                t[..6].copy_from_slice(&k);
+                Radial::Theta(ThetaPoly(t))
+            }
+            Distortion::GenericPolynomial { k } => Radial::Theta(ThetaPoly(k)),
+            _ => return None,
+        })
+    }
+
+    /// True for a distorted normalised point `(xd, yd)` beyond the radial
+    /// distortion limit (for a digital lens: its optical point beyond the
+    /// optical model's limit, or a point the warp does not invert).
+    pub fn is_masked(&self, xd: f64, yd: f64) -> bool {
+        match *self {
+            Distortion::Digital { warp, .. } => {
+                let (x, y) = warp.unrecord(xd, yd);
+                x.hypot(y) > self.optical().radial_limit() || x.is_nan() || y.is_nan()
+            }
+            _ => xd.hypot(yd) > self.radial_limit(),
+        }
     }
 
     /// Rejects non-finite coefficients, naming the key.
     pub fn validate(&self) -> Result<()> {
+        if let Distortion::Digital { warp, .. } = self {
+            let frame_ok = warp.frame.iter().all(|v| v.is_finite())
+                && warp.frame[0] > 0.0
+                && warp.frame[1] > 0.0;
+            let stretch_ok = warp.lens != super::digital::Lens::DigitalStretch
+                || (warp.params[0] > 0.0 && warp.params[1] > 0.0);
+            if !frame_ok || !stretch_ok || !warp.params.iter().all(|v| v.is_finite()) {
+                return Err(Error::invalid(
+                    "distortion.warp",
+                    format!(
+                        "the {} warp needs finite parameters (a positive frame scale and \
+                         stretch), got params {:?}, frame {:?}",
+                        warp.lens.name(),
+                        warp.params,
+                        warp.frame
+                    ),
+                ));
+            }
+        }
+        if !matches!(
+            self,
+            Distortion::None | Distortion::Opencv { .. } | Distortion::Fisheye { .. }
+        ) {
+            let (m, k) = self.parts();
+            if let Some(i) = k.iter().position(|v| !v.is_finite()) {
+                return Err(Error::invalid(
+                    format!("distortion.k[{i}]"),
+                    format!("{} needs finite coefficients, got {}", m.name(), k[i]),
+                ));
+            }
+            return Ok(());
+        }
         if let Distortion::OpencvStandard { k } = self {
             if let Some(i) = k.iter().position(|v| !v.is_finite()) {
                 return Err(Error::invalid(
@@ -168,6 +291,15 @@ impl Distortion {
                 let s = self.fisheye_scale(x, y).0;
                 (s * x, s * y)
             }
+            Distortion::Insta360 { k } => insta360::distort(&k, x, y),
+            Distortion::Digital { warp, .. } => {
+                let (xd, yd) = self.optical().distort(x, y);
+                warp.record(xd, yd).0
+            }
+            _ => match self.radial() {
+                Some(p) => radial::distort(p.profile(), x, y),
+                None => (x, y),
+            },
         }
     }
 
@@ -182,10 +314,17 @@ impl Distortion {
     /// The radial distortion limit (normalised distorted radius) beyond
     /// which no pinhole ray is seen, Gyroflow's `radial_distortion_limit`:
     /// the fisheye's `fisheye::limit`; infinite for the other models.
+    /// The radial models' (`super::radial`) limit likewise; for a digital
+    /// lens the optical model's, on the optical image ([`Distortion::is_masked`]
+    /// un-warps first); `insta360` and OpenCV's have none (as in Gyroflow).
     pub fn radial_limit(&self) -> f64 {
         match self {
             Distortion::Fisheye { .. } => super::fisheye::limit(self.fisheye_k()),
-            _ => f64::INFINITY,
+            Distortion::Digital { .. } => self.optical().radial_limit(),
+            _ => match self.radial() {
+                Some(p) => radial::limit(p.profile()),
+                None => f64::INFINITY,
+            },
         }
     }
 
@@ -242,6 +381,17 @@ impl Distortion {
                 let (s, g) = self.fisheye_scale(x, y);
                 [[s + g * x * x, g * x * y], [g * x * y, s + g * y * y]]
             }
+            Distortion::Insta360 { k } => insta360::jacobian(&k, x, y),
+            Distortion::Digital { warp, .. } => {
+                let o = self.optical();
+                let (xd, yd) = o.distort(x, y);
+                let (_, jw) = warp.record(xd, yd);
+                mul(&jw, &o.jacobian(x, y))
+            }
+            _ => match self.radial() {
+                Some(p) => radial::jacobian(p.profile(), x, y),
+                None => IDENTITY,
+            },
         }
     }
 
@@ -262,6 +412,19 @@ impl Distortion {
             let r = th.tan();
             let (x, y) = (xd * r / rd, yd * r / rd);
             return self.converged(x, y, xd, yd);
+        }
+        if let Distortion::Digital { warp, .. } = *self {
+            let (xo, yo) = warp.unrecord(xd, yd);
+            let (x, y) = self.optical().undistort(xo, yo)?;
+            return self.converged(x, y, xd, yd);
+        }
+        if let Some(p) = self.radial() {
+            let rd = xd.hypot(yd);
+            if rd == 0.0 {
+                return Some((0.0, 0.0));
+            }
+            let r = radial::solve(p.profile(), rd, UNDISTORT_TOL * 1e-2)?;
+            return self.converged(xd * r / rd, yd * r / rd, xd, yd);
         }
         let (mut x, mut y) = (xd, yd);
         for _ in 0..MAX_ITER {
@@ -288,6 +451,40 @@ impl Distortion {
     }
 }
 
+/// The radial models' profiles (`super::radial::Profile`), without allocation.
+enum Radial {
+    P3(Poly3),
+    P5(Poly5),
+    Pt(Ptlens),
+    Theta(ThetaPoly),
+}
+
+impl Radial {
+    fn profile(&self) -> &dyn Profile {
+        match self {
+            Radial::P3(p) => p,
+            Radial::P5(p) => p,
+            Radial::Pt(p) => p,
+            Radial::Theta(p) => p,
+        }
+    }
+}
+
+/// The product `a b` of two 2x2 matrices.
+#[inline]
+pub fn mul(a: &Jac, b: &Jac) -> Jac {
+    [
+        [
+            a[0][0] * b[0][0] + a[0][1] * b[1][0],
+            a[0][0] * b[0][1] + a[0][1] * b[1][1],
+        ],
+        [
+            a[1][0] * b[0][0] + a[1][1] * b[1][0],
+            a[1][0] * b[0][1] + a[1][1] * b[1][1],
+        ],
+    ]
+}
+
 /// `J v` for a 2x2 Jacobian.
 #[inline]
 pub fn apply(j: &Jac, v: (f64, f64)) -> (f64, f64) {
@@ -299,22 +496,7 @@ mod tests {
     use super::*;
 
     fn models() -> Vec<Distortion> {
-        vec![
-            Distortion::WIDE_ANGLE,
-            Distortion::Opencv {
-                k1: 0.12,
-                k2: -0.03,
-                p1: 0.0,
-                p2: 0.0,
-                k3: 0.0,
-            },
-            Distortion::Fisheye {
-                k1: 0.031,
-                k2: 0.06,
-                k3: -0.05,
-                k4: 0.012,
-            },
-        ]
+        crate::camera::parts::samples()
     }
 
     #[test]

@@ -35,7 +35,7 @@
 //! `use_opencv_standard: true`), `frame_readout_time` (ms) and
 //! `frame_readout_direction`. A profile gives pixels only: the pixel pitch is
 //! `focal_length / fx` when the profile has a `focal_length` in mm, otherwise a
-//! nominal 1 um ([`NOMINAL_PITCH_MM`]), which scales the mm/s outputs but not px/s.
+//! nominal 1 um (`gyroflow::NOMINAL_PITCH_MM`), which scales the mm/s outputs but not px/s.
 
 use super::distortion::Distortion;
 use super::intrinsics::Camera;
@@ -47,8 +47,7 @@ use serde::{Deserialize, Serialize};
 use serde_json::Value;
 use std::path::Path;
 
-/// Pixel pitch (mm) assumed for a Gyroflow profile without a focal length in mm.
-pub const NOMINAL_PITCH_MM: f64 = 0.001;
+pub use super::gyroflow::Choice;
 
 /// Largest camera file read, bytes (a real one is under 10 kB; Gyroflow
 /// profiles a few kB). Bounds the parsers' time and memory: a 6 MB TOML
@@ -186,6 +185,7 @@ impl CameraFile {
             noise: self.noise.or(base.noise),
             lens: self.lens.or(base.lens),
         }
+        .refit_digital()
     }
 
     /// The camera of a configuration's `[camera]` section (the experiment's;
@@ -201,6 +201,13 @@ impl CameraFile {
     /// object with `fisheye_params`). Errors name `path` and the key. Not
     /// validated.
     pub fn parse(text: &str, path: &Path) -> Result<Camera> {
+        Self::parse_for(text, path, &Choice::default())
+    }
+
+    /// [`CameraFile::parse`] for a video of `choice`'s size and a zoom lens's
+    /// focal length (a Gyroflow profile's `compatible_settings` and
+    /// `interpolations`, `super::gyroflow`).
+    pub fn parse_for(text: &str, path: &Path, choice: &Choice) -> Result<Camera> {
         let config = |message: String| Error::Config {
             path: path.into(),
             message,
@@ -211,7 +218,8 @@ impl CameraFile {
         }
         let value: Value = serde_json::from_str(text).map_err(|e| config(e.to_string()))?;
         if value.get("fisheye_params").is_some() {
-            return from_gyroflow(&value).map_err(|e| config(e.to_string()));
+            return super::gyroflow::from_gyroflow(&value, choice)
+                .map_err(|e| config(e.to_string()));
         }
         let file: CameraFile = serde_json::from_value(value).map_err(|e| config(e.to_string()))?;
         file.camera().map_err(|e| config(e.to_string()))
@@ -233,6 +241,10 @@ pub struct CameraOverrides {
     /// Then sensor noise at this light level (electrons per second of a
     /// white pixel), with the camera's other noise keys or their defaults.
     pub light_e_per_s: Option<f64>,
+    /// A Gyroflow zoom profile's focal length, mm: its `interpolations` at
+    /// that focal length (none: the profile as it is, as Gyroflow without
+    /// lens metadata).
+    pub lens_focal_mm: Option<f64>,
 }
 
 impl Camera {
@@ -243,8 +255,14 @@ impl Camera {
     /// ([`crate::bounded::read_text`]: a regular file or a pipe, at most
     /// [`crate::bounded::MAX_TEXT_BYTES`]). Errors name the file and the key.
     pub fn load(path: &Path) -> Result<Self> {
+        Self::load_for(path, &Choice::default())
+    }
+
+    /// [`Camera::load`] for a video of `choice`'s size and a zoom lens's focal
+    /// length (a Gyroflow profile's `compatible_settings` and `interpolations`).
+    pub fn load_for(path: &Path, choice: &Choice) -> Result<Self> {
         let text = crate::bounded::read_text_at_most(path, MAX_CAMERA_BYTES)?;
-        let cam = CameraFile::parse(&text, path)?;
+        let cam = CameraFile::parse_for(&text, path, choice)?;
         cam.validate().map_err(|e| Error::Config {
             path: path.into(),
             message: e.to_string(),
@@ -256,7 +274,13 @@ impl Camera {
     /// camera) with `over` applied, validated.
     pub fn resolve(file: Option<&Path>, over: &CameraOverrides) -> Result<Self> {
         let base = match file {
-            Some(p) => Camera::load(p)?,
+            Some(p) => Camera::load_for(
+                p,
+                &Choice {
+                    video: over.scale_to,
+                    focal_mm: over.lens_focal_mm,
+                },
+            )?,
             None => Camera::thesis(),
         };
         let mut c = over.keys.over(&base);
@@ -272,196 +296,6 @@ impl Camera {
         c.validate()?;
         Ok(c)
     }
-}
-
-fn num(v: &Value, key: &str) -> Result<f64> {
-    v.as_f64()
-        .filter(|x| x.is_finite())
-        .ok_or_else(|| Error::invalid(key, format!("expected a finite number, got {v}")))
-}
-
-/// A camera from a parsed Gyroflow lens profile.
-pub fn from_gyroflow(p: &Value) -> Result<Camera> {
-    let dims = p.get("calib_dimension").ok_or_else(|| {
-        Error::invalid(
-            "calib_dimension",
-            "missing (expected {\"w\": .., \"h\": ..})",
-        )
-    })?;
-    let dim = |k: &str| -> Result<u32> {
-        let key = format!("calib_dimension.{k}");
-        let v = dims.get(k).ok_or_else(|| Error::invalid(&key, "missing"))?;
-        v.as_u64()
-            .filter(|&n| n > 0 && n <= u32::MAX as u64)
-            .map(|n| n as u32)
-            .ok_or_else(|| Error::invalid(&key, format!("expected a positive integer, got {v}")))
-    };
-    let (w, h) = (dim("w")?, dim("h")?);
-    let fp = &p["fisheye_params"];
-    let m = fp
-        .get("camera_matrix")
-        .and_then(Value::as_array)
-        .filter(|rows| rows.len() == 3)
-        .ok_or_else(|| Error::invalid("fisheye_params.camera_matrix", "expected a 3x3 array"))?;
-    let mut k = [[0.0; 3]; 3];
-    for (r, row) in m.iter().enumerate() {
-        let row = row.as_array().filter(|c| c.len() == 3).ok_or_else(|| {
-            Error::invalid("fisheye_params.camera_matrix", "expected a 3x3 array")
-        })?;
-        for (c, v) in row.iter().enumerate() {
-            k[r][c] = num(v, &format!("fisheye_params.camera_matrix[{r}][{c}]"))?;
-        }
-    }
-    // Gyroflow divides the focal lengths by `crop` and takes their size
-    // (a negative fx or fy is a mirrored calibration; the speed is the same).
-    let crop = match p.get("crop") {
-        None | Some(Value::Null) => 1.0,
-        Some(v) => num(v, "crop")?,
-    };
-    if crop.is_nan() || crop <= 0.0 {
-        return Err(Error::invalid(
-            "crop",
-            format!("must be positive, got {crop}"),
-        ));
-    }
-    let (fx, fy) = ((k[0][0] / crop).abs(), (k[1][1] / crop).abs());
-    if !(fx > 0.0 && fy > 0.0) {
-        return Err(Error::invalid(
-            "fisheye_params.camera_matrix",
-            format!(
-                "focal lengths must be non-zero, got fx = {}, fy = {}",
-                k[0][0], k[1][1]
-            ),
-        ));
-    }
-    if let Some(lens) = p.get("digital_lens").filter(|v| !v.is_null()) {
-        return Err(Error::invalid(
-            "digital_lens",
-            format!(
-                "{lens} is not supported (mmbm reads optical lens models only; a digital \
-                 lens warp such as gopro_superview is not applied)"
-            ),
-        ));
-    }
-    let coeffs: Vec<f64> = match fp.get("distortion_coeffs") {
-        None | Some(Value::Null) => vec![],
-        Some(Value::Array(a)) => a
-            .iter()
-            .enumerate()
-            .map(|(i, v)| num(v, &format!("fisheye_params.distortion_coeffs[{i}]")))
-            .collect::<Result<_>>()?,
-        Some(v) => {
-            return Err(Error::invalid(
-                "fisheye_params.distortion_coeffs",
-                format!("expected an array, got {v}"),
-            ))
-        }
-    };
-    let model = match p.get("distortion_model").and_then(Value::as_str) {
-        Some(s) => s.to_string(),
-        None if p.get("use_opencv_standard").and_then(Value::as_bool) == Some(true) => {
-            "opencv_standard".into()
-        }
-        None => "opencv_fisheye".into(),
-    };
-    let distortion = gyroflow_distortion(&model, &coeffs)?;
-    let focal_mm = match p.get("focal_length").and_then(Value::as_f64) {
-        Some(f) if f > 0.0 && f.is_finite() => f,
-        _ => fx * NOMINAL_PITCH_MM,
-    };
-    let readout_ms = match p.get("frame_readout_time") {
-        None | Some(Value::Null) => 0.0,
-        Some(v) => num(v, "frame_readout_time")?,
-    };
-    let mut direction = match p.get("frame_readout_direction") {
-        None | Some(Value::Null) => Readout::TopToBottom,
-        Some(Value::String(s)) => gyroflow_direction(s)?,
-        Some(v) => gyroflow_direction(&v.to_string())?,
-    };
-    // Gyroflow: a negative readout time is the opposite direction.
-    if readout_ms < 0.0 {
-        direction = direction.reversed();
-    }
-    // The principal point is the image centre unless the profile says
-    // `asymmetrical: true` (Gyroflow's `get_camera_matrix`).
-    let asymmetrical = p.get("asymmetrical").and_then(Value::as_bool) == Some(true);
-    let (cx, cy) = if asymmetrical {
-        (k[0][2], k[1][2])
-    } else {
-        (w as f64 / 2.0, h as f64 / 2.0)
-    };
-    Ok(Camera {
-        focal_mm,
-        pitch_x_mm: focal_mm / fx,
-        pitch_y_mm: focal_mm / fy,
-        width: w,
-        height: h,
-        cx,
-        cy,
-        skew: k[0][1],
-        distortion,
-        shutter: Shutter {
-            readout_s: readout_ms.abs() / 1000.0,
-            direction,
-        },
-        noise: None,
-        lens: None,
-    })
-}
-
-/// The distortion of a Gyroflow profile's `distortion_model` and
-/// `distortion_coeffs` (missing coefficients are 0). Coefficients that are
-/// all zero (or none) are the plain pinhole, as in Gyroflow; a model mmbm
-/// does not implement is refused by name, and so is an `opencv_fisheye`
-/// with more than its 4 coefficients or an `opencv_standard` with more than
-/// its 12 (none is dropped silently).
-fn gyroflow_distortion(model: &str, coeffs: &[f64]) -> Result<Distortion> {
-    let c = |i: usize| coeffs.get(i).copied().unwrap_or(0.0);
-    let most = match model {
-        "opencv_fisheye" => 4,
-        "opencv_standard" => 12,
-        other => {
-            return Err(Error::invalid(
-                "distortion_model",
-                format!(
-                    "'{other}' is not supported (mmbm reads opencv_fisheye and opencv_standard; \
-                     Gyroflow's poly3, poly5, ptlens, insta360 and sony models are not implemented)"
-                ),
-            ))
-        }
-    };
-    if let Some(i) = (most..coeffs.len()).find(|&i| coeffs[i] != 0.0) {
-        return Err(Error::invalid(
-            format!("fisheye_params.distortion_coeffs[{i}]"),
-            format!(
-                "{model} has {most} coefficients, this profile gives a non-zero {}th",
-                i + 1
-            ),
-        ));
-    }
-    if coeffs.iter().all(|&x| x == 0.0) {
-        return Ok(Distortion::None);
-    }
-    Ok(if model == "opencv_fisheye" {
-        Distortion::Fisheye {
-            k1: c(0),
-            k2: c(1),
-            k3: c(2),
-            k4: c(3),
-        }
-    } else {
-        Distortion::opencv_standard(std::array::from_fn(c))
-    })
-}
-
-/// Gyroflow's direction names and numbers ([`Readout::from_gyroflow`]).
-fn gyroflow_direction(s: &str) -> Result<Readout> {
-    Readout::from_gyroflow(s.trim_matches('"')).ok_or_else(|| {
-        Error::invalid(
-            "frame_readout_direction",
-            format!("'{s}' is not a readout direction"),
-        )
-    })
 }
 
 #[cfg(test)]
@@ -539,6 +373,7 @@ mod tests {
             },
             scale_to: Some((1280, 960)),
             light_e_per_s: Some(1000.0),
+            lens_focal_mm: None,
         };
         let c = Camera::resolve(None, &over).unwrap();
         let mut want = Camera {

@@ -131,6 +131,23 @@ impl Camera {
             skew: self.skew * sx,
             ..*self
         }
+        .refit_digital()
+    }
+
+    /// A digital lens's warp placed on this camera's frame (its `[fx / W, fy
+    /// / H, cx / W - 0.5, cy / H - 0.5]`, `super::digital`); the camera
+    /// unchanged without one.
+    pub fn refit_digital(mut self) -> Self {
+        if let Distortion::Digital { ref mut warp, .. } = self.distortion {
+            let (w, h) = (self.width as f64, self.height as f64);
+            warp.frame = [
+                self.focal_mm / self.pitch_x_mm / w,
+                self.focal_mm / self.pitch_y_mm / h,
+                self.cx / w - 0.5,
+                self.cy / h - 0.5,
+            ];
+        }
+        self
     }
 
     /// The camera turned to the other orientation, as Gyroflow's
@@ -148,6 +165,7 @@ impl Camera {
             cy: self.cx,
             ..*self
         }
+        .refit_digital()
     }
 
     /// [`Camera::scaled_to`] a `width x height` video, transposed first
@@ -173,6 +191,7 @@ impl Camera {
             cy: height as f64 / 2.0,
             ..*self
         }
+        .refit_digital()
     }
 
     /// A sensor size from integers as another door gives them (Python): each
@@ -300,7 +319,8 @@ impl Camera {
     /// distortion limit: masked, excluded from the metric's mean.
     #[inline]
     pub fn is_masked_mm(&self, ud: f64, vd: f64) -> bool {
-        ud.hypot(vd) > self.radial_limit_mm()
+        let f = self.focal_mm;
+        self.distortion.is_masked(ud / f, vd / f)
     }
 
     /// The share of the sensor's area within the radial distortion limit
@@ -311,6 +331,21 @@ impl Camera {
         let r = self.sensor_rect();
         if !rl.is_finite() {
             return 1.0;
+        }
+        if let Distortion::Digital { warp, .. } = self.distortion {
+            // The warp bends the mask's edge: the share of a 512 x 512 grid's cell centres.
+            const N: u32 = 512;
+            let (f, limit) = (self.focal_mm, self.distortion.radial_limit());
+            let mut valid = 0u64;
+            for j in 0..N {
+                for i in 0..N {
+                    let u = r.u0 + (r.u1 - r.u0) * (i as f64 + 0.5) / N as f64;
+                    let v = r.v0 + (r.v1 - r.v0) * (j as f64 + 0.5) / N as f64;
+                    let (x, y) = warp.unrecord(u / f, v / f);
+                    valid += u64::from(x.hypot(y) <= limit);
+                }
+            }
+            return valid as f64 / (N * N) as f64;
         }
         // Area of the disc within [0, a] x [0, b], a, b >= 0.
         let quadrant = |a: f64, b: f64| -> f64 {

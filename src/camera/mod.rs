@@ -8,19 +8,32 @@
 //! `bounded` to read its files).
 
 pub(crate) mod blur;
+pub(crate) mod digital;
 pub(crate) mod distortion;
 pub(crate) mod file;
 pub(crate) mod fisheye;
+pub(crate) mod gyroflow;
+pub(crate) mod insta360;
 pub(crate) mod intrinsics;
 pub(crate) mod lens;
+pub(crate) mod models;
 pub(crate) mod noise;
 pub(crate) mod opencv;
+pub(crate) mod parts;
+pub(crate) mod poly3;
+pub(crate) mod poly5;
+pub(crate) mod ptlens;
+pub(crate) mod radial;
 pub(crate) mod shutter;
+pub(crate) mod sony;
 
 pub use blur::{blur_px, checked_blur_px, checked_px_s, exposure_for_blur};
+pub use digital::{Lens as DigitalLens, Warp};
 pub use distortion::Distortion;
 pub use file::{CameraFile, CameraOverrides, MAX_CAMERA_BYTES};
+pub use gyroflow::Choice;
 pub use intrinsics::{Camera, SensorRect};
 pub use lens::Lens;
+pub use models::Model;
 pub use noise::Noise;
 pub use shutter::{Readout, Shutter};

@@ -124,8 +124,11 @@ impl Grid {
         if camera.distortion.coefficients().is_none() {
             return Err(Error::invalid(
                 "distortion",
-                "the 12-coefficient opencv_standard model (rational k4..k6, thin prism \
-                 s1..s4) is not in the GPU kernel: use a CPU method (riemann, gauss, exact)",
+                format!(
+                    "the {} model is not in the GPU kernel (it has opencv with k1, k2, p1, \
+                     p2, k3 and opencv_fisheye): use a CPU method (riemann, gauss, exact)",
+                    camera.distortion.name()
+                ),
             ));
         }
         if camera.masked_fraction() > 0.0 {
