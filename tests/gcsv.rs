@@ -75,14 +75,15 @@ fn walk_reads_as_the_scaled_and_oriented_raw_columns() {
         let (gx, gy, gz) = (gx * GSCALE, gy * GSCALE, gz * GSCALE);
         let gyroflow = [gy, -gx, gz];
         let camera = DVec3::new(-gyroflow[1], -gyroflow[0], -gyroflow[2]);
-        assert_eq!(s.t, t * TSCALE);
+        // Time from the first sample (t = 1000 raw units).
+        assert_eq!(s.t, (t - 1000.0) * TSCALE);
         assert_eq!(s.omega, camera, "t = {t}");
         assert_eq!(s.omega, DVec3::new(gx, -gy, -gz));
         assert_eq!(s.velocity, None);
         assert_eq!(s.depth, None);
     }
-    assert_eq!(samples[0].t, 1.0);
-    assert_eq!(samples[19].t, 1.095);
+    assert_eq!(samples[0].t, 0.0);
+    assert_eq!(samples[19].t, 95.0 * TSCALE);
 }
 
 #[test]
@@ -215,10 +216,16 @@ fn malformed_rows_name_the_line_of_the_gcsv_file() {
         e.contains("walk_bad.gcsv:23:gy:") && e.contains("'abc'"),
         "{e}"
     );
-    let bad = with_line(&text, 30, &row(30).replacen(",", ",inf,", 1));
+    let bad = with_line(&text, 30, "1055,1,2");
     let e = err(&write(dir.path(), "ragged.gcsv", &bad));
     assert!(
-        e.contains("ragged.gcsv:30:field count (expected 10, found 11)"),
+        e.contains("ragged.gcsv:30:field count (expected at least 4, found 3)"),
+        "{e}"
+    );
+    let bad = with_line(&text, 30, &row(30).replacen(",", ",inf,", 1));
+    let e = err(&write(dir.path(), "inf.gcsv", &bad));
+    assert!(
+        e.contains("inf.gcsv:30:gx:") && e.contains("not finite"),
         "{e}"
     );
     let bad = with_line(&text, 19, &row(19).replacen("40", "NaN", 1));
@@ -266,26 +273,28 @@ fn malformed_rows_name_the_line_of_the_gcsv_file() {
 }
 
 #[test]
-fn missing_scales_and_bad_files_are_errors() {
+fn absent_scales_are_telemetry_parsers_defaults_and_bad_ones_errors() {
     let dir = tempfile::tempdir().unwrap();
     let text = walk_text();
-    let e = err(&write(
+    let raw = raw_rows(&text);
+    // No gscale: 1.0 (the raw gyro columns are rad/s).
+    let p = write(
         dir.path(),
         "nog.gcsv",
         &text.replace("gscale,0.00122173047\n", ""),
-    ));
-    assert!(
-        e.contains("nog.gcsv:17:gscale:") && e.contains("missing"),
-        "{e}"
     );
-    let e = err(&write(
-        dir.path(),
-        "not.gcsv",
-        &text.replace("tscale,0.001\n", ""),
-    ));
-    assert!(
-        e.contains("not.gcsv:17:tscale:") && e.contains("missing"),
-        "{e}"
+    assert_eq!(read_header(&p).unwrap().gscale, 1.0);
+    let s = read_log(&p, GyroOptions::default()).unwrap();
+    for (s, [t, gx, gy, gz]) in s.iter().zip(&raw) {
+        assert_eq!(s.omega, DVec3::new(*gx, -gy, -gz));
+        assert_eq!(s.t, (t - 1000.0) * TSCALE);
+    }
+    // No tscale: 0.001 (ms), the same times as the fixture's tscale,0.001.
+    let p = write(dir.path(), "not.gcsv", &text.replace("tscale,0.001\n", ""));
+    assert_eq!(read_header(&p).unwrap().tscale, 0.001);
+    assert_eq!(
+        read_log(&p, GyroOptions::default()).unwrap(),
+        read_log(&walk(), GyroOptions::default()).unwrap()
     );
     let e = err(&write(
         dir.path(),
@@ -293,13 +302,23 @@ fn missing_scales_and_bad_files_are_errors() {
         &text.replace("gscale,0.00122173047", "gscale,0"),
     ));
     assert!(e.contains("zero.gcsv:15:gscale:"), "{e}");
+    // Columns by position: the names are not read.
+    let p = write(
+        dir.path(),
+        "names.gcsv",
+        &text.replace("t,gx,gy,gz,ax,ay,az,mx,my,mz", "time,x,y,z"),
+    );
+    assert_eq!(
+        read_log(&p, GyroOptions::default()).unwrap(),
+        read_log(&walk(), GyroOptions::default()).unwrap()
+    );
     let e = err(&write(
         dir.path(),
-        "nogz.gcsv",
-        &text.replace("t,gx,gy,gz,", "t,gx,gy,gq,"),
+        "short.gcsv",
+        &text.replace("t,gx,gy,gz,ax,ay,az,mx,my,mz", "t,gx,gy"),
     ));
     assert!(
-        e.contains("nogz.gcsv:18:gz:") && e.contains("missing column"),
+        e.contains("short.gcsv:18:") && e.contains("at least 4"),
         "{e}"
     );
     // A .gcsv name needs the magic line; the magic line needs no .gcsv name.
@@ -346,9 +365,10 @@ fn missing_scales_and_bad_files_are_errors() {
 /// The fixture as a plain gyro CSV, computed here.
 fn equivalent_csv(samples_from_raw: &[[f64; 4]]) -> String {
     let mut s = String::from("t,wx,wy,wz\n");
+    let t0 = samples_from_raw[0][0];
     for [t, gx, gy, gz] in samples_from_raw {
         let w = [gx * GSCALE, -(gy * GSCALE), -(gz * GSCALE)];
-        s += &format!("{},{},{},{}\n", t * TSCALE, w[0], w[1], w[2]);
+        s += &format!("{},{},{},{}\n", (t - t0) * TSCALE, w[0], w[1], w[2]);
     }
     s
 }
@@ -430,7 +450,7 @@ fn frames_use_the_gcsv_readout() {
     let frames = write(
         dir.path(),
         "frames.csv",
-        "t_start,exposure_s\n1.001,0.002\n1.050,0.002\n",
+        "t_start,exposure_s\n0.001,0.002\n0.050,0.002\n",
     );
     let out = common::mmbm_cmd()
         .args(["frames", "--gyro"])
@@ -482,4 +502,162 @@ fn live_replay_uses_the_gcsv_readout() {
     );
     let own = run(&["--rolling-readout", "0.005"]);
     assert!(!own.contains("rolling shutter from"), "{own}");
+}
+
+/// Header lines without a comma (`version:1.3`, written by real loggers) are
+/// skipped, as telemetry-parser skips them; a negative `frame_readout_time`
+/// is its magnitude with the direction reversed (Gyroflow's sign).
+#[test]
+fn comma_free_header_lines_and_negative_readouts() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = walk_text();
+    let p = write(
+        dir.path(),
+        "colon.gcsv",
+        &with_line(&text, 2, "version:1.3"),
+    );
+    let h = read_header(&p).unwrap();
+    assert_eq!(h.get("version"), None);
+    assert_eq!(h.fields.len(), 15);
+    assert_eq!(
+        read_log(&p, GyroOptions::default()).unwrap(),
+        read_log(&walk(), GyroOptions::default()).unwrap()
+    );
+    for (ms, dir_line, want) in [
+        (
+            "-15.23",
+            "frame_readout_direction,0",
+            ReadoutDirection::BottomToTop,
+        ),
+        ("-15.23", "note,none", ReadoutDirection::BottomToTop),
+        (
+            "-15.23",
+            "frame_readout_direction,1",
+            ReadoutDirection::TopToBottom,
+        ),
+        (
+            "-15.23",
+            "frame_readout_direction,2",
+            ReadoutDirection::RightToLeft,
+        ),
+        (
+            "15.23",
+            "frame_readout_direction,1",
+            ReadoutDirection::BottomToTop,
+        ),
+    ] {
+        let t = with_line(&text, 12, &format!("frame_readout_time,{ms}"));
+        let p = write(dir.path(), "neg.gcsv", &with_line(&t, 13, dir_line));
+        let h = read_header(&p).unwrap();
+        assert_eq!(h.readout_s, Some(0.01523), "{ms} {dir_line}");
+        assert_eq!(h.readout_direction, Some(want), "{ms} {dir_line}");
+    }
+}
+
+/// The time origin and the scales a `.gcsv` log took are stated on stderr.
+#[test]
+fn the_time_origin_and_scales_are_stated() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = write(
+        dir.path(),
+        "nog.gcsv",
+        &walk_text().replace("gscale,0.00122173047\n", ""),
+    );
+    let o = mmbm(&["series", "--gyro", p.to_str().unwrap(), "--out", "-"]);
+    assert!(o.status.success());
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        e.contains("time from the first sample (t0 = 1 s is t = 0)")
+            && e.contains("tscale 0.001 s (from the header)")
+            && e.contains("gscale 1 rad/s (telemetry-parser's default"),
+        "{e}"
+    );
+    let first = String::from_utf8(o.stdout).unwrap();
+    let t0: f64 = first
+        .lines()
+        .nth(1)
+        .unwrap()
+        .split(',')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert_eq!(t0, 0.0, "{first}");
+}
+
+/// Gyroflow's IMU rotation (pitch, roll, yaw in degrees) applies in its IMU
+/// frame after the orientation, as `Rz(roll) Ry(pitch) Rx(yaw)`; mmbm's
+/// `--imu-rotation` applies after it, in the camera frame.
+#[test]
+fn gyroflow_rotation_acts_in_gyroflows_imu_frame() {
+    use mmbm::io::gcsv::gyroflow_rotation;
+    let raw = raw_rows(&walk_text());
+    let read = |angles: Option<[f64; 3]>, m: DMat3| {
+        let opts = GyroOptions {
+            gyroflow_rotation: angles,
+            imu_to_camera: m,
+            ..GyroOptions::default()
+        };
+        read_log(&walk(), opts).unwrap()
+    };
+    // Yaw 90 degrees turns about Gyroflow's x (up): its y (left) becomes z
+    // (back), z becomes -y. Computed here from the file's columns (YxZ).
+    let s = read(Some([0.0, 0.0, 90.0]), DMat3::IDENTITY);
+    for (s, [_, gx, gy, gz]) in s.iter().zip(&raw) {
+        let gf = DVec3::new(gy * GSCALE, -gx * GSCALE, gz * GSCALE);
+        let turned = DVec3::new(gf.x, -gf.z, gf.y);
+        let camera = DVec3::new(-turned.y, -turned.x, -turned.z);
+        assert!((s.omega - camera).abs().max_element() < 1e-12, "{s:?}");
+    }
+    // Pitch about y (left), roll about z (back), in that composition.
+    let r = gyroflow_rotation([30.0, 20.0, 10.0]).unwrap();
+    let want = DMat3::from_rotation_z(20f64.to_radians())
+        * DMat3::from_rotation_y(30f64.to_radians())
+        * DMat3::from_rotation_x(10f64.to_radians());
+    assert!((r - want).to_cols_array().iter().all(|d| d.abs() < 1e-15));
+    let m = mmbm::io::gyro::parse_rotation("0,-1,0,1,0,0,0,0,1").unwrap();
+    let s = read(Some([30.0, 20.0, 10.0]), m);
+    for (s, [_, gx, gy, gz]) in s.iter().zip(&raw) {
+        let g = DVec3::new(*gx, *gy, *gz) * GSCALE;
+        let want = m * GYROFLOW_TO_CAMERA * r * orientation_matrix("YxZ").unwrap() * g;
+        assert!((s.omega - want).abs().max_element() < 1e-12);
+    }
+    assert!(gyroflow_rotation([f64::NAN, 0.0, 0.0])
+        .unwrap_err()
+        .to_string()
+        .contains("pitch"));
+    // The command line: the same as the library, and refused for a CSV log.
+    let dir = tempfile::tempdir().unwrap();
+    let csv = write(dir.path(), "w.csv", "t,wx,wy,wz\n0,1,2,3\n1,1,2,3\n");
+    let o = mmbm(&[
+        "series",
+        "--gyro",
+        csv.to_str().unwrap(),
+        "--gyroflow-rotation",
+        "0,0,90",
+    ]);
+    assert!(!o.status.success());
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(e.contains("w.csv") && e.contains(".gcsv log only"), "{e}");
+    let g = walk();
+    let a = mmbm(&[
+        "series",
+        "--gyro",
+        g.to_str().unwrap(),
+        "--gyroflow-rotation",
+        "0,0,90",
+        "--out",
+        "-",
+    ]);
+    let b = mmbm(&["series", "--gyro", g.to_str().unwrap(), "--out", "-"]);
+    assert!(a.status.success(), "{}", String::from_utf8_lossy(&a.stderr));
+    assert_ne!(a.stdout, b.stdout);
+    let o = mmbm(&[
+        "series",
+        "--gyro",
+        g.to_str().unwrap(),
+        "--gyroflow-rotation",
+        "1,2",
+    ]);
+    assert_eq!(o.status.code(), Some(2));
 }
