@@ -124,7 +124,7 @@ pub fn run(a: SeriesArgs) -> Result<()> {
     }
     let reader = GyroReader::open(&a.gyro, a.gyro_opts.options()?)?;
     let mut eval = series::evaluator(opts)?;
-    let pitch = opts.scene.camera.pitch_x_mm;
+    let px = series::px_of(&opts)?;
     if let Some(te) = a.exposure {
         mmbm::check::positive("--exposure (s)", te)?;
     }
@@ -132,7 +132,7 @@ pub fn run(a: SeriesArgs) -> Result<()> {
         Some(p) => {
             let mut n = 0;
             mmbm::io::atomic::write_atomic(p, |w| {
-                n = series::run(reader, &mut eval, pitch, a.exposure, w)?;
+                n = series::run(reader, &mut eval, &*px, a.exposure, w)?;
                 Ok(())
             })?;
             n
@@ -140,7 +140,7 @@ pub fn run(a: SeriesArgs) -> Result<()> {
         None => series::run(
             reader,
             &mut eval,
-            pitch,
+            &*px,
             a.exposure,
             std::io::stdout().lock(),
         )?,
