@@ -75,14 +75,15 @@ fn walk_reads_as_the_scaled_and_oriented_raw_columns() {
         let (gx, gy, gz) = (gx * GSCALE, gy * GSCALE, gz * GSCALE);
         let gyroflow = [gy, -gx, gz];
         let camera = DVec3::new(-gyroflow[1], -gyroflow[0], -gyroflow[2]);
-        assert_eq!(s.t, t * TSCALE);
+        // Time from the first sample (t = 1000 raw units).
+        assert_eq!(s.t, (t - 1000.0) * TSCALE);
         assert_eq!(s.omega, camera, "t = {t}");
         assert_eq!(s.omega, DVec3::new(gx, -gy, -gz));
         assert_eq!(s.velocity, None);
         assert_eq!(s.depth, None);
     }
-    assert_eq!(samples[0].t, 1.0);
-    assert_eq!(samples[19].t, 1.095);
+    assert_eq!(samples[0].t, 0.0);
+    assert_eq!(samples[19].t, 95.0 * TSCALE);
 }
 
 #[test]
@@ -215,10 +216,16 @@ fn malformed_rows_name_the_line_of_the_gcsv_file() {
         e.contains("walk_bad.gcsv:23:gy:") && e.contains("'abc'"),
         "{e}"
     );
-    let bad = with_line(&text, 30, &row(30).replacen(",", ",inf,", 1));
+    let bad = with_line(&text, 30, "1055,1,2");
     let e = err(&write(dir.path(), "ragged.gcsv", &bad));
     assert!(
-        e.contains("ragged.gcsv:30:field count (expected 10, found 11)"),
+        e.contains("ragged.gcsv:30:field count (expected at least 4, found 3)"),
+        "{e}"
+    );
+    let bad = with_line(&text, 30, &row(30).replacen(",", ",inf,", 1));
+    let e = err(&write(dir.path(), "inf.gcsv", &bad));
+    assert!(
+        e.contains("inf.gcsv:30:gx:") && e.contains("not finite"),
         "{e}"
     );
     let bad = with_line(&text, 19, &row(19).replacen("40", "NaN", 1));
@@ -266,26 +273,28 @@ fn malformed_rows_name_the_line_of_the_gcsv_file() {
 }
 
 #[test]
-fn missing_scales_and_bad_files_are_errors() {
+fn absent_scales_are_telemetry_parsers_defaults_and_bad_ones_errors() {
     let dir = tempfile::tempdir().unwrap();
     let text = walk_text();
-    let e = err(&write(
+    let raw = raw_rows(&text);
+    // No gscale: 1.0 (the raw gyro columns are rad/s).
+    let p = write(
         dir.path(),
         "nog.gcsv",
         &text.replace("gscale,0.00122173047\n", ""),
-    ));
-    assert!(
-        e.contains("nog.gcsv:17:gscale:") && e.contains("missing"),
-        "{e}"
     );
-    let e = err(&write(
-        dir.path(),
-        "not.gcsv",
-        &text.replace("tscale,0.001\n", ""),
-    ));
-    assert!(
-        e.contains("not.gcsv:17:tscale:") && e.contains("missing"),
-        "{e}"
+    assert_eq!(read_header(&p).unwrap().gscale, 1.0);
+    let s = read_log(&p, GyroOptions::default()).unwrap();
+    for (s, [t, gx, gy, gz]) in s.iter().zip(&raw) {
+        assert_eq!(s.omega, DVec3::new(*gx, -gy, -gz));
+        assert_eq!(s.t, (t - 1000.0) * TSCALE);
+    }
+    // No tscale: 0.001 (ms), the same times as the fixture's tscale,0.001.
+    let p = write(dir.path(), "not.gcsv", &text.replace("tscale,0.001\n", ""));
+    assert_eq!(read_header(&p).unwrap().tscale, 0.001);
+    assert_eq!(
+        read_log(&p, GyroOptions::default()).unwrap(),
+        read_log(&walk(), GyroOptions::default()).unwrap()
     );
     let e = err(&write(
         dir.path(),
@@ -293,13 +302,23 @@ fn missing_scales_and_bad_files_are_errors() {
         &text.replace("gscale,0.00122173047", "gscale,0"),
     ));
     assert!(e.contains("zero.gcsv:15:gscale:"), "{e}");
+    // Columns by position: the names are not read.
+    let p = write(
+        dir.path(),
+        "names.gcsv",
+        &text.replace("t,gx,gy,gz,ax,ay,az,mx,my,mz", "time,x,y,z"),
+    );
+    assert_eq!(
+        read_log(&p, GyroOptions::default()).unwrap(),
+        read_log(&walk(), GyroOptions::default()).unwrap()
+    );
     let e = err(&write(
         dir.path(),
-        "nogz.gcsv",
-        &text.replace("t,gx,gy,gz,", "t,gx,gy,gq,"),
+        "short.gcsv",
+        &text.replace("t,gx,gy,gz,ax,ay,az,mx,my,mz", "t,gx,gy"),
     ));
     assert!(
-        e.contains("nogz.gcsv:18:gz:") && e.contains("missing column"),
+        e.contains("short.gcsv:18:") && e.contains("at least 4"),
         "{e}"
     );
     // A .gcsv name needs the magic line; the magic line needs no .gcsv name.
@@ -346,9 +365,10 @@ fn missing_scales_and_bad_files_are_errors() {
 /// The fixture as a plain gyro CSV, computed here.
 fn equivalent_csv(samples_from_raw: &[[f64; 4]]) -> String {
     let mut s = String::from("t,wx,wy,wz\n");
+    let t0 = samples_from_raw[0][0];
     for [t, gx, gy, gz] in samples_from_raw {
         let w = [gx * GSCALE, -(gy * GSCALE), -(gz * GSCALE)];
-        s += &format!("{},{},{},{}\n", t * TSCALE, w[0], w[1], w[2]);
+        s += &format!("{},{},{},{}\n", (t - t0) * TSCALE, w[0], w[1], w[2]);
     }
     s
 }
@@ -430,7 +450,7 @@ fn frames_use_the_gcsv_readout() {
     let frames = write(
         dir.path(),
         "frames.csv",
-        "t_start,exposure_s\n1.001,0.002\n1.050,0.002\n",
+        "t_start,exposure_s\n0.001,0.002\n0.050,0.002\n",
     );
     let out = common::mmbm_cmd()
         .args(["frames", "--gyro"])

@@ -18,10 +18,16 @@ pub struct GyroArgs {
     /// Unit of wx, wy, wz: rad or deg (per second; CSV only).
     #[arg(long, default_value = "rad")]
     pub angle_unit: AngleUnit,
-    /// IMU-to-camera rotation, 9 numbers row-major (applied to w and v; for
-    /// a .gcsv log, after its orientation).
+    /// IMU-to-camera rotation, 9 numbers row-major, in mmbm's camera frame
+    /// (x right, y down, z forward): w_camera = R * w_log (also v). Applied
+    /// last: for a .gcsv log, after its orientation and --gyroflow-rotation.
     #[arg(long, value_name = "R11,...,R33", allow_hyphen_values = true, value_parser = rotation)]
     pub imu_rotation: Option<glam::DMat3>,
+    /// .gcsv only: Gyroflow's IMU rotation, degrees, as Gyroflow's "IMU
+    /// rotation" pitch, roll, yaw: Rz(roll) Ry(pitch) Rx(yaw) in Gyroflow's
+    /// IMU frame (x up, y left, z back), after the orientation.
+    #[arg(long, value_name = "PITCH,ROLL,YAW", allow_hyphen_values = true, value_parser = angles)]
+    pub gyroflow_rotation: Option<[f64; 3]>,
     /// Added to every time stamp, s.
     #[arg(
         allow_negative_numbers = true,
@@ -42,12 +48,28 @@ fn rotation(s: &str) -> std::result::Result<glam::DMat3, String> {
     parse_rotation(s).map_err(|e| e.to_string())
 }
 
+/// `--gyroflow-rotation`: 3 finite numbers, degrees (clap reports a bad one, exit 2).
+fn angles(s: &str) -> std::result::Result<[f64; 3], String> {
+    let v: Vec<f64> = s
+        .split(',')
+        .map(|x| x.trim().parse::<f64>())
+        .collect::<std::result::Result<_, _>>()
+        .map_err(|_| format!("'{s}': expected 3 comma-separated numbers (degrees)"))?;
+    match v[..] {
+        [p, r, y] if v.iter().all(|x| x.is_finite()) => Ok([p, r, y]),
+        _ => Err(format!(
+            "'{s}': expected 3 finite numbers, pitch,roll,yaw (degrees)"
+        )),
+    }
+}
+
 impl GyroArgs {
     pub fn options(&self) -> Result<GyroOptions> {
         Ok(GyroOptions {
             time_unit: self.time_unit,
             angle_unit: self.angle_unit,
             imu_to_camera: self.imu_rotation.unwrap_or(glam::DMat3::IDENTITY),
+            gyroflow_rotation: self.gyroflow_rotation,
             time_offset: mmbm::check::finite("--time-offset", self.time_offset)?,
             topic: self.topic.clone(),
         })
@@ -102,7 +124,7 @@ pub fn run(a: SeriesArgs) -> Result<()> {
     }
     let reader = GyroReader::open(&a.gyro, a.gyro_opts.options()?)?;
     let mut eval = series::evaluator(opts)?;
-    let pitch = opts.scene.camera.pitch_x_mm;
+    let px = series::px_of(&opts)?;
     if let Some(te) = a.exposure {
         mmbm::check::positive("--exposure (s)", te)?;
     }
@@ -110,7 +132,7 @@ pub fn run(a: SeriesArgs) -> Result<()> {
         Some(p) => {
             let mut n = 0;
             mmbm::io::atomic::write_atomic(p, |w| {
-                n = series::run(reader, &mut eval, pitch, a.exposure, w)?;
+                n = series::run(reader, &mut eval, &*px, a.exposure, w)?;
                 Ok(())
             })?;
             n
@@ -118,7 +140,7 @@ pub fn run(a: SeriesArgs) -> Result<()> {
         None => series::run(
             reader,
             &mut eval,
-            pitch,
+            &*px,
             a.exposure,
             std::io::stdout().lock(),
         )?,

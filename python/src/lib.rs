@@ -242,6 +242,7 @@ fn read_gyro<'py>(
         },
         time_offset,
         topic,
+        gyroflow_rotation: None,
     };
     let log = interruptible(py, err, || mmbm::io::gyro::read_log(&path, opts))?;
     let d = samples_dict(py, &log)?;

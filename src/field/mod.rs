@@ -37,7 +37,9 @@ pub struct FlowField {
     pub u: Vec<f32>,
     /// Vertical flow, px/s (+ down).
     pub v: Vec<f32>,
-    /// Mean speed of the field's samples (mm/s on the sensor; also px/s).
+    /// Mean speed of the field's samples: `mm_s` on the sensor, `px_s` the
+    /// mean of [`FlowField::speed`] (the true pixel speed; `mm_s / pitch`
+    /// with square, unskewed pixels).
     pub mmbm: Mmbm,
 }
 
@@ -52,13 +54,35 @@ impl FlowField {
     }
 }
 
-fn to_mmbm(scene: &Scene, mean_mm_s: f64, grid: &Grid) -> Result<Mmbm> {
+/// The MMBM of a field's samples: `mean_mm_s`, and in px/s `mean_mm_s / pitch`
+/// with square pixels, else the mean of the samples' px/s speeds `field`
+/// (which [`needs_field`] says must then be computed).
+fn to_mmbm(scene: &Scene, mean_mm_s: f64, grid: &Grid, field: &[[f32; 2]]) -> Result<Mmbm> {
+    let px_s = if needs_field(scene) {
+        let sum: f64 = field.iter().map(|x| x[0].hypot(x[1]) as f64).sum();
+        let px = sum / field.len() as f64;
+        if !px.is_finite() {
+            return Err(Error::invalid(
+                "MMBM",
+                format!("the field's mean pixel speed is {px}, not a finite number"),
+            ));
+        }
+        px
+    } else {
+        crate::camera::checked_px_s(mean_mm_s, scene.camera.pitch_x_mm)?
+    };
     Ok(Mmbm {
         mm_s: mean_mm_s,
-        px_s: crate::camera::checked_px_s(mean_mm_s, scene.camera.pitch_x_mm)?,
+        px_s,
         error_estimate: None,
         evaluations: grid.len() as u64,
     })
+}
+
+/// True when the MMBM in px/s needs the field's px/s samples (pixels not
+/// square or skewed: [`crate::metric::pixel_map`]).
+fn needs_field(scene: &Scene) -> bool {
+    crate::metric::pixel_map(&scene.camera).is_some()
 }
 
 static ANNOUNCED: AtomicBool = AtomicBool::new(false);
@@ -125,7 +149,7 @@ pub fn flow_field(
         height: grid.height,
         u: field.iter().map(|x| x[0]).collect(),
         v: field.iter().map(|x| x[1]).collect(),
-        mmbm: to_mmbm(scene, mean, &grid)?,
+        mmbm: to_mmbm(scene, mean, &grid, &field)?,
     })
 }
 
@@ -142,7 +166,7 @@ pub fn mmbm_gpu(scene: &Scene, tw: &Twist, w: u32, h: u32) -> Result<Mmbm> {
     let grid = Grid::new(&scene.camera, w, h)?;
     let g = TwistGpu::new(scene.camera.focal_mm, tw, scene.plane.as_ref());
     let mut r = FlowRunner::new()?;
-    let (sums, _) = r.tiles(&grid, &[g], false)?;
+    let (sums, field) = r.tiles(&grid, &[g], needs_field(scene))?;
     let mean = sums[0] / grid.len() as f64;
     if !mean.is_finite() {
         return Err(Error::invalid(
@@ -150,5 +174,5 @@ pub fn mmbm_gpu(scene: &Scene, tw: &Twist, w: u32, h: u32) -> Result<Mmbm> {
             format!("MMBM is {mean}: the flow overflows f32 on the GPU"),
         ));
     }
-    to_mmbm(scene, mean, &grid)
+    to_mmbm(scene, mean, &grid, &field)
 }

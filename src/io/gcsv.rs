@@ -1,22 +1,30 @@
-//! Gyroflow's IMU log, `.gcsv` (docs.gyroflow.xyz, "GCSV format"): a magic
-//! line, `key,value` header lines, a column line, then raw samples.
+//! Gyroflow's IMU log, `.gcsv` (docs.gyroflow.xyz, "GCSV format"), read as
+//! Gyroflow's telemetry-parser reads it: a magic line, header lines, a column
+//! line, then raw samples.
 //!
 //! ```text
 //! GYROFLOW IMU LOG            (or CAMERA IMU LOG)
-//! version,1.3
-//! orientation,YxZ
-//! frame_readout_time,15.23    (ms, optional)
+//! version,1.3                 (a line without a comma, e.g. version:1.3, is skipped)
+//! orientation,YxZ             (optional: default xzY)
+//! frame_readout_time,15.23    (ms, optional; negative: the direction reversed)
 //! frame_readout_direction,0   (optional: 0 top-to-bottom, 1 bottom-to-top, 2 left-to-right, 3 right-to-left)
-//! tscale,0.001
-//! gscale,0.00122173047
-//! t,gx,gy,gz,ax,ay,az         (gx, gy, gz required; other columns are not read)
+//! tscale,0.001                (optional: default 0.001, ms)
+//! gscale,0.00122173047        (optional: default 1.0, rad/s)
+//! t,gx,gy,gz,ax,ay,az         (the column line: its first field t or time)
 //! 0,39,86,183,-1137,-15689,-2986
 //! ```
 //!
-//! - Time: `t * tscale`, s. Angular velocity: `g * gscale`, rad/s. Both
-//!   scales are required (no default is guessed).
+//! - Columns by position, as telemetry-parser reads them: field 1 is the
+//!   time, fields 2-4 the gyro's x, y, z, whatever the column line names them
+//!   (only its first field, `t` or `time`, is looked for); further fields
+//!   (accelerometer, magnetometer) are not read. A row needs at least 4 fields.
+//! - Time: `(t - t0) * tscale`, s, where `t0` is the first row's `t`: time
+//!   from the first sample, as Gyroflow counts it (the reader states `t0`;
+//!   `--time-offset` is added after). Angular velocity: `g * gscale`, rad/s.
+//!   A scale the header does not give is telemetry-parser's default,
+//!   [`DEFAULT_TSCALE`] (ms) and [`DEFAULT_GSCALE`] (rad/s).
 //! - Axes, as Gyroflow reads them (telemetry-parser, and `orient` in
-//!   Gyroflow's `gyro_source.rs`): letter `i` of `orientation` names the file
+//!   Gyroflow's IMU transforms): letter `i` of `orientation` names the file
 //!   column that becomes Gyroflow's IMU axis `i`, uppercase with its sign,
 //!   lowercase negated ([`orientation_matrix`]; `YxZ`: `(gy, -gx, gz)`).
 //!   Gyroflow's IMU frame has, for a level camera looking forward, x up,
@@ -26,8 +34,14 @@
 //!   z forward) is [`GYROFLOW_TO_CAMERA`] times that, so `w_camera =
 //!   camera_matrix(orientation) * g * gscale` ([`camera_matrix`]). A header
 //!   without `orientation` gets Gyroflow's default for `.gcsv`, `xzY`.
+//!   Gyroflow's IMU rotation (pitch, roll, yaw in degrees, applied in its
+//!   IMU frame after the orientation) is [`gyroflow_rotation`]
+//!   (`--gyroflow-rotation`); mmbm's `--imu-rotation` applies last, in the
+//!   camera frame.
 //! - `frame_readout_time` is in milliseconds; [`GcsvHeader::readout_s`] is in
-//!   seconds. Other header keys are kept in [`GcsvHeader::fields`], unread.
+//!   seconds, its magnitude; a negative time reverses the direction
+//!   (Gyroflow's sign: bottom to top for the default top to bottom). Other
+//!   header keys are kept in [`GcsvHeader::fields`], unread.
 //!
 //! [`GcsvReader`] yields the rows as samples (s, rad/s, camera frame) one
 //! line at a time, each with its line in the file, so that
@@ -55,6 +69,14 @@ pub const MAGIC: [&str; 2] = ["GYROFLOW IMU LOG", "CAMERA IMU LOG"];
 /// Orientation used when the header has none (Gyroflow's default for `.gcsv`).
 pub const DEFAULT_ORIENTATION: &str = "xzY";
 
+/// `tscale` when the header has none: s per unit of `t` (telemetry-parser's
+/// default, milliseconds).
+pub const DEFAULT_TSCALE: f64 = 0.001;
+
+/// `gscale` when the header has none: rad/s per unit of the gyro columns
+/// (telemetry-parser's default).
+pub const DEFAULT_GSCALE: f64 = 1.0;
+
 /// Gyroflow's IMU frame (x up, y left, z backwards for a level camera looking
 /// forward) to mmbm's camera frame (x right, y down, z forward):
 /// `(x, y, z) -> (-y, -x, -z)`, a rotation (determinant +1).
@@ -78,9 +100,9 @@ pub struct GcsvHeader {
     pub readout_direction: Option<ReadoutDirection>,
     /// `orientation` as written (validated), or [`DEFAULT_ORIENTATION`].
     pub orientation: String,
-    /// Seconds per unit of `t`.
+    /// Seconds per unit of `t` ([`DEFAULT_TSCALE`] when the header has none).
     pub tscale: f64,
-    /// rad/s per unit of `gx, gy, gz`.
+    /// rad/s per unit of the gyro columns ([`DEFAULT_GSCALE`] when the header has none).
     pub gscale: f64,
     /// Every `key,value` header line, in file order (the value is everything
     /// after the first comma, trimmed).
@@ -157,6 +179,28 @@ pub fn orientation_matrix(orientation: &str) -> Result<DMat3> {
 /// `(-gy, -gx, -gz)`, `YxZ` gives `(gx, -gy, -gz)`.
 pub fn camera_matrix(orientation: &str) -> Result<DMat3> {
     Ok(GYROFLOW_TO_CAMERA * orientation_matrix(orientation)?)
+}
+
+/// Gyroflow's IMU rotation from its `[pitch, roll, yaw]` angles in degrees
+/// (the project's `gyro_source.rotation`, Gyroflow's "IMU rotation"), as its
+/// IMU transforms build it: `Rz(roll) * Ry(pitch) * Rx(yaw)` (nalgebra's
+/// `from_euler_angles(yaw, pitch, roll)`), acting on vectors in Gyroflow's
+/// IMU frame (x up, y left, z back) after the orientation: Gyroflow's
+/// `w = R * orientation_matrix * g`. So yaw turns about the up axis, pitch
+/// about the left axis, roll about the backward axis. In mmbm's camera frame
+/// it is `GYROFLOW_TO_CAMERA * R * GYROFLOW_TO_CAMERA^T`
+/// ([`GcsvReader::with_rotation`]). An error names the angle that is not finite.
+pub fn gyroflow_rotation(pitch_roll_yaw_deg: [f64; 3]) -> Result<DMat3> {
+    for (v, name) in pitch_roll_yaw_deg.iter().zip(["pitch", "roll", "yaw"]) {
+        if !v.is_finite() {
+            return Err(Error::invalid(
+                "Gyroflow IMU rotation",
+                format!("{name} = {v} degrees is not finite"),
+            ));
+        }
+    }
+    let [pitch, roll, yaw] = pitch_roll_yaw_deg.map(f64::to_radians);
+    Ok(DMat3::from_rotation_z(roll) * DMat3::from_rotation_y(pitch) * DMat3::from_rotation_x(yaw))
 }
 
 /// `camera_matrix` as a signed axis map (exact arithmetic: a sign and a pick).

@@ -100,8 +100,14 @@ pub struct GyroOptions {
     pub time_unit: TimeUnit,
     /// Unit of `wx, wy, wz`.
     pub angle_unit: AngleUnit,
-    /// Rotation taking IMU-frame vectors to the camera frame (applied to `w` and `v`).
+    /// Rotation taking IMU-frame vectors to the camera frame (applied to `w`
+    /// and `v`, last: for a `.gcsv` log, after its orientation and
+    /// `gyroflow_rotation`, in mmbm's camera frame; `--imu-rotation`).
     pub imu_to_camera: DMat3,
+    /// A `.gcsv` log only: Gyroflow's IMU rotation `[pitch, roll, yaw]`,
+    /// degrees, in Gyroflow's IMU frame after the orientation
+    /// ([`super::gcsv::gyroflow_rotation`]; `--gyroflow-rotation`). None: none.
+    pub gyroflow_rotation: Option<[f64; 3]>,
     /// Added to every time stamp after unit conversion, s (camera clock = IMU clock + offset).
     pub time_offset: f64,
     /// MCAP input: the topic of `sensor_msgs/msg/Imu` messages (None: the
@@ -115,6 +121,7 @@ impl Default for GyroOptions {
             time_unit: TimeUnit::S,
             angle_unit: AngleUnit::Rad,
             imu_to_camera: DMat3::IDENTITY,
+            gyroflow_rotation: None,
             time_offset: 0.0,
             topic: None,
         }
@@ -245,6 +252,13 @@ impl GyroReader {
             }
             Ok(())
         };
+        let gcsv = path.as_os_str() != "-" && super::gcsv::is_gcsv(path);
+        if opts.gyroflow_rotation.is_some() && !gcsv {
+            return Err(Error::invalid(
+                path.display().to_string(),
+                "Gyroflow's IMU rotation (--gyroflow-rotation) applies to a Gyroflow .gcsv log only, in Gyroflow's IMU frame; for this log give --imu-rotation (camera frame)",
+            ));
+        }
         let (source, path) = if path.as_os_str() == "-" {
             let name = Path::new("<stdin>");
             (
@@ -257,9 +271,12 @@ impl GyroReader {
                 Source::Mcap(ImuStream::open(path, opts.topic.as_deref())?),
                 path,
             )
-        } else if super::gcsv::is_gcsv(path) {
+        } else if gcsv {
             own_units("a Gyroflow .gcsv log carries its own scales (tscale, gscale): leave --time-unit and --angle-unit at their defaults")?;
-            let rows = GcsvReader::open(path)?;
+            let mut rows = GcsvReader::open(path)?;
+            if let Some(angles) = opts.gyroflow_rotation {
+                rows = rows.with_rotation(angles)?;
+            }
             let h = rows.header();
             readout = h.readout_s.map(|readout_s| LogReadout {
                 readout_s,
@@ -387,6 +404,9 @@ impl GyroReader {
             }
             return Ok(None);
         };
+        if self.count == 0 {
+            self.state_gcsv_conventions();
+        }
         let s = self.opts.sample(raw.t, raw.w, raw.v, raw.depth);
         let line = raw.line;
         check_increasing(&self.path, line, self.time_column(), s.t, self.last_t)?;
@@ -396,6 +416,32 @@ impl GyroReader {
         self.last_t = Some((s.t, line));
         self.count += 1;
         Ok(Some(s))
+    }
+
+    /// For a `.gcsv` log, says on the log (info) where its time starts and
+    /// which scales it took: `(t - t0) * tscale`, with the first row's `t0`.
+    fn state_gcsv_conventions(&self) {
+        let Source::Gcsv(g) = &self.source else {
+            return;
+        };
+        let h = g.header();
+        let given = |key: &str| {
+            if h.get(key).is_some() {
+                "from the header"
+            } else {
+                "telemetry-parser's default: the header has none"
+            }
+        };
+        log::info!(
+            "{}: Gyroflow .gcsv log: time from the first sample (t0 = {} s is t = 0), tscale {} s ({}), gscale {} rad/s ({}), orientation {}",
+            self.path.display(),
+            g.first_time_s().unwrap_or(0.0),
+            h.tscale,
+            given("tscale"),
+            h.gscale,
+            given("gscale"),
+            h.orientation
+        );
     }
 
     /// Gap detection in constant memory: the median of the first 101 intervals

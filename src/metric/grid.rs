@@ -171,6 +171,28 @@ impl GridRule {
     }
 }
 
+impl GridRule {
+    /// The rule's estimate of the mean of `|m J flow|`: the speed after the
+    /// linear map `m` (row-major 2 x 2, applied after the distortion's
+    /// Jacobian if any), e.g. the true pixel speed, px/s, with the camera's
+    /// pixel map ([`super::pixel_map`]).
+    pub fn mean_mapped_speed(&self, poly: &FlowPoly, m: [f64; 4]) -> f64 {
+        match &self.jac {
+            None => super::avx2::rule_mean(&self.m, &self.w, &poly.mapped(m)),
+            Some(jac) => {
+                let mut sum = 0.0;
+                for (k, j) in jac.iter().enumerate() {
+                    let (a, b) = poly.eval(self.m[0][k], self.m[1][k]);
+                    let (x, y) = (j[0] * a + j[1] * b, j[2] * a + j[3] * b);
+                    let (x, y) = (m[0] * x + m[1] * y, m[2] * x + m[3] * y);
+                    sum += self.w[k] * (x * x + y * y).sqrt();
+                }
+                sum
+            }
+        }
+    }
+}
+
 /// Points (mm, row by row) and weights (summing to 1) of the midpoint rule
 /// on `nu x nv` equal cells over `r`.
 pub fn riemann_points(r: &SensorRect, nu: u32, nv: u32) -> (Vec<(f64, f64)>, Vec<f64>) {

@@ -230,7 +230,11 @@ impl fmt::Display for Method {
 pub struct Mmbm {
     /// Mean flow speed over the sensor, mm/s.
     pub mm_s: f64,
-    /// Same in pixels per second (`mm_s / pitch_x`).
+    /// Mean true pixel speed over the sensor, px/s: the mean of `|(u', v')|`
+    /// where `(u', v')` is the flow in px/s on each axis (`u` over `pitch_x`
+    /// plus the skew term, `v` over `pitch_y`: [`pixel_map`]). With square,
+    /// unskewed pixels it is `mm_s / pitch`; otherwise it is computed with the
+    /// same method, and is what a flow field's mean speed estimates.
     pub px_s: f64,
     /// Error estimate (mm/s), for the exact method.
     pub error_estimate: Option<f64>,
@@ -325,7 +329,7 @@ pub fn mmbm_poly(cam: &Camera, poly: &FlowPoly, method: Method) -> Result<Mmbm> 
             let r = if pinhole {
                 exact(poly, &rect, tol)
             } else {
-                masked_exact(cam, poly, tol)
+                masked_exact(cam, poly, tol, None)
             };
             (r.value, Some(r.error), r.evaluations)
         }
@@ -338,10 +342,56 @@ pub fn mmbm_poly(cam: &Camera, poly: &FlowPoly, method: Method) -> Result<Mmbm> 
     }
     Ok(Mmbm {
         mm_s,
-        px_s: crate::camera::checked_px_s(mm_s, cam.pitch_x_mm)?,
+        px_s: mean_px_speed(cam, poly, method, mm_s)?,
         error_estimate: err,
         evaluations: evals,
     })
+}
+
+/// The camera's map from sensor velocity (mm/s) to pixel velocity (px/s),
+/// row-major: `(u', v') = (m[0] du + m[1] dv, m[2] du + m[3] dv)` with
+/// `m = [1/pitch_x, skew/focal, 0, 1/pitch_y]` (as
+/// [`Camera::mm_to_px_velocity`]). None for square, unskewed pixels, where
+/// px/s is mm/s over the pitch.
+pub fn pixel_map(cam: &Camera) -> Option<[f64; 4]> {
+    if cam.pitch_x_mm == cam.pitch_y_mm && cam.skew == 0.0 {
+        return None;
+    }
+    Some([
+        1.0 / cam.pitch_x_mm,
+        cam.skew / cam.focal_mm,
+        0.0,
+        1.0 / cam.pitch_y_mm,
+    ])
+}
+
+/// The MMBM in px/s ([`Mmbm::px_s`]) of `poly` with `method`, given its
+/// value `mm_s` in mm/s (all it needs with square pixels).
+fn mean_px_speed(cam: &Camera, poly: &FlowPoly, method: Method, mm_s: f64) -> Result<f64> {
+    let Some(m) = pixel_map(cam) else {
+        return crate::camera::checked_px_s(mm_s, cam.pitch_x_mm);
+    };
+    let rect = cam.sensor_rect();
+    let px = match method {
+        Method::Riemann { nu, nv } => GridRule::riemann(&rect, nu, nv)
+            .distorted(cam)?
+            .mean_mapped_speed(poly, m),
+        Method::Gauss { nu, nv } => GridRule::gauss(&rect, nu, nv)
+            .distorted(cam)?
+            .mean_mapped_speed(poly, m),
+        Method::Exact { tol } if cam.distortion.is_none() => {
+            exact(&poly.mapped(m), &rect, tol).value
+        }
+        Method::Exact { tol } => masked_exact(cam, poly, tol, Some(m)).value,
+    };
+    if px.is_finite() {
+        Ok(px)
+    } else {
+        Err(Error::invalid(
+            "MMBM",
+            format!("{mm_s:?} mm/s is {px} px/s on this camera's pixels, not a finite number"),
+        ))
+    }
 }
 
 /// Flow speed (mm/s) at the sensor point `(u, v)` mm of `cam` (through its
@@ -351,17 +401,22 @@ pub fn point_speed(cam: &Camera, poly: &FlowPoly, u: f64, v: f64) -> f64 {
     if cam.distortion.is_none() {
         poly.speed(u, v)
     } else {
-        distorted_speed(cam, poly, u, v)
+        distorted_speed(cam, poly, u, v, None)
     }
 }
 
-/// `|J flow|` (mm/s) at the distorted sensor point `(ud, vd)` mm; NaN where it
-/// does not undistort (the caller reports a non-finite result).
-fn distorted_speed(cam: &Camera, poly: &FlowPoly, ud: f64, vd: f64) -> f64 {
+/// `|J flow|` (mm/s) at the distorted sensor point `(ud, vd)` mm, or
+/// `|m J flow|` with a map `m` (row-major, e.g. [`pixel_map`]: px/s); NaN
+/// where it does not undistort (the caller reports a non-finite result).
+fn distorted_speed(cam: &Camera, poly: &FlowPoly, ud: f64, vd: f64, m: Option<[f64; 4]>) -> f64 {
     match cam.undistort_mm(ud, vd) {
         Some((u, v)) => {
             let (a, b) =
                 crate::camera::distortion::apply(&cam.distortion_jacobian(u, v), poly.eval(u, v));
+            let (a, b) = match m {
+                Some(m) => (m[0] * a + m[1] * b, m[2] * a + m[3] * b),
+                None => (a, b),
+            };
             (a * a + b * b).sqrt()
         }
         None => f64::NAN,
@@ -371,13 +426,14 @@ fn distorted_speed(cam: &Camera, poly: &FlowPoly, ud: f64, vd: f64) -> f64 {
 /// The exact mean through the distortion over the sensor's unmasked part:
 /// the speed is 0 beyond the radial distortion limit and the integral is
 /// divided by the unmasked share of the area ([`Camera::valid_fraction`]).
-fn masked_exact(cam: &Camera, poly: &FlowPoly, tol: f64) -> ExactResult {
+/// With a map `m`, the mean of `|m J flow|` instead (e.g. px/s).
+fn masked_exact(cam: &Camera, poly: &FlowPoly, tol: f64, m: Option<[f64; 4]>) -> ExactResult {
     let valid = cam.valid_fraction();
     let speed = |u: f64, v: f64| {
         if cam.is_masked_mm(u, v) {
             0.0
         } else {
-            distorted_speed(cam, poly, u, v)
+            distorted_speed(cam, poly, u, v, m)
         }
     };
     let mut r = exact_with(speed, &cam.sensor_rect(), tol);
@@ -421,8 +477,18 @@ impl Evaluator {
             (None, Method::Exact { tol }) if self.camera.distortion.is_none() => {
                 exact(poly, &self.camera.sensor_rect(), tol).value
             }
-            (None, Method::Exact { tol }) => masked_exact(&self.camera, poly, tol).value,
+            (None, Method::Exact { tol }) => masked_exact(&self.camera, poly, tol, None).value,
             _ => unreachable!("Evaluator::new accepts only CPU methods"),
+        }
+    }
+
+    /// MMBM in px/s ([`Mmbm::px_s`]) of a flow polynomial whose MMBM in mm/s
+    /// is `mm_s` (from [`Evaluator::mean_speed`]): `mm_s / pitch` with square
+    /// pixels, else the mean true pixel speed by the same method.
+    pub fn mean_px_speed(&self, poly: &FlowPoly, mm_s: f64) -> Result<f64> {
+        match (&self.rule, pixel_map(&self.camera)) {
+            (Some(rule), Some(m)) => Ok(rule.mean_mapped_speed(poly, m)),
+            _ => mean_px_speed(&self.camera, poly, self.method, mm_s),
         }
     }
 

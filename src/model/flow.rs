@@ -111,6 +111,16 @@ impl FlowPoly {
         let (du, dv) = self.eval(u, v);
         (du * du + dv * dv).sqrt()
     }
+
+    /// The flow seen through the linear map `m` (row-major 2 x 2): the
+    /// polynomial of `(m[0] du + m[1] dv, m[2] du + m[3] dv)`, e.g. mm/s to
+    /// px/s with a camera's pixel map (`metric::pixel_map`).
+    pub fn mapped(&self, m: [f64; 4]) -> FlowPoly {
+        FlowPoly {
+            du: std::array::from_fn(|k| m[0] * self.du[k] + m[1] * self.dv[k]),
+            dv: std::array::from_fn(|k| m[2] * self.du[k] + m[3] * self.dv[k]),
+        }
+    }
 }
 
 #[cfg(test)]

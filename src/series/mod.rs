@@ -148,13 +148,47 @@ pub fn evaluator(opts: SeriesOptions<AnyMethod>) -> Result<Box<BatchFn<'static>>
     }
 }
 
+/// The MMBM in px/s of a sample given its MMBM in mm/s (the true pixel
+/// speed, as [`crate::Mmbm::px_s`]).
+pub type PxFn = dyn Fn(&GyroSample, f64) -> Result<f64> + Sync;
+
+/// The px/s of `opts`' samples ([`PxFn`]): mm/s over the pitch with square,
+/// unskewed pixels; otherwise the mean true pixel speed
+/// ([`Evaluator::mean_px_speed`]) with the CPU method, or for `gpu:WxH` the
+/// midpoint rule at the field's `W x H` cells (the points the field averages).
+pub fn px_of(opts: &SeriesOptions<AnyMethod>) -> Result<Box<PxFn>> {
+    let cam = opts.scene.camera;
+    if crate::metric::pixel_map(&cam).is_none() {
+        let pitch = cam.pitch_x_mm;
+        return Ok(Box::new(move |_, m| crate::camera::checked_px_s(m, pitch)));
+    }
+    let method = match opts.method {
+        AnyMethod::Cpu(m) => m,
+        AnyMethod::Gpu { width, height } => Method::Riemann {
+            nu: if width == 0 { cam.width } else { width },
+            nv: if height == 0 { cam.height } else { height },
+        },
+    };
+    let ev = Evaluator::new(&cam, method)?;
+    let cpu = SeriesOptions {
+        scene: opts.scene,
+        method,
+        use_velocity: opts.use_velocity,
+    };
+    Ok(Box::new(move |s, m| {
+        let (tw, scene) = sample_scene(s, &cpu)?;
+        ev.mean_px_speed(&scene.flow_poly(&tw), m)
+    }))
+}
+
 /// Streams `reader` through `eval` in batches of [`BATCH`] and writes the CSV.
 /// Parsing runs on a second thread, overlapped with evaluation and
 /// formatting (shortest round-trip floats via `ryu`). Returns the number of samples.
+/// `px` gives each sample's px/s ([`px_of`]); `blur_px` is px/s times the exposure.
 pub fn run<W: Write>(
     reader: GyroReader,
     eval: &mut BatchFn,
-    pitch_mm: f64,
+    px: &PxFn,
     exposure_s: Option<f64>,
     out: W,
 ) -> Result<u64> {
@@ -211,7 +245,7 @@ pub fn run<W: Write>(
             let texts: Vec<Result<Vec<u8>>> = batch
                 .par_chunks(FORMAT_CHUNK)
                 .zip(vals.par_chunks(FORMAT_CHUNK))
-                .map(|(b, v)| format_rows(b, v, pitch_mm, exposure_s))
+                .map(|(b, v)| format_rows(b, v, px, exposure_s))
                 .collect();
             for text in texts {
                 out.write_all(&text?).map_err(werr)?;
@@ -232,25 +266,32 @@ const FORMAT_CHUNK: usize = 2048;
 fn format_rows(
     batch: &[GyroSample],
     vals: &[f64],
-    pitch_mm: f64,
+    px: &PxFn,
     exposure_s: Option<f64>,
 ) -> Result<Vec<u8>> {
     let mut out = Vec::with_capacity(batch.len() * 72);
     let mut r = ryu::Buffer::new();
     for (s, m) in batch.iter().zip(vals) {
         let at = |e: Error| Error::invalid(format!("sample at t = {} s", s.t), e.to_string());
-        let px = crate::camera::checked_px_s(*m, pitch_mm).map_err(at)?;
+        let px = px(s, *m).map_err(at)?;
+        let blur = exposure_s.map(|te| px * te);
+        if let Some(b) = blur.filter(|b| !b.is_finite()) {
+            return Err(at(Error::invalid(
+                "blur",
+                format!("{px:?} px/s over the exposure is {b} px, not a finite number"),
+            )));
+        }
         out.extend_from_slice(r.format(s.t).as_bytes());
         out.push(b',');
         out.extend_from_slice(r.format(*m).as_bytes());
         out.push(b',');
         out.extend_from_slice(r.format(px).as_bytes());
-        if let Some(te) = exposure_s {
-            let blur = crate::camera::checked_blur_px(*m, te, pitch_mm).map_err(at)?;
+        if let Some(blur) = blur {
             out.push(b',');
             out.extend_from_slice(r.format(blur).as_bytes());
         }
-        out.push(b'\n');
+        out.push(b'
+');
     }
     Ok(out)
 }

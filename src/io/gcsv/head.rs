@@ -4,7 +4,7 @@
 
 use super::{
     is_magic, next_line, parse_err, parse_orientation, utf8, Columns, GcsvHeader, ReadoutDirection,
-    DEFAULT_ORIENTATION, MAGIC,
+    DEFAULT_GSCALE, DEFAULT_ORIENTATION, DEFAULT_TSCALE, MAGIC,
 };
 use crate::error::{quote, Result};
 use crate::io::input::MAX_HEADER_BYTES;
@@ -37,14 +37,21 @@ pub(super) fn read_head<R: BufRead>(
     let keys = Keys {
         fields: &raw.fields,
         path,
-        column_line: raw.line,
     };
-    let tscale = keys.scale("tscale", "seconds per unit of t")?;
-    let gscale = keys.scale("gscale", "rad/s per unit of gx, gy, gz")?;
+    let tscale = keys.scale("tscale", DEFAULT_TSCALE)?;
+    let gscale = keys.scale("gscale", DEFAULT_GSCALE)?;
     let orientation = keys.orientation()?;
-    let readout_s = keys.readout_time()?;
-    let readout_direction = keys.readout_direction()?;
-    let g = gyro_columns(&raw.columns, path, raw.line)?;
+    let readout = keys.readout_time()?;
+    let mut readout_direction = keys.readout_direction()?;
+    // A negative frame_readout_time reverses the direction (Gyroflow's
+    // sign convention: -15 ms top to bottom is 15 ms bottom to top).
+    let readout_s = readout.map(|ms| {
+        if ms < 0.0 {
+            readout_direction = Some(readout_direction.unwrap_or_default().reversed());
+        }
+        ms.abs() / 1000.0
+    });
+    check_columns(&raw.columns, path, raw.line)?;
     let header = GcsvHeader {
         readout_s,
         readout_direction,
@@ -56,7 +63,7 @@ pub(super) fn read_head<R: BufRead>(
     let cols = Columns {
         names: raw.columns,
         t: 0,
-        g,
+        g: [1, 2, 3],
     };
     Ok((header, cols, raw.line))
 }
@@ -79,8 +86,9 @@ fn read_magic<R: BufRead>(src: &mut R, path: &Path) -> Result<usize> {
 }
 
 /// Reads the lines after the magic line up to the column line (the first
-/// line starting with `t` or `time`): `key,value` lines, with blank and `#`
-/// lines skipped, at most [`MAX_HEADER_BYTES`] in all.
+/// line whose first field is `t` or `time`): `key,value` lines, with blank
+/// and `#` lines and lines without a comma (`version:1.3`, as telemetry-parser
+/// skips them) skipped, at most [`MAX_HEADER_BYTES`] in all.
 fn read_lines<R: BufRead>(src: &mut R, path: &Path, first_len: usize) -> Result<RawHead> {
     let mut buf = Vec::new();
     let mut line = 1u64;
@@ -106,7 +114,7 @@ fn read_lines<R: BufRead>(src: &mut R, path: &Path, first_len: usize) -> Result<
         line += 1;
         head_bytes += buf.len() + 1;
         let text = utf8(&buf, path, line)?.trim();
-        if text.is_empty() || text.starts_with('#') {
+        if text.is_empty() || text.starts_with('#') || !text.contains(',') {
             continue;
         }
         let names: Vec<String> = text.split(',').map(|s| s.trim().to_string()).collect();
@@ -133,10 +141,7 @@ fn key_value(text: &str, path: &Path, line: u64) -> Result<Field> {
             path,
             line,
             "-",
-            format!(
-                "{}: expected a 'key,value' header line or the column line (t,gx,gy,gz,...)",
-                quote(text)
-            ),
+            format!("{}: expected a 'key,value' header line", quote(text)),
         )),
     }
 }
@@ -145,8 +150,6 @@ fn key_value(text: &str, path: &Path, line: u64) -> Result<Field> {
 struct Keys<'a> {
     fields: &'a [Field],
     path: &'a Path,
-    /// Where a missing key is reported.
-    column_line: u64,
 }
 
 impl Keys<'_> {
@@ -168,16 +171,12 @@ impl Keys<'_> {
         Ok(first.map(|f| (f.value.as_str(), f.line)))
     }
 
-    /// A required scale (`tscale`, `gscale`): a finite number > 0.
-    fn scale(&self, key: &str, what: &str) -> Result<f64> {
-        let (v, l) = self.find(key)?.ok_or_else(|| {
-            parse_err(
-                self.path,
-                self.column_line,
-                key,
-                format!("missing header key '{key}' ({what}); it must come before the column line"),
-            )
-        })?;
+    /// A scale (`tscale`, `gscale`): a finite number > 0, or `default` when
+    /// the key is absent (telemetry-parser's defaults).
+    fn scale(&self, key: &str, default: f64) -> Result<f64> {
+        let Some((v, l)) = self.find(key)? else {
+            return Ok(default);
+        };
         match v.parse::<f64>() {
             Ok(x) if x.is_finite() && x > 0.0 => Ok(x),
             _ => Err(parse_err(
@@ -200,17 +199,18 @@ impl Keys<'_> {
         }
     }
 
-    /// `frame_readout_time` (ms, >= 0) in seconds; empty or absent: None.
+    /// `frame_readout_time` as written, ms (negative: the direction
+    /// reversed); empty or absent: None.
     fn readout_time(&self) -> Result<Option<f64>> {
         match self.find("frame_readout_time")? {
             Some(("", _)) | None => Ok(None),
             Some((v, l)) => match v.parse::<f64>() {
-                Ok(ms) if ms.is_finite() && ms >= 0.0 => Ok(Some(ms / 1000.0)),
+                Ok(ms) if ms.is_finite() => Ok(Some(ms)),
                 _ => Err(parse_err(
                     self.path,
                     l,
                     "frame_readout_time",
-                    format!("{} is not a finite number >= 0 (ms)", quote(v)),
+                    format!("{} is not a finite number (ms)", quote(v)),
                 )),
             },
         }
@@ -235,31 +235,22 @@ impl Keys<'_> {
     }
 }
 
-/// The positions of `gx, gy, gz` in the column line (`t`, `gx`, `gy`, `gz`
-/// at most once each).
-fn gyro_columns(columns: &[String], path: &Path, line: u64) -> Result<[usize; 3]> {
-    for n in ["t", "gx", "gy", "gz"] {
-        if columns.iter().filter(|c| *c == n).count() > 1 {
-            return Err(parse_err(
-                path,
-                line,
-                n,
-                format!("column '{n}' appears more than once in the column line"),
-            ));
-        }
+/// The column line names the columns, but the reader takes them by position
+/// (t, then the gyro's x, y, z), as telemetry-parser does: only `t` or `time`
+/// first is required (the column line is found by it), and names may repeat.
+/// A column line with fewer than 4 fields is an error.
+fn check_columns(columns: &[String], path: &Path, line: u64) -> Result<()> {
+    if columns.len() < 4 {
+        return Err(parse_err(
+            path,
+            line,
+            "-",
+            format!(
+                "the column line has {} fields ({}): expected at least 4, t and the gyro's x, y, z by position (t,gx,gy,gz,...)",
+                columns.len(),
+                columns.join(",")
+            ),
+        ));
     }
-    let need = |n: &str| {
-        columns.iter().position(|c| c == n).ok_or_else(|| {
-            parse_err(
-                path,
-                line,
-                n,
-                format!(
-                    "missing column '{n}' (the column line is: {})",
-                    columns.join(",")
-                ),
-            )
-        })
-    };
-    Ok([need("gx")?, need("gy")?, need("gz")?])
+    Ok(())
 }

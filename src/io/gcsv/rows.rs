@@ -6,7 +6,7 @@ use super::{
 };
 use crate::error::{quote, Error, Result};
 use crate::io::input::open_stream;
-use glam::DVec3;
+use glam::{DMat3, DVec3};
 use std::fs::File;
 use std::io::BufReader;
 use std::path::{Path, PathBuf};
@@ -16,24 +16,33 @@ use std::path::{Path, PathBuf};
 pub struct GcsvRow {
     /// The row's line number in the file (1-based).
     pub line: u64,
-    /// `t * tscale`, s.
+    /// `(t - t0) * tscale`, s, where `t0` is the first row's `t` (time from
+    /// the first sample, as Gyroflow counts it).
     pub t: f64,
-    /// `(gx, gy, gz) * gscale` in mmbm's camera frame ([`super::camera_matrix`]), rad/s.
+    /// `(gx, gy, gz) * gscale` in mmbm's camera frame ([`super::camera_matrix`],
+    /// then [`GcsvReader::with_rotation`]'s rotation if any), rad/s.
     pub omega: DVec3,
 }
 
-/// Reads the rows of a `.gcsv` file after its header: each row scaled
-/// (`tscale`, `gscale`) and turned into the camera frame (exact: a sign and
-/// a pick per axis). Blank and `#` lines are skipped. A bad row (field
-/// count, non-UTF-8 text, a non-number, a non-finite value or product) is an
-/// error naming the file, its line and the `.gcsv` column. The order of the
-/// times is the caller's to check ([`crate::io::gyro::GyroReader`]).
+/// Reads the rows of a `.gcsv` file after its header: each row's fields by
+/// position (`t`, then the gyro's x, y, z; further fields, accelerometer and
+/// magnetometer, are not read), scaled (`tscale`, `gscale`), its time counted
+/// from the first row's, and turned into the camera frame (exact: a sign and a
+/// pick per axis, unless a rotation is given). Blank and `#` lines are
+/// skipped. A bad row (fewer than 4 fields, non-UTF-8 text, a non-number, a
+/// non-finite value or product) is an error naming the file, its line and the
+/// `.gcsv` column. The order of the times is the caller's to check
+/// ([`crate::io::gyro::GyroReader`]).
 pub struct GcsvReader {
     path: PathBuf,
     src: BufReader<File>,
     header: GcsvHeader,
     cols: Columns,
     axes: Axes,
+    /// Camera-frame rotation applied after `axes` (Gyroflow's IMU rotation).
+    rotation: Option<DMat3>,
+    /// The first row's `t`, as written (None before the first row).
+    t0: Option<f64>,
     line: u64,
     buf: Vec<u8>,
 }
@@ -53,9 +62,27 @@ impl GcsvReader {
             header,
             cols,
             axes,
+            rotation: None,
+            t0: None,
             line,
             buf: Vec::new(),
         })
+    }
+
+    /// The reader with Gyroflow's IMU rotation `[pitch, roll, yaw]` (degrees,
+    /// in Gyroflow's IMU frame, after the orientation:
+    /// [`super::gyroflow_rotation`]) applied to every row.
+    pub fn with_rotation(mut self, pitch_roll_yaw_deg: [f64; 3]) -> Result<Self> {
+        let r = super::gyroflow_rotation(pitch_roll_yaw_deg)?;
+        let g = super::GYROFLOW_TO_CAMERA;
+        self.rotation = Some(g * r * g.transpose());
+        Ok(self)
+    }
+
+    /// The first row's time `t0 * tscale`, s, which the rows' times are
+    /// counted from (None before the first row is read).
+    pub fn first_time_s(&self) -> Option<f64> {
+        self.t0.map(|t0| t0 * self.header.tscale)
     }
 
     /// The file's header.
@@ -86,43 +113,57 @@ impl GcsvReader {
         }
     }
 
+    /// The name of column `i` in errors: the column line's, else its position.
+    fn column_name(&self, i: usize) -> String {
+        match self.cols.names.get(i) {
+            Some(n) if !n.is_empty() => n.clone(),
+            _ => format!("column {}", i + 1),
+        }
+    }
+
     /// The line in `buf` as a row (None for a blank or `#` line).
-    fn row(&self) -> Result<Option<GcsvRow>> {
+    fn row(&mut self) -> Result<Option<GcsvRow>> {
         let (path, line) = (self.path.as_path(), self.line);
         let text = utf8(&self.buf, path, line)?.trim();
         if text.is_empty() || text.starts_with('#') {
             return Ok(None);
         }
         let fields: Vec<&str> = text.split(',').map(str::trim).collect();
-        let names = &self.cols.names;
-        if fields.len() != names.len() {
+        if fields.len() < 4 {
             return Err(parse_err(
                 path,
                 line,
-                &format!(
-                    "field count (expected {}, found {})",
-                    names.len(),
-                    fields.len()
-                ),
+                &format!("field count (expected at least 4, found {})", fields.len()),
+                "a row has t and the gyro's x, y, z first (t,gx,gy,gz,...)".into(),
+            ));
+        }
+        let t_name = self.column_name(self.cols.t);
+        let t_raw = scaled(fields[self.cols.t], 1.0, path, line, &t_name)?;
+        let t0 = *self.t0.get_or_insert(t_raw);
+        let num = |i: usize, scale: f64| scaled(fields[i], scale, path, line, &self.column_name(i));
+        let t = (t_raw - t0) * self.header.tscale;
+        if !t.is_finite() {
+            return Err(parse_err(
+                path,
+                line,
+                &t_name,
                 format!(
-                    "a row must have one field per column of the column line ({})",
-                    names.join(",")
+                    "{} minus the first row's {t0}, times tscale {}, overflows",
+                    quote(fields[self.cols.t]),
+                    self.header.tscale
                 ),
             ));
         }
-        let num = |i: usize, scale: f64| scaled(fields[i], scale, path, line, &names[i]);
-        let t = num(self.cols.t, self.header.tscale)?;
         let g = [
             num(self.cols.g[0], self.header.gscale)?,
             num(self.cols.g[1], self.header.gscale)?,
             num(self.cols.g[2], self.header.gscale)?,
         ];
-        let w = self.axes.map(|(a, s)| s * g[a]);
-        Ok(Some(GcsvRow {
-            line,
-            t,
-            omega: DVec3::from_array(w),
-        }))
+        let mut omega = DVec3::from_array(self.axes.map(|(a, s)| s * g[a]));
+        if let Some(r) = self.rotation {
+            omega = r * omega;
+        }
+        Ok(Some(GcsvRow { line, t, omega }))
     }
 }
 

@@ -24,6 +24,7 @@ fn reads_valid_log_with_comments_units_and_rotation() {
         imu_to_camera: parse_rotation("0,-1,0,1,0,0,0,0,1").unwrap(),
         time_offset: 0.5,
         topic: None,
+        gyroflow_rotation: None,
     };
     let v = read_log(f.path(), opts).unwrap();
     assert_eq!(v.len(), 2);
