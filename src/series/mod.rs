@@ -290,8 +290,7 @@ fn format_rows(
             out.push(b',');
             out.extend_from_slice(r.format(blur).as_bytes());
         }
-        out.push(b'
-');
+        out.push(b'\n');
     }
     Ok(out)
 }
