@@ -104,7 +104,7 @@ impl TaskModel {
 
 /// `task:FPS:light=E[:read=E][:tmin=Tms]`: one frame per slot of the fixed
 /// rate, like `deadline:FPS` (observe the first `1/e` of the slot, then take
-/// the first sample whose predicted success reaches the best observed, or the
+/// the first sample whose predicted success beats the best observed, or the
 /// slot's last one), scored by the highest predicted probability over the
 /// exposures ([`TaskModel::best`]) at the decision sample's MMBM; the frame
 /// is exposed for that exposure with the gain raised by `T / t_e`.
@@ -167,7 +167,7 @@ impl Policy for Task {
         }
         let dt = obs.previous_time().map_or(0.0, |p| now - p);
         let deadline = now + 1.5 * dt >= start + period;
-        if (!observing && score >= self.obs_max) || deadline {
+        if (!observing && score > self.obs_max) || deadline {
             self.taken = true;
             return true;
         }
