@@ -66,7 +66,7 @@ impl Exposure {
 impl Exposure {
     /// The exposure (s) from the inner policy's forecast, at most `t_max`;
     /// `None` when it has none now.
-    fn from_forecast(&self, obs: &Observation, t_max: f64) -> Option<f64> {
+    fn forecast_exposure_s(&self, obs: &Observation, t_max: f64) -> Option<f64> {
         let t_min = self.min_exposure.min(t_max);
         let pitch = obs.timing.pitch_mm;
         let mut ready = false;
@@ -108,7 +108,7 @@ impl Policy for Exposure {
     }
     fn exposure(&self, obs: &Observation) -> (f64, f64) {
         let (t_inner, gain_inner) = self.inner.exposure(obs);
-        let te = match self.from_forecast(obs, t_inner) {
+        let te = match self.forecast_exposure_s(obs, t_inner) {
             Some(te) => te,
             None => self.exposure_for(obs.current(), obs.timing).min(t_inner),
         };
