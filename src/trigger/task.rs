@@ -291,9 +291,12 @@ mod tests {
         assert!(f.len() >= 45, "{}", f.len());
         let quiet = f.iter().filter(|x| x.mmbm_trigger_mm_s < 0.1).count();
         assert!(quiet + 2 >= f.len(), "{quiet} of {}", f.len());
-        // Quiet and dim: long exposures; each frame's gain keeps the brightness.
+        // Quiet and dim: exposures past the SNR cliff (16 e- at 1000 e-/s),
+        // far above the shortest; each frame's gain keeps the brightness.
+        let model = TaskModel::at_light(1000.0);
         for x in f.iter().filter(|x| x.mmbm_trigger_mm_s < 0.1) {
-            assert!(x.exposure_s() > 0.03, "{x:?}");
+            assert!(x.exposure_s() > 0.016, "{x:?}");
+            assert!(model.snr(x.exposure_s()) > 1.1 * model.s50, "{x:?}");
             assert!((x.gain * x.exposure_s() - 0.07).abs() < 1e-9);
         }
     }
