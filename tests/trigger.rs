@@ -513,8 +513,8 @@ fn quality_order_on_simulated_gaits() {
         println!("{g}: oracle {o:.4} forecast {f:.4} phase {ph:.4} threshold {t:.4} fixed {x:.4}; forecast recovers {:.0} %, phase {:.0} % of the oracle's gain over threshold", 100.0 * (t - f) / (t - o), 100.0 * (t - ph) / (t - o));
         assert!(o < f && f < t && t < x, "{g}: {o} {f} {t} {x}");
         // The learned phase forecast: issue 11's goal is 70 % of the oracle's
-        // gain on the moderate walk (64 % on these seeds; 76 % mean, 68-83 %,
-        // over seeds 1-10 of 120 s); the slow walk 52 %. Floors below those,
+        // gain on the moderate walk (68 % on these seeds; 74 % mean, 65-80 %,
+        // over the 60 s walks of seeds 1-5); the slow walk 55 %. Floors below those,
         // so the test fails on a predictor that stops learning (the blind
         // forecast: 5 % and 13 %).
         let share = (t - ph) / (t - o);

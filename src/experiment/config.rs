@@ -121,6 +121,9 @@ impl Default for MapSection {
                 "deadline:5+exp:1:0.003",
                 "fixed:5+exp:2:0.02",
                 "deadline:5",
+                "task:5:light=1000",
+                "task:5:light=4000",
+                "task:5:light=20000",
                 "ae:5:cap=10ms",
                 "ae:5:cap=3ms",
             ]
@@ -147,9 +150,9 @@ impl MapSection {
     }
 
     /// The reduced map of `mmbm demo`: the half board on the moderate walk,
-    /// seeds 1-5, four lights, a coarser grid (3, 10, 20, 70 ms), three
-    /// gyro-driven candidates (trigger timing with a loose and a tight blur
-    /// budget, and alone) and one auto-exposure.
+    /// seeds 1-5, four lights, a coarser grid (3, 10, 20, 70 ms), five
+    /// gyro-driven candidates (trigger timing alone, and the predicted task
+    /// success at each light, stated) and one auto-exposure.
     pub fn reduced() -> Self {
         MapSection {
             lights_e_per_s: vec![1_000.0, 4_000.0, 20_000.0, 100_000.0],
@@ -157,9 +160,11 @@ impl MapSection {
             boards: vec!["blobs:0.5".into()],
             seeds: (1..=5).collect(),
             policies: [
-                "deadline:5+exp:3:0.02",
-                "deadline:5+exp:1:0.003",
                 "deadline:5",
+                "task:5:light=1000",
+                "task:5:light=4000",
+                "task:5:light=20000",
+                "task:5:light=100000",
                 "ae:5:cap=10ms",
             ]
             .map(String::from)

@@ -44,7 +44,8 @@
 //! | `gate:X[:FPS[@PHASE]]` | `fixed` (default 5 fps), frames whose exposure MMBM is above `X` marked not kept |
 //! | `gate0:X[:FPS[@PHASE]]` | the same, on the MMBM at the exposure start (the decision sample): the thesis's test |
 //! | `deadline:FPS[:X]` | one frame per fixed-rate slot at the best causal instant (see [`Deadline`]) |
-//! | `P+exp:B[:TMIN]` | any policy `P` with exposure control: each frame's exposure shortened (and gain raised) so the blur the MMBM predicts stays within `B` px (see [`Exposure`]) |
+//! | `task:FPS:light=E[:read=E][:tmin=Tms]` | one frame per fixed-rate slot, exposure and instant chosen for the highest predicted probability that the frame is sharp, from the predicted blur and the SNR at the stated light (see [`Task`], [`TaskModel`]) |
+//! | `P+exp:B[:TMIN]` | any policy `P` with exposure control: each frame's exposure shortened (and gain raised) so the blur predicted over the exposure stays within `B` px: the forecast of `phase`, the MMBM at the decision sample for the others (see [`Exposure`]) |
 //!
 //! # Live
 //!
@@ -75,6 +76,7 @@ mod run;
 mod session;
 mod stats;
 mod stream;
+mod task;
 mod timing;
 
 pub use baselines::{AeParams, AutoExposure, FixedExposure};
@@ -97,4 +99,5 @@ pub use stats::{
     FRAME_HEADER,
 };
 pub use stream::{Stream, StreamControl, StreamEnd, StreamOptions, StreamOutcome, POLL};
+pub use task::{Task, TaskModel};
 pub use timing::{exposure_means, CameraTiming, Frame, Integral};

@@ -10,6 +10,7 @@ use super::phase::Phase;
 use super::policy::{Level, Policy};
 use super::predict::{Forecast, Oracle};
 use super::rules::{Adaptive, Deadline, Fixed, Gate, Threshold};
+use super::task::{parse_task, Task, TaskModel};
 use crate::error::{Error, Result};
 
 /// Highest frame rate a policy accepts, frames/s.
@@ -44,7 +45,7 @@ fn parse_rate(s: &str, spec: &str) -> Result<(f64, f64)> {
 }
 
 const GRAMMAR: &str = "fixed:FPS[@PHASE][@Tms], ae:FPS[@PHASE][:cap=Tms][:target=F][:damp=F][:scene=F], threshold:X, adaptive[:X[:FPS]], oracle:X[:H], \
-forecast:X[:H], phase:X[:H], gate:X[:FPS[@PHASE]], gate0:X[:FPS[@PHASE]] or deadline:FPS[:X] (X in mm/s or pNN), \
+forecast:X[:H], phase:X[:H], gate:X[:FPS[@PHASE]], gate0:X[:FPS[@PHASE]], deadline:FPS[:X] (X in mm/s or pNN) or task:FPS:light=E[:read=E][:tmin=Tms], \
 each optionally followed by +exp:B[:TMIN] (exposure control: blur budget B px, shortest exposure TMIN s)";
 
 /// Parses a policy string (grammar in the module docs) and builds the policy.
@@ -80,6 +81,8 @@ pub enum Family {
     Deadline,
     /// `ae:FPS[...]`, motion-blind auto-exposure.
     Ae,
+    /// `task:FPS:light=E[...]`, the predicted task success.
+    Task,
 }
 
 impl Family {
@@ -96,6 +99,7 @@ impl Family {
             Family::Gate0 => "gate0",
             Family::Deadline => "deadline",
             Family::Ae => "ae",
+            Family::Task => "task",
         }
     }
 
@@ -111,6 +115,7 @@ impl Family {
             Family::Gate0,
             Family::Deadline,
             Family::Ae,
+            Family::Task,
         ]
         .into_iter()
         .find(|f| f.name() == s)
@@ -204,6 +209,8 @@ pub struct PolicySpec {
     pub fixed_exposure_s: Option<f64>,
     /// The auto-exposure of `ae:...`.
     pub ae: Option<AeParams>,
+    /// The success model of `task:...` (with its stated light).
+    pub task: Option<TaskModel>,
 }
 
 impl PolicySpec {
@@ -225,9 +232,9 @@ impl PolicySpec {
                 Error::invalid("policy", format!("'{spec}': {msg}; expected {GRAMMAR}"))
             };
             let mut inner = PolicySpec::parse(base)?;
-            if inner.fixed_exposure_s.is_some() || inner.ae.is_some() {
+            if inner.fixed_exposure_s.is_some() || inner.ae.is_some() || inner.task.is_some() {
                 return Err(bad(
-                    "a fixed exposure (@Tms) or auto-exposure (ae) sets its own exposure; +exp does not apply",
+                    "a fixed exposure (@Tms), auto-exposure (ae) or task sets its own exposure; +exp does not apply",
                 ));
             }
             let parts: Vec<&str> = modifier.trim().split(':').collect();
@@ -277,6 +284,7 @@ impl PolicySpec {
             exposure: None,
             fixed_exposure_s: None,
             ae: None,
+            task: None,
         };
         match (family, args) {
             (Family::Fixed, [r]) => {
@@ -287,6 +295,10 @@ impl PolicySpec {
             (Family::Ae, [r, keys @ ..]) => {
                 out.rate = Some(rate(r)?);
                 out.ae = Some(parse_ae(keys, spec)?);
+            }
+            (Family::Task, [f, keys @ ..]) => {
+                out.rate = Some(fps_only(f, "frame rate")?);
+                out.task = Some(parse_task(keys, spec)?);
             }
             (Family::Threshold, [x]) => out.threshold = Some(level(x)?),
             (Family::Adaptive, []) => {
@@ -411,6 +423,11 @@ impl PolicySpec {
             Family::Gate => Box::new(Gate::new(spec, level, rate.fps, rate.phase)),
             Family::Gate0 => Box::new(Gate::at_start(spec, level, rate.fps, rate.phase)),
             Family::Deadline => Box::new(Deadline::new(spec, rate.fps, self.threshold)),
+            Family::Task => Box::new(Task::new(
+                spec,
+                rate.fps,
+                self.task.unwrap_or(TaskModel::at_light(1.0)),
+            )),
         }
     }
 }

@@ -47,6 +47,15 @@ use std::collections::VecDeque;
 ///   touchdowns are known, when the log is not periodic, when the clock does
 ///   not fit the touchdowns (residual deviation above [`Phase::LOCK`] of its
 ///   period) or the last touchdown is more than two clock periods old (lock lost).
+/// - **Robustness**: with five or more touchdowns the clock is fitted
+///   robustly (see `Phase::clock`: touchdowns more than [`Phase::OUTLIER`]
+///   robust deviations off the first fit, a stumble or a double crossing,
+///   are left out of the refit and of the fold); an outlying last touchdown
+///   is replaced by its tick, and when none came [`Phase::MISSED`] periods
+///   after the last, the one due is taken as missed (the fold aligned on its tick).
+/// - **Exposure control** (`phase:X+exp:B`): [`Phase::forecast_exposure`]
+///   forecasts the exposure MMBM for any exposure, which
+///   [`Exposure`](super::Exposure) uses instead of the decision sample.
 #[derive(Debug, Clone)]
 pub struct Phase {
     spec: String,
@@ -66,11 +75,11 @@ impl Phase {
     /// Previous cycles folded into the forecast.
     pub const CYCLES: usize = 8;
     /// The forecast is the fold's mean plus this many standard deviations.
-    pub const RISK: f64 = 2.0;
+    pub const RISK: f64 = 2.5;
     /// Exposures must end this many clock residual deviations before the next tick.
     pub const MARGIN: f64 = 3.0;
     /// Lock: the clock's residual deviation at most this share of its period.
-    pub const LOCK: f64 = 0.1;
+    pub const LOCK: f64 = 0.15;
     /// A period is the shortest autocorrelation peak reaching this share of the highest.
     pub const SHORTEST: f64 = 0.5;
     /// The first period estimate needs this much log, s (later ones use
@@ -82,6 +91,12 @@ impl Phase {
     pub const REFRACTORY: f64 = 0.6;
     /// Time after a touchdown at which its peak is taken as known, s.
     pub const PEAK_AFTER: f64 = 0.1;
+    /// A touchdown this many robust deviations off the clock is an outlier.
+    pub const OUTLIER: f64 = 3.0;
+    /// The robust deviation is at least this share of the period.
+    pub const OUTLIER_FLOOR: f64 = 0.02;
+    /// No touchdown this many periods after the last: the one due is taken as missed.
+    pub const MISSED: f64 = 1.3;
 
     /// Threshold `level` on the forecast exposure average, look-ahead `horizon` s.
     pub fn new(spec: &str, level: Level, horizon: f64) -> Self {
@@ -160,11 +175,12 @@ impl Phase {
         starts: impl Iterator<Item = f64>,
         now: f64,
         timing: &CameraTiming,
+        exposure_s: f64,
     ) -> Option<(f64, f64)> {
         let (mut sum, mut sum2, mut k) = (0.0, 0.0, 0);
         for t in starts {
             let a = t + timing.delay;
-            let b = a + timing.exposure;
+            let b = a + exposure_s;
             if b <= now {
                 let e = self.hist.mean(a, b);
                 sum += e;
@@ -180,7 +196,11 @@ impl Phase {
     }
 
     /// The gait clock fitted to the known touchdowns (least squares of their
-    /// times on their step numbers); `None` when they do not fit one.
+    /// times on their step numbers); `None` when they do not fit one. With
+    /// five or more touchdowns the fit is made robust: touchdowns further than
+    /// [`Phase::OUTLIER`] robust deviations (1.4826 median absolute residuals,
+    /// at least [`Phase::OUTLIER_FLOOR`] of the period) from the first fit are
+    /// marked outliers and the clock refitted on the others.
     fn clock(&self, p: f64) -> Option<Clock> {
         let first = *self.touchdowns.front()?;
         let ks: Vec<f64> = self
@@ -188,50 +208,89 @@ impl Phase {
             .iter()
             .map(|&t| ((t - first) / p).round())
             .collect();
-        let n = ks.len() as f64;
-        let (mk, mt) = (
-            ks.iter().sum::<f64>() / n,
-            self.touchdowns.iter().sum::<f64>() / n,
-        );
-        let (mut skk, mut skt) = (0.0, 0.0);
-        for (k, t) in ks.iter().zip(&self.touchdowns) {
-            skk += (k - mk) * (k - mk);
-            skt += (k - mk) * (t - mt);
+        let all = vec![true; ks.len()];
+        let (origin, period, _) = fit_line(&ks, &self.touchdowns, &all)?;
+        let res: Vec<f64> = ks
+            .iter()
+            .zip(&self.touchdowns)
+            .map(|(k, t)| t - origin - k * period)
+            .collect();
+        let mut inlier = all;
+        if ks.len() >= 5 {
+            let mut a: Vec<f64> = res.iter().map(|r| r.abs()).collect();
+            a.sort_by(f64::total_cmp);
+            let sd_r = (1.4826 * a[a.len() / 2]).max(Self::OUTLIER_FLOOR * period);
+            for (f, r) in inlier.iter_mut().zip(&res) {
+                *f = r.abs() <= Self::OUTLIER * sd_r;
+            }
         }
-        if skk <= 0.0 {
-            return None;
-        }
-        let period = skt / skk;
+        let (origin, period, sd) = fit_line(&ks, &self.touchdowns, &inlier)?;
         if !(0.8 * p..=1.25 * p).contains(&period) {
             return None;
         }
-        let origin = mt - period * mk;
-        let res2 = ks
-            .iter()
-            .zip(&self.touchdowns)
-            .map(|(k, t)| (t - origin - k * period).powi(2))
-            .sum::<f64>();
         Some(Clock {
-            sd: (res2 / (n - 2.0).max(1.0)).sqrt(),
+            sd,
             origin,
             first,
             period,
+            inlier,
         })
     }
 
-    /// The folded forecast for triggers at `now + u` for each `u` in `us`;
-    /// `None` when it cannot be made.
-    fn forecast(&self, now: f64, us: &[f64], timing: &CameraTiming) -> Option<Vec<f64>> {
+    /// The forecast exposure MMBM (mm/s, mean plus [`Phase::RISK`] standard
+    /// deviations over the folded cycles, as in the decision) of a frame
+    /// triggered at `now` and exposed for `exposure_s`; `None` while the
+    /// fold cannot be made (the decision falls back to the thesis rule then).
+    /// Infinite when such an exposure would end within [`Phase::MARGIN`]
+    /// clock deviations of the next touchdown.
+    pub fn forecast_exposure(
+        &self,
+        now: f64,
+        timing: &CameraTiming,
+        exposure_s: f64,
+    ) -> Option<f64> {
+        self.forecast(now, &[0.0], timing, exposure_s).map(|v| v[0])
+    }
+
+    /// The folded forecast for triggers at `now + u` for each `u` in `us`,
+    /// exposed for `exposure_s`; `None` when it cannot be made.
+    fn forecast(
+        &self,
+        now: f64,
+        us: &[f64],
+        timing: &CameraTiming,
+        exposure_s: f64,
+    ) -> Option<Vec<f64>> {
         let p = self.period?;
         let n = self.touchdowns.len();
         if n < Self::MIN_CYCLES + 1 {
             return None;
         }
-        let last = self.touchdowns[n - 1];
-        let s = now - last;
-        let past: Vec<f64> = self.touchdowns.iter().take(n - 1).copied().collect();
         let clock = self.clock(self.step_interval()?)?;
-        if clock.sd > Self::LOCK * clock.period || s > 2.0 * clock.period {
+        let raw_last = self.touchdowns[n - 1];
+        if clock.sd > Self::LOCK * clock.period || now - raw_last > 2.0 * clock.period {
+            return None;
+        }
+        // An outlying last touchdown is replaced by its tick; a missed one
+        // (no crossing a period and more after the last) by the tick due.
+        let mut last = if clock.inlier[n - 1] {
+            raw_last
+        } else {
+            clock.tick(clock.index(raw_last))
+        };
+        if now - last > Self::MISSED * clock.period {
+            last = clock.tick(clock.index(last) + ((now - last) / clock.period).floor());
+        }
+        let s = now - last;
+        let past: Vec<f64> = self
+            .touchdowns
+            .iter()
+            .zip(&clock.inlier)
+            .take(n - 1)
+            .filter(|(_, &ok)| ok)
+            .map(|(&t, _)| t)
+            .collect();
+        if past.len() < Self::MIN_CYCLES {
             return None;
         }
         // Amplitude of the current cycle against the folded ones.
@@ -249,21 +308,23 @@ impl Phase {
             1.0
         };
         let next_tick = clock.tick(clock.index(last) + 1.0);
-        // Ticks of the known touchdowns but the first: the ends of the folded cycles.
+        // Ticks of the known inlying touchdowns but the first: the ends of the folded cycles.
         let ticks: Vec<f64> = self
             .touchdowns
             .iter()
+            .zip(&clock.inlier)
             .skip(1)
-            .map(|&tj| clock.tick(clock.index(tj)))
+            .filter(|(_, &ok)| ok)
+            .map(|(&tj, _)| clock.tick(clock.index(tj)))
             .collect();
         let mut out = Vec::with_capacity(us.len());
         for &u in us {
             // After the last touchdown: aligned on it; before the next: on the clock.
-            let post = self.fold(past.iter().map(|&tj| tj + s + u), now, timing)?;
+            let post = self.fold(past.iter().map(|&tj| tj + s + u), now, timing, exposure_s)?;
             let r = next_tick - (now + u);
-            let pre = self.fold(ticks.iter().map(|&tk| tk - r), now, timing);
+            let pre = self.fold(ticks.iter().map(|&tk| tk - r), now, timing, exposure_s);
             let w = (((s + u) / p - 0.3) / 0.4).clamp(0.0, 1.0);
-            if now + u + timing.delay + timing.exposure > next_tick - Self::MARGIN * clock.sd {
+            if now + u + timing.delay + exposure_s > next_tick - Self::MARGIN * clock.sd {
                 out.push(f64::INFINITY);
                 continue;
             }
@@ -280,13 +341,49 @@ impl Phase {
     }
 }
 
+/// Least squares `t = origin + k period` over the points `use_` marks:
+/// `(origin, period, residual deviation)`; `None` without two distinct `k`.
+fn fit_line(ks: &[f64], ts: &VecDeque<f64>, use_: &[bool]) -> Option<(f64, f64, f64)> {
+    let pts = || {
+        ks.iter()
+            .zip(ts)
+            .zip(use_)
+            .filter(|(_, &u)| u)
+            .map(|((&k, &t), _)| (k, t))
+    };
+    let n = pts().count() as f64;
+    if n < 2.0 {
+        return None;
+    }
+    let (mk, mt) = (
+        pts().map(|(k, _)| k).sum::<f64>() / n,
+        pts().map(|(_, t)| t).sum::<f64>() / n,
+    );
+    let (mut skk, mut skt) = (0.0, 0.0);
+    for (k, t) in pts() {
+        skk += (k - mk) * (k - mk);
+        skt += (k - mk) * (t - mt);
+    }
+    if skk <= 0.0 {
+        return None;
+    }
+    let period = skt / skk;
+    let origin = mt - period * mk;
+    let res2 = pts()
+        .map(|(k, t)| (t - origin - k * period).powi(2))
+        .sum::<f64>();
+    Some((origin, period, (res2 / (n - 2.0).max(1.0)).sqrt()))
+}
+
 /// A gait clock: touchdown `k` is due at `origin + k period`.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 struct Clock {
     sd: f64,
     origin: f64,
     first: f64,
     period: f64,
+    /// Per known touchdown: false for an outlier of the robust fit.
+    inlier: Vec<bool>,
 }
 
 impl Clock {
@@ -303,6 +400,9 @@ impl Clock {
 impl Policy for Phase {
     fn spec(&self) -> &str {
         &self.spec
+    }
+    fn forecast_exposure_mmbm(&self, obs: &Observation, exposure_s: f64) -> Option<f64> {
+        self.forecast_exposure(obs.now(), obs.timing, exposure_s)
     }
     fn prepare(&mut self, log: &LogView, _timing: &CameraTiming) -> Result<()> {
         self.x = self.level.resolve(log.mmbm)?;
@@ -343,9 +443,106 @@ impl Policy for Phase {
         let us: Vec<f64> = (0..=Forecast::GRID)
             .map(|q| q as f64 * self.horizon / Forecast::GRID as f64)
             .collect();
-        let Some(e) = self.forecast(now, &us, obs.timing) else {
+        let Some(e) = self.forecast(now, &us, obs.timing, obs.timing.exposure) else {
             return thesis_rule(obs.mmbm, self.x);
         };
         e[0] < self.x && e[1..].iter().all(|&v| e[0] <= v)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::trigger::{parse_policy, run};
+
+    /// A clocked gait (0.8 s, touchdowns jittered by up to 30 ms): a sharp
+    /// transient per step on a 0.2 mm/s floor; `extra` adds spurious
+    /// transients (a stumble) at the given times.
+    fn gait(secs: f64, extra: &[f64]) -> (Vec<f64>, Vec<f64>) {
+        let t: Vec<f64> = (0..(600.0 * secs) as usize)
+            .map(|k| k as f64 / 600.0)
+            .collect();
+        let jitter = [0.0, 0.03, -0.02, 0.01, -0.03, 0.02, 0.0, -0.01];
+        let mut td: Vec<f64> = (0..(secs / 0.8) as usize + 1)
+            .map(|k| 0.8 * k as f64 + jitter[k % 8])
+            .collect();
+        td.extend_from_slice(extra);
+        td.sort_by(f64::total_cmp);
+        let m = t
+            .iter()
+            .map(|&x| {
+                let k = td.partition_point(|&d| d <= x);
+                let s = if k == 0 { 10.0 } else { x - td[k - 1] };
+                0.2 + 1.5 * (-s / 0.03).exp()
+            })
+            .collect();
+        (t, m)
+    }
+
+    #[test]
+    fn robust_clock_ignores_a_stumble() {
+        // A spurious transient 0.5 s after the touchdown at 16 s: a touchdown
+        // off the clock, which the robust fit marks and the fold leaves out.
+        let (t, m) = gait(17.0, &[16.5]);
+        let mut p = Phase::new("phase:0.4", Level::Abs(0.4), 0.2);
+        run(&t, &m, &mut p, &CameraTiming::default()).unwrap();
+        assert!(p.touchdowns().any(|x| (x - 16.5).abs() < 0.01));
+        let step = p.step_interval().unwrap();
+        let c = p.clock(step).unwrap();
+        let bad: Vec<f64> = p
+            .touchdowns()
+            .zip(&c.inlier)
+            .filter(|(_, &ok)| !ok)
+            .map(|(x, _)| x)
+            .collect();
+        assert_eq!(bad.len(), 1, "{bad:?}");
+        assert!((bad[0] - 16.5).abs() < 0.01, "{bad:?}");
+        assert!((c.period - 0.8).abs() < 0.01 && c.sd < 0.03, "{c:?}");
+    }
+
+    #[test]
+    fn exposure_control_on_the_phase_forecast() {
+        // Once locked, the forecast over the exposure sees the next
+        // touchdown coming: frames triggered late in a step get an exposure
+        // short enough to end before it, so the realised blur stays within
+        // the budget far more often than with the decision sample's rule.
+        let (t, m) = gait(40.0, &[]);
+        let timing = CameraTiming::default();
+        let over = |spec: &str| {
+            let mut p = parse_policy(spec).unwrap();
+            let f = run(&t, &m, p.as_mut(), &timing).unwrap();
+            let late: Vec<_> = f.into_iter().filter(|f| f.trigger_t > 12.0).collect();
+            let n = late
+                .iter()
+                .filter(|f| {
+                    crate::camera::blur_px(f.mmbm_exposure_mm_s, f.exposure_s(), timing.pitch_mm)
+                        > 3.5
+                })
+                .count();
+            (n, late.len())
+        };
+        let (n_phase, k_phase) = over("phase:0.4+exp:3");
+        assert!(k_phase >= 20, "{k_phase}");
+        assert!(
+            n_phase * 10 <= k_phase,
+            "{n_phase} of {k_phase} over budget"
+        );
+        // Mid-step, a short exposure is forecast on the floor; one that
+        // would end within the margin of the next tick is refused (infinite).
+        let mut p = Phase::new("phase:0.4", Level::Abs(0.4), 0.2);
+        let cut = t.partition_point(|&x| x < 20.5);
+        run(&t[..cut], &m[..cut], &mut p, &timing).unwrap();
+        let now = t[cut - 1];
+        let c = p.clock(p.step_interval().unwrap()).unwrap();
+        let last = p.touchdowns().last().unwrap();
+        let next = c.tick(c.index(last) + 1.0);
+        let short = p.forecast_exposure(now, &timing, 0.01).unwrap();
+        assert!(short < 0.3, "{short}");
+        let cross = next - now - timing.delay + 0.005;
+        assert!(cross > 0.01 && cross < 0.4, "{cross}");
+        assert_eq!(
+            p.forecast_exposure(now, &timing, cross),
+            Some(f64::INFINITY)
+        );
     }
 }

@@ -97,6 +97,14 @@ pub trait Policy {
     fn exposure(&self, obs: &Observation) -> (f64, f64) {
         (obs.timing.exposure, 1.0)
     }
+    /// The policy's forecast of the exposure MMBM (mm/s) of a frame triggered
+    /// at `obs` and exposed for `exposure_s` (infinite: an exposure the
+    /// policy would not take), for exposure control; `None` (the default)
+    /// when the policy has no forecast of its own (exposure control then
+    /// uses the MMBM at the decision sample).
+    fn forecast_exposure_mmbm(&self, _obs: &Observation, _exposure_s: f64) -> Option<f64> {
+        None
+    }
 }
 
 /// A threshold: an absolute MMBM (mm/s) or a percentile of the log's own series.
