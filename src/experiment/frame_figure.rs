@@ -248,7 +248,7 @@ mod tests {
             }
         }
         Shot {
-            trigger_t: 3.14159,
+            trigger_t: 3.13579,
             blur_px: 2.25,
             blobs_matched: matched,
             blobs_expected: 16,

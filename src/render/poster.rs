@@ -157,9 +157,9 @@ mod tests {
     #[test]
     fn stays_in_range_and_averages_to_the_grey() {
         let g = crate::render::DEFAULT_BACKGROUND;
-        for ch in 0..3 {
+        for (ch, grey) in g.iter().enumerate() {
             let amp: f32 = LAYERS.iter().map(|l| l.amplitude[ch]).sum();
-            assert!(amp <= g[ch] + 1e-6, "channel {ch}: {amp}");
+            assert!(amp <= grey + 1e-6, "channel {ch}: {amp}");
         }
         // The mean over a 7.4 m square (20 periods of the coarsest layer) is the grey.
         let n = 1480;
@@ -167,9 +167,8 @@ mod tests {
         for i in 0..n {
             for j in 0..n {
                 let (a, b) = ((i as f64 + 0.5) * 0.005, (j as f64 + 0.5) * 0.005);
-                let c = at(g, a, b);
-                for k in 0..3 {
-                    sum[k] += c[k] as f64;
+                for (s, c) in sum.iter_mut().zip(at(g, a, b)) {
+                    *s += c as f64;
                 }
             }
         }
