@@ -45,10 +45,10 @@ pub struct CellPolicy {
     /// Blobs found away from every board place, over all kept frames (clutter, noise).
     pub false_alarms: usize,
     /// Mean corner repeatability of the kept frames with corners
-    /// ([`super::corners`]; NaN when none had any).
+    /// (`corners.rs`; NaN when none had any).
     pub corner_rep: f64,
     /// Frames usable for odometry per second: repeatability at least
-    /// [`super::corners::REPEAT_OK`] (all seeds pooled).
+    /// `corners::REPEAT_OK` (all seeds pooled).
     pub vo_fps: f64,
 }
 

@@ -58,7 +58,7 @@ pub struct FrameMeasure {
     pub pose_err_m: f64,
     /// The same for the orientation, degrees.
     pub pose_err_deg: f64,
-    /// Corner repeatability ([`super::corners`]): share of the sharp
+    /// Corner repeatability (`corners.rs`): share of the sharp
     /// frame's FAST corners re-found within 2 px; NaN without corners.
     pub corner_rep: f64,
     /// Samples per pixel used by the renderer.
