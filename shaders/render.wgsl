@@ -26,7 +26,7 @@ struct Params {
     tex: vec4<f32>,
     colour_a: vec4<f32>,
     colour_b: vec4<f32>,
-    lod: vec4<f32>,        // LOD_SCALE, 1/N, 0, 0
+    lod: vec4<f32>,        // LOD_SCALE, 1/N, poster layers (0: plain background), 0
     dims: vec4<u32>,       // width, height, kind, N
     lattice: vec4<u32>,    // g1, g2, distortion map offset (0: none), seed
     range: vec4<u32>,      // row0, k0, k1, (k0 g1) mod N
@@ -34,6 +34,7 @@ struct Params {
     bbox: vec4<u32>,       // x0, y0, x1, y1 (end exclusive)
     lens: vec4<f32>,       // aperture radius (m; 0: pinhole), fx / s, fy / s, skew / s
     lens_gen: vec4<u32>,   // g3, g4, (k0 g3) mod N, (k0 g4) mod N
+    poster: array<vec4<f32>, 8>, // per layer [S, 1/S, pa, pb], [r, g, b, 0] (src/render/poster.rs)
 }
 
 struct Homography {
@@ -92,6 +93,22 @@ fn trilinear(u: f32, v: f32, lod_in: f32) -> vec3<f32> {
     return a + (b - a) * f;
 }
 
+// The poster (src/render/poster.rs) at plane point (a, b), or the plain
+// background without one.
+fn poster_point(a: f32, b: f32) -> vec3<f32> {
+    var c = P.background.xyz;
+    let n = u32(P.lod.z);
+    if (n == 0u || abs(a) > P.poster[1].w || abs(b) > P.poster[3].w) {
+        return c;
+    }
+    for (var k = 0u; k < n; k = k + 1u) {
+        let l = P.poster[2u * k];
+        let s = i32(floor((a + l.z) * l.y)) + i32(floor((b + l.w) * l.y));
+        c = c + select(-1.0, 1.0, (s & 1) == 0) * P.poster[2u * k + 1u].xyz;
+    }
+    return c;
+}
+
 fn shade(h: Homography, px: f32, py: f32) -> vec3<f32> {
     let bg = P.background.xyz;
     let w = h.h2.x * px + h.h2.y * py + h.h2.z;
@@ -112,7 +129,7 @@ fn shade(h: Homography, px: f32, py: f32) -> vec3<f32> {
         let pitch = P.tex.y;
         let half = P.tex.z;
         if (abs(a) > half || abs(b) > half) {
-            return bg;
+            return poster_point(a, b);
         }
         let inv_pitch = P.tex.w;
         let ca = (clamp(floor(a * inv_pitch + 2.0), 0.0, 3.0) - 1.5) * pitch;
@@ -125,7 +142,7 @@ fn shade(h: Homography, px: f32, py: f32) -> vec3<f32> {
     let u = a / P.tex.x + 0.5;
     let v = b / P.tex.y + 0.5;
     if (u < 0.0 || u > 1.0 || v < 0.0 || v > 1.0) {
-        return bg;
+        return poster_point(a, b);
     }
     // Footprint side (m) = sqrt(|det H| / w^3); in texels of level 0.
     let tx = sqrt(h.h2.w * r * r * r) * P.tex.z;
@@ -354,6 +371,27 @@ fn trap_in(lo: f32, hi: f32, c: f32, p: f32, q: f32, tiny: f32) -> f32 {
     return trap_cdf(hi - c, p, q, tiny) - trap_cdf(lo - c, p, q, tiny);
 }
 
+// The poster averaged over a footprint with marginal half-widths (pa, qa)
+// along a and (pb, qb) along b (each layer a product of square waves).
+fn poster_mean(a: f32, b: f32, pa: f32, qa: f32, pb: f32, qb: f32) -> vec3<f32> {
+    let bg = P.background.xyz;
+    let ha = P.poster[1].w;
+    let hb = P.poster[3].w;
+    // The poster's coverage of the footprint (independent axes, as the board's).
+    let cover = trap_in(-ha, ha, a, pa, qa, TINY * ha) * trap_in(-hb, hb, b, pb, qb, TINY * hb);
+    if (cover <= 0.0) {
+        return bg;
+    }
+    var c = bg;
+    let n = u32(P.lod.z);
+    for (var k = 0u; k < n; k = k + 1u) {
+        let l = P.poster[2u * k];
+        let m = square_mean(a + l.z, pa, qa, l.x, l.y) * square_mean(b + l.w, pb, qb, l.x, l.y);
+        c = c + m * P.poster[2u * k + 1u].xyz;
+    }
+    return bg + (c - bg) * cover;
+}
+
 // Board and blob-column (or row) coverage along one axis: (board, blobs).
 fn board_axis(c: f32, p: f32, q: f32) -> vec2<f32> {
     let sq = P.tex.x;
@@ -426,7 +464,14 @@ fn footprint_eval(a: f32, b: f32, dax: f32, day: f32, dbx: f32, dby: f32) -> vec
     let cb = board_axis(b, pb, qb);
     let white = P.colour_b.xyz;
     let red = P.colour_a.xyz;
-    return bg + (white - bg) * (ca.x * cb.x) + (red - white) * (ca.y * cb.y);
+    // Behind the board: the poster where there is one (not needed where the
+    // board covers the whole footprint).
+    let board = ca.x * cb.x;
+    var back = bg;
+    if (P.lod.z > 0.0 && board < 1.0) {
+        back = poster_mean(a, b, pa, qa, pb, qb);
+    }
+    return back + (white - back) * board + (red - white) * (ca.y * cb.y);
 }
 
 @compute @workgroup_size(8, 8, 1)

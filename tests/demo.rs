@@ -61,7 +61,9 @@ fn demo_report_matches_the_docs() {
     // Every kept frame of the demo's policies rendered, with the new columns.
     let header = frames.lines().next().unwrap();
     assert!(
-        header.ends_with("blur_h_px,blur_v_px,jnbm_2d,cpbd_2d,gain,family"),
+        header.ends_with(
+            "blur_h_px,blur_v_px,jnbm_2d,cpbd_2d,gain,family,blobs_false,corner_repeatability"
+        ),
         "{header}"
     );
     let rendered = header.split(',').position(|c| c == "rendered").unwrap();

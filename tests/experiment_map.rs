@@ -15,6 +15,7 @@ fn tiny() -> ExperimentConfig {
         policies: vec!["fixed:5".into()],
         quality: "fast".into(),
         sweep_exposures_s: Vec::new(),
+        background: "poster".into(),
         camera: CameraFile {
             noise: Some(Noise {
                 seed: 1,
@@ -129,8 +130,32 @@ fn the_map_leads_the_report_and_holds_together() {
     assert_eq!(answer.lines().count(), 2 + m.cells.len());
     // frames.csv names every policy's family.
     let csv = std::fs::read_to_string(d.path().join("frames.csv")).unwrap();
-    assert!(csv.lines().next().unwrap().ends_with(",gain,family"));
-    assert!(csv.lines().skip(1).all(|l| l.ends_with(",fixed")));
+    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    assert!(header.ends_with(&["gain", "family", "blobs_false", "corner_repeatability"]));
+    let family = header.iter().position(|c| *c == "family").unwrap();
+    // The second task metric: a repeatability in [0, 1] for every rendered frame.
+    let rep = header.len() - 1;
+    let reps: Vec<f64> = csv
+        .lines()
+        .skip(1)
+        .filter_map(|l| l.split(',').nth(rep).and_then(|v| v.parse().ok()))
+        .collect();
+    assert!(
+        !reps.is_empty() && reps.iter().all(|r| (0.0..=1.0).contains(r)),
+        "{reps:?}"
+    );
+    assert!(md.contains("## Clutter and corners") && md.contains("Background `poster`"));
+    assert!(md.contains("Second task metric (visual odometry)"));
+    for c in &m.cells {
+        for p in &c.policies {
+            assert!(p.vo_fps >= 0.0 && p.vo_fps <= 5.1, "{p:?}");
+            assert!(p.corner_rep.is_nan() || (0.0..=1.0).contains(&p.corner_rep));
+        }
+    }
+    assert!(csv
+        .lines()
+        .skip(1)
+        .all(|l| l.split(',').nth(family) == Some("fixed")));
 }
 
 #[test]

@@ -402,3 +402,93 @@ fn image_texture_lateral_translation_equals_exact_integral() {
         );
     }
 }
+
+/// The poster behind the board (`background = "poster"`): still, each pixel
+/// inside one of its patches is that patch's colour (`poster::at`), pixels
+/// beyond it the plain grey; moving, the analytic integrator agrees with
+/// supersampling (`lattice`), and with `none` nothing changes off the board.
+#[test]
+fn poster_renders_its_texture_around_the_board() {
+    use mmbm::render::poster;
+    let cam = Camera::thesis().with_resolution(160, 120);
+    let mut t = Target::blobs(0.5, 6.0);
+    t.surround = mmbm::render::Background::Poster;
+    let still = Trajectory::from_twist(Twist::default(), 0.01).unwrap();
+    let job = |t: &Target, tr: &Trajectory, i: Integrator, q: Quality| {
+        let mut j = RenderJob::new(cam, 0.01, tr.clone(), t.clone());
+        j.backend = Backend::Cpu { threads: None };
+        j.integrator = i;
+        j.quality = q;
+        j.with_maps = false;
+        render_frame(&j).unwrap().rgb
+    };
+    let img = job(&t, &still, Integrator::Analytic, Quality::Default);
+    let id = (glam::DQuat::IDENTITY, DVec3::ZERO);
+    let plane = |x: f64, y: f64| {
+        let p = t.intersect(&cam, &id, x, y).unwrap();
+        (p.x, p.y)
+    };
+    let grey = mmbm::render::DEFAULT_BACKGROUND;
+    let half = 0.165; // the half board's half width, m
+    let (mut patches, mut plain) = (0, 0);
+    for j in 0..cam.height {
+        for i in 0..cam.width {
+            let corners = [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0)]
+                .map(|(dx, dy)| plane(i as f64 + dx, j as f64 + dy));
+            let px = &img[3 * (j * cam.width + i) as usize..][..3];
+            let outside = |l: f64| corners.iter().all(|c| c.0.abs() > l || c.1.abs() > l);
+            if outside(2.0 * half + 0.01) {
+                // Beyond the poster: the plain grey.
+                assert_eq!(px, grey, "pixel ({i}, {j})");
+                plain += 1;
+                continue;
+            }
+            let inside_poster = corners
+                .iter()
+                .all(|c| c.0.abs() < 2.0 * half && c.1.abs() < 2.0 * half);
+            let off_board = corners
+                .iter()
+                .all(|c| c.0.abs() > half + 0.01 || c.1.abs() > half + 0.01);
+            let colours = corners.map(|c| poster::at(grey, c.0, c.1));
+            if inside_poster && off_board && colours.iter().all(|c| *c == colours[0]) {
+                for k in 0..3 {
+                    assert!(
+                        (px[k] - colours[0][k]).abs() < 1e-4,
+                        "({i}, {j}): {px:?} vs {colours:?}"
+                    );
+                }
+                patches += 1;
+            }
+        }
+    }
+    assert!(
+        patches > 2000 && plain > 2000,
+        "{patches} patch pixels, {plain} plain"
+    );
+    // Moving: analytic against 4096 supersamples.
+    let tw = Twist::new(DVec3::new(0.3, -0.5, 0.2), DVec3::ZERO);
+    let moving = Trajectory::from_twist(tw, 0.01).unwrap();
+    let a = job(&t, &moving, Integrator::Analytic, Quality::Default);
+    let l = job(
+        &t,
+        &moving,
+        Integrator::Lattice,
+        Quality::Custom {
+            min_samples: 4096,
+            max_spacing_px: 0.25,
+        },
+    );
+    let mean = a
+        .iter()
+        .zip(&l)
+        .map(|(x, y)| (x - y).abs() as f64)
+        .sum::<f64>()
+        / a.len() as f64;
+    assert!(mean < 2e-3, "mean |analytic - lattice| = {mean}");
+    // Plain: the same board, grey around it.
+    let mut p = t.clone();
+    p.surround = mmbm::render::Background::Plain;
+    let g = job(&p, &still, Integrator::Analytic, Quality::Default);
+    let differ = g.iter().zip(&img).filter(|(x, y)| x != y).count();
+    assert!(differ > 3 * 4000, "{differ} values differ");
+}

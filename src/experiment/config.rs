@@ -49,6 +49,12 @@ pub struct ExperimentConfig {
     pub start_distance_m: f64,
     /// Closest allowed distance, m (the walk stops approaching there).
     pub min_distance_m: f64,
+    /// What is behind the board, in its plane: `none` (the thesis's plain
+    /// grey) or `poster` (the procedural CC0 texture of
+    /// [`crate::render::poster`]: clutter for blob extraction, corners for
+    /// the repeatability metric). The demo keeps `none` (its time with the
+    /// poster is not yet measured).
+    pub background: String,
     /// Rendered resolution `[width, height]` (thesis: 640 x 480), thesis focal length and pitch.
     pub resolution: [u32; 2],
     /// Render quality preset: `default` or `fast` (the report states its measured error).
@@ -295,6 +301,7 @@ impl Default for ExperimentConfig {
             readout_s: CameraTiming::DEFAULT_READOUT_S,
             min_interval_s: CameraTiming::DEFAULT_MIN_INTERVAL_S,
             target: "blobs:0.5".into(),
+            background: "none".into(),
             start_distance_m: 6.0,
             min_distance_m: 1.5,
             resolution: [640, 480],
@@ -363,6 +370,13 @@ impl ExperimentConfig {
             sweep_exposures_s: Vec::new(),
             ..d
         }
+    }
+
+    /// The target `spec` at `distance` m with this experiment's [`Self::background`].
+    pub fn scene_target(&self, spec: &str, distance: f64) -> Result<crate::render::Target> {
+        let mut t = crate::render::Target::parse(spec, distance)?;
+        t.surround = self.background.parse()?;
+        Ok(t)
     }
 
     /// Loads a TOML file; missing fields take the defaults.
@@ -434,6 +448,8 @@ impl ExperimentConfig {
         self.quality
             .parse::<crate::render::Quality>()
             .map_err(|e| key("quality", e))?;
+        // The error names the key (`background`).
+        self.background.parse::<crate::render::Background>()?;
         crate::render::Target::parse(&self.target, self.start_distance_m)
             .map_err(|e| key("target", e))?;
         for &e in &self.sweep_exposures_s {
@@ -465,6 +481,24 @@ impl ExperimentConfig {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn background_key_is_checked_and_reaches_the_target() {
+        let d = ExperimentConfig {
+            background: "poster".into(),
+            ..ExperimentConfig::demo()
+        };
+        assert_eq!(ExperimentConfig::demo().background, "none");
+        assert_eq!(ExperimentConfig::default().background, "none");
+        let t = d.scene_target("blobs:0.5", 6.0).unwrap();
+        assert_eq!(t.surround, crate::render::Background::Poster);
+        let bad = ExperimentConfig {
+            background: "bricks".into(),
+            ..ExperimentConfig::default()
+        };
+        let e = bad.validate().unwrap_err().to_string();
+        assert!(e.contains("background") && e.contains("bricks"), "{e}");
+    }
 
     #[test]
     fn demo_camera_fills_the_range_at_the_nominal_exposure() {

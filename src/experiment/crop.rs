@@ -6,8 +6,15 @@
 /// whole 64 x 64 blocks), cropped from the frame; the whole frame when no
 /// centres are known.
 pub fn pattern_crop(img: &image::RgbImage, expected: &[(f64, f64)]) -> image::RgbImage {
+    let [cx, cy, cw, ch] = pattern_box(img.width(), img.height(), expected);
+    image::imageops::crop_imm(img, cx, cy, cw, ch).to_image()
+}
+
+/// [`pattern_crop`]'s region of a `width` x `height` frame: `[x, y, w, h]` px
+/// (the whole frame when no centres are known).
+pub fn pattern_box(width: u32, height: u32, expected: &[(f64, f64)]) -> [u32; 4] {
     if expected.is_empty() {
-        return img.clone();
+        return [0, 0, width, height];
     }
     let p = pitch_px(expected);
     let (mut x0, mut y0, mut x1, mut y1) = (
@@ -22,7 +29,7 @@ pub fn pattern_crop(img: &image::RgbImage, expected: &[(f64, f64)]) -> image::Rg
         x1 = x1.max(x + p);
         y1 = y1.max(y + p);
     }
-    let (w, h) = (img.width() as f64, img.height() as f64);
+    let (w, h) = (width as f64, height as f64);
     let grow = |a: f64, b: f64, lim: f64| {
         let (c, half) = ((a + b) / 2.0, ((b - a) / 2.0).max(64.0));
         let lo = (c - half).clamp(0.0, (lim - 2.0 * half).max(0.0));
@@ -30,9 +37,7 @@ pub fn pattern_crop(img: &image::RgbImage, expected: &[(f64, f64)]) -> image::Rg
     };
     let (cx, cw) = grow(x0, x1, w);
     let (cy, ch) = grow(y0, y1, h);
-    let cw = cw.min(img.width() - cx);
-    let ch = ch.min(img.height() - cy);
-    image::imageops::crop_imm(img, cx, cy, cw, ch).to_image()
+    [cx, cy, cw.min(width - cx), ch.min(height - cy)]
 }
 
 /// Blob pitch (px): the smallest distance between two expected centres.

@@ -1,6 +1,6 @@
 //! Report figures: the MMBM trace with trigger instants and shaded exposures
-//! (thesis Figs. 5.2 and 5.6), blur histograms per policy, and a side-by-side
-//! montage of frames.
+//! (thesis Figs. 5.2 and 5.6), blur histograms per policy, and each policy's
+//! sharpest and most blurred frame, labelled (`frame_figure`).
 
 use super::config::ExperimentConfig;
 use super::measure::FrameRecord;
@@ -8,7 +8,6 @@ use super::walk::Walk;
 use crate::error::Result;
 use crate::gpu::Backend;
 use crate::io::atomic::write_atomic_path;
-use crate::io::images::{half, linear_to_srgb8, save_rgb8};
 use crate::metric::Scene;
 use crate::plot::{ensure_font, plot_error};
 use crate::trigger::Family;
@@ -16,17 +15,11 @@ use plotters::prelude::*;
 use std::collections::HashMap;
 use std::path::Path;
 
-/// The sharpest and the most blurred rendered frame of one run: `(blur px, linear RGB)`.
-pub struct Extremes {
-    /// The frame with the least ground-truth blur.
-    pub sharpest: (f64, Vec<f32>),
-    /// The frame with the most.
-    pub blurriest: (f64, Vec<f32>),
-}
+pub use super::frame_figure::Extremes;
 
 /// Writes every figure of the report into `out`: per walk the MMBM traces of
 /// the main policies, the blur histograms, the sharpest/most blurred frame
-/// montage (from `extremes`, keyed by `(walk, policy)` index) and a flow
+/// figure (from `extremes`, keyed by `(walk, policy)` index) and a flow
 /// quiver at the sample of highest MMBM. Returns the file names.
 pub fn write_all(
     out: &Path,
@@ -91,18 +84,16 @@ pub fn write_all(
         let name = format!("blur_hist_{}.png", w.name);
         blur_histograms(&out.join(&name), &series)?;
         figs.push(name);
-        // Sharpest and most blurred frame per policy, half resolution.
-        let mut imgs = Vec::new();
-        for pi in 0..w.runs.len() {
-            if let Some(e) = extremes.get(&(wi, pi)) {
-                imgs.push(half(cam.width, cam.height, &e.sharpest.1));
-                imgs.push(half(cam.width, cam.height, &e.blurriest.1));
-            }
-        }
-        if !imgs.is_empty() {
-            let refs: Vec<&[f32]> = imgs.iter().map(|v| v.as_slice()).collect();
+        // Sharpest and most blurred frame per policy, labelled, cropped to the board.
+        let rows: Vec<(String, &Extremes)> = w
+            .runs
+            .iter()
+            .enumerate()
+            .filter_map(|(pi, (p, _))| extremes.get(&(wi, pi)).map(|e| (p.to_string(), e)))
+            .collect();
+        if !rows.is_empty() {
             let name = format!("frames_{}.png", w.name);
-            montage(&out.join(&name), cam.width / 2, cam.height / 2, &refs, 2)?;
+            super::frame_figure::frames_png(&out.join(&name), cam.width, cam.height, &rows)?;
             figs.push(name);
         }
         // Flow quiver at the sample of highest MMBM.
@@ -276,32 +267,4 @@ pub fn blur_histograms(path: &Path, series: &[(String, Vec<f64>)]) -> Result<()>
         root.present().map_err(&e)?;
         Ok(())
     })
-}
-
-/// Places linear-RGB images (same size, interleaved) in a grid of `cols`
-/// columns with a 4-px grey gutter and saves the sRGB montage.
-pub fn montage(path: &Path, width: u32, height: u32, images: &[&[f32]], cols: u32) -> Result<()> {
-    let cols = cols.max(1);
-    let rows = (images.len() as u32).div_ceil(cols).max(1);
-    let g = 4;
-    let (w, h) = (cols * (width + g) + g, rows * (height + g) + g);
-    let mut out = image::RgbImage::from_pixel(w, h, image::Rgb([128, 128, 128]));
-    for (k, img) in images.iter().enumerate() {
-        let (cx, cy) = (k as u32 % cols, k as u32 / cols);
-        let (x0, y0) = (g + cx * (width + g), g + cy * (height + g));
-        for y in 0..height {
-            for x in 0..width {
-                let i = ((y * width + x) * 3) as usize;
-                if i + 2 < img.len() {
-                    let px = [
-                        linear_to_srgb8(img[i]),
-                        linear_to_srgb8(img[i + 1]),
-                        linear_to_srgb8(img[i + 2]),
-                    ];
-                    out.put_pixel(x0 + x, y0 + y, image::Rgb(px));
-                }
-            }
-        }
-    }
-    save_rgb8(path, &out)
 }

@@ -11,7 +11,7 @@ use serde::{Serialize, Serializer};
 pub const FRAMES_HEADER: &str = "policy,trigger_t,blur_px,jnbm,blobs_found,blobs_ok,walk,exposure_start,exposure_end,\
 mmbm_trigger_mm_s,mmbm_exposure_mm_s,kept,rendered,distance_m,disp_px,cpbd,blur_effect,laplacian_var,\
 blobs_matched,samples_per_pixel,render_ms,pose_err_m,pose_err_deg,quality,seed,blobs_ok_fixed,\
-blur_h_px,blur_v_px,jnbm_2d,cpbd_2d,gain,family";
+blur_h_px,blur_v_px,jnbm_2d,cpbd_2d,gain,family,blobs_false,corner_repeatability";
 
 /// An f64 written as Rust's `Display` shows it (shortest round-trip digits,
 /// never an exponent: `1`, `0.0000001`, `NaN`, `inf`), not as the `csv`
@@ -75,6 +75,10 @@ struct FrameRow<'a> {
     /// SPEC section 10's family of the policy (`fixed`, `fixed-exposure`,
     /// `auto-exposure`, `mmbm`, `oracle`).
     family: &'static str,
+    /// Blobs found away from every board place (false alarms).
+    blobs_false: Option<usize>,
+    /// Share of the sharp frame's corners re-found within 2 px.
+    corner_repeatability: Measured,
 }
 
 impl<'a> FrameRow<'a> {
@@ -116,6 +120,8 @@ impl<'a> FrameRow<'a> {
             gain: Shown(f.gain),
             family: crate::trigger::PolicySpec::parse(&f.policy)
                 .map_or("", |p| p.policy_family().name()),
+            blobs_false: m.map(|m| m.blobs_false),
+            corner_repeatability: v(|m| m.corner_rep),
         }
     }
 }
@@ -170,6 +176,8 @@ mod tests {
             laplacian_var: 73.92057289971574,
             blobs_found: 16,
             blobs_matched: 15,
+            blobs_false: 2,
+            corner_rep: 0.375,
             blobs_ok: true,
             blobs_ok_fixed: false,
             pose_err_m: f64::NEG_INFINITY,
@@ -201,7 +209,8 @@ mod tests {
     }
 
     /// The text as the hand-written `writeln!` produced it before `frames.csv`
-    /// went through `csv` + serde (byte for byte).
+    /// went through `csv` + serde (byte for byte), with the two columns
+    /// appended since (`blobs_false`, `corner_repeatability`).
     #[test]
     fn frames_csv_text_is_unchanged() {
         let want = format!(
@@ -209,9 +218,9 @@ mod tests {
              deadline:5:0.4,0.30000000000000004,2,0.25,16,1,slow,1,0.0000001,\
              1000000000000000000000,-0,1,1,5.999652405925646,,123456789.125,\
              0.41040770904235263,73.92057289971574,15,64,52.500659,,11.599904771512902,\
-             fast,3,0,,0.0000000001,-1.5,0,1,mmbm\n\
+             fast,3,0,,0.0000000001,-1.5,0,1,mmbm,2,0.375\n\
              fixed:5+exp:2:0.02,NaN,,,,,fast,1,inf,1000000000000000000000,-0,0,0,\
-             ,,,,,,,,,,,18446744073709551615,,,,,,2.5,mmbm\n"
+             ,,,,,,,,,,,18446744073709551615,,,,,,2.5,mmbm,,\n"
         );
         assert_eq!(frames_csv(&records(), "fast").unwrap(), want);
         assert_eq!(
@@ -227,7 +236,7 @@ mod tests {
         let text = frames_csv(&records(), "fast").unwrap();
         let mut rd = csv::Reader::from_reader(text.as_bytes());
         let header: Vec<String> = rd.headers().unwrap().iter().map(String::from).collect();
-        assert_eq!(header.len(), 32);
+        assert_eq!(header.len(), 34);
         let rows: Vec<csv::StringRecord> = rd.records().map(|r| r.unwrap()).collect();
         assert_eq!(rows.len(), 2);
         let col = |row: &csv::StringRecord, name: &str| -> String {
@@ -246,6 +255,9 @@ mod tests {
         assert_eq!(col(&rows[1], "seed"), "18446744073709551615");
         assert_eq!(col(&rows[1], "gain"), "2.5");
         assert_eq!(col(&rows[1], "family"), "mmbm");
+        assert_eq!(col(&rows[0], "blobs_false"), "2");
+        assert_eq!(col(&rows[0], "corner_repeatability"), "0.375");
+        assert_eq!(col(&rows[1], "corner_repeatability"), "");
         // The struct's own field names, as serde writes them, are the header.
         let mut w = csv::Writer::from_writer(Vec::new());
         w.serialize(FrameRow::new(&records()[1], "fast")).unwrap();

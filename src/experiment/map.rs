@@ -17,7 +17,7 @@
 
 use super::benefit::{Estimate, WalkBlocks, BOOTSTRAP_SEED, RESAMPLES};
 use super::config::ExperimentConfig;
-use super::map_render::{blobs_at_lights, Light};
+use super::map_render::{judge_at_lights, Light};
 use super::walk::{make_walk, Walk};
 use crate::camera::Noise;
 use crate::error::Result;
@@ -42,6 +42,14 @@ pub struct CellPolicy {
     pub mean_exposure_s: f64,
     /// Kept frames whose gain the sensor's maximum capped (darker than meant).
     pub gain_capped: usize,
+    /// Blobs found away from every board place, over all kept frames (clutter, noise).
+    pub false_alarms: usize,
+    /// Mean corner repeatability of the kept frames with corners
+    /// (`corners.rs`; NaN when none had any).
+    pub corner_rep: f64,
+    /// Frames usable for odometry per second: repeatability at least
+    /// `corners::REPEAT_OK` (all seeds pooled).
+    pub vo_fps: f64,
 }
 
 /// One cell of the map.
@@ -140,6 +148,19 @@ fn in_grid(cfg: &ExperimentConfig, p: &PolicySpec) -> bool {
     }
 }
 
+/// Per light and policy: what its kept frames gave.
+#[derive(Debug, Clone, Copy, Default)]
+struct Tally {
+    frames: usize,
+    sharp: usize,
+    exposure_s: f64,
+    capped: usize,
+    false_alarms: usize,
+    rep_sum: f64,
+    rep_n: usize,
+    vo: usize,
+}
+
 /// Per block: its seconds and, per light and policy, its sharp frames.
 struct Block {
     seconds: f64,
@@ -170,6 +191,7 @@ pub fn benefit_map(
         m.seeds.clone()
     };
     let sensor = cfg.camera.noise.unwrap_or_else(|| Noise::at_light(1.0));
+    let surround: crate::render::Background = cfg.background.parse()?;
     let lights: Vec<Light> = m
         .lights_e_per_s
         .iter()
@@ -210,8 +232,8 @@ pub fn benefit_map(
     for (gi, g) in gaits.iter().enumerate() {
         for board in &m.boards {
             let mut blocks: Vec<Block> = Vec::new();
-            // Per light and policy: frames, sharp, exposure sum, capped.
-            let mut tally = vec![(0usize, 0usize, 0.0f64, 0usize); nl * np];
+            // Per light and policy.
+            let mut tally = vec![Tally::default(); nl * np];
             for (_, w) in walks.iter().filter(|(wg, _)| *wg == gi) {
                 let wb = WalkBlocks::of(w);
                 let first = blocks.len();
@@ -224,19 +246,33 @@ pub fn benefit_map(
                 for (pi, (_, frames)) in w.runs.iter().enumerate() {
                     for f in frames.iter().filter(|f| f.kept) {
                         bar.message(&format!("{g} {board} {}", f.policy));
-                        let ok =
-                            blobs_at_lights(board, w, f, cam, quality, renders as u32, &lights)?;
+                        let judged = judge_at_lights(
+                            board,
+                            surround,
+                            w,
+                            f,
+                            cam,
+                            quality,
+                            renders as u32,
+                            &lights,
+                        )?;
                         renders += 1;
                         bar.advance(1);
                         let b = wb.index(f.trigger_t);
-                        for (li, &sharp) in ok.iter().enumerate() {
+                        for (li, j) in judged.iter().enumerate() {
                             let k = li * np + pi;
-                            blocks[first + b].sharp[k] += f64::from(u8::from(sharp));
+                            blocks[first + b].sharp[k] += f64::from(u8::from(j.ok));
                             let t = &mut tally[k];
-                            t.0 += 1;
-                            t.1 += usize::from(sharp);
-                            t.2 += f.exposure_s();
-                            t.3 += usize::from(lights[li].capped(f.gain));
+                            t.frames += 1;
+                            t.sharp += usize::from(j.ok);
+                            t.exposure_s += f.exposure_s();
+                            t.capped += usize::from(lights[li].capped(f.gain));
+                            t.false_alarms += j.false_alarms;
+                            if j.corner_rep.is_finite() {
+                                t.rep_sum += j.corner_rep;
+                                t.rep_n += 1;
+                                t.vo += usize::from(j.corner_rep >= super::corners::REPEAT_OK);
+                            }
                         }
                     }
                 }
@@ -293,7 +329,7 @@ fn cell(
     policies: &[PolicySpec],
     blocks: &[Block],
     li: usize,
-    tally: &[(usize, usize, f64, usize)],
+    tally: &[Tally],
     (light, gait, board): (f64, &str, &str),
 ) -> Cell {
     let np = policies.len();
@@ -305,16 +341,24 @@ fn cell(
         }
         ok / secs
     };
+    let seconds: f64 = blocks.iter().map(|b| b.seconds).sum();
     let ps: Vec<CellPolicy> = policies
         .iter()
         .enumerate()
         .map(|(pi, p)| CellPolicy {
             policy: p.clone(),
             sharp_fps: fps(&mut (0..blocks.len()), pi),
-            frames: tally[pi].0,
-            sharp: tally[pi].1,
-            mean_exposure_s: tally[pi].2 / tally[pi].0.max(1) as f64,
-            gain_capped: tally[pi].3,
+            frames: tally[pi].frames,
+            sharp: tally[pi].sharp,
+            mean_exposure_s: tally[pi].exposure_s / tally[pi].frames.max(1) as f64,
+            gain_capped: tally[pi].capped,
+            false_alarms: tally[pi].false_alarms,
+            corner_rep: if tally[pi].rep_n > 0 {
+                tally[pi].rep_sum / tally[pi].rep_n as f64
+            } else {
+                f64::NAN
+            },
+            vo_fps: tally[pi].vo as f64 / seconds,
         })
         .collect();
     let fam = |f: PolicyFamily| move |p: &CellPolicy| p.policy.policy_family() == f;

@@ -2,12 +2,13 @@
 //! judged (blob extraction) at every light level with the sensor noise of
 //! that light and the gain a camera would set there (SPEC section 10).
 
+use super::corners;
 use super::measure::{blob_metrics, bulk_job, frame_motion};
 use super::walk::Walk;
 use crate::camera::{Camera, Noise};
 use crate::error::Result;
 use crate::io::images::to_rgb8;
-use crate::render::{self, Quality, Target};
+use crate::render::{self, Background, Quality, Target};
 use crate::trigger::Frame;
 
 /// The window judged at each light: the blob grid padded by this many blob pitches.
@@ -58,24 +59,40 @@ impl Light {
     }
 }
 
-/// Renders `frame` of `walk` on `target` (`blobs` or `blobs:0.5`) once with
-/// the noiseless camera `cam` and returns, for each of `lights`, whether all
-/// 16 blobs were extracted at their true places. `seed` seeds the render's
-/// sampling lattice and the noise (RNG stream `seed * 64 + light index`).
-pub fn blobs_at_lights(
+/// What a frame gave at one light.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Judged {
+    /// All 16 blobs extracted at their true places (and no other).
+    pub ok: bool,
+    /// Blobs found away from every board place.
+    pub false_alarms: usize,
+    /// Corner repeatability in the window ([`super::corners`]); NaN without corners.
+    pub corner_rep: f64,
+}
+
+/// Renders `frame` of `walk` on `target` (`blobs` or `blobs:0.5`, with
+/// `surround` behind it) once with the noiseless camera `cam` and returns,
+/// for each of `lights`, the blob verdict, the false alarms and the corner
+/// repeatability against the sharp frame at mid-exposure (noiseless, the
+/// same window). `seed` seeds the render's sampling lattice and the noise
+/// (RNG stream `seed * 64 + light index`).
+#[allow(clippy::too_many_arguments)]
+pub fn judge_at_lights(
     target: &str,
+    surround: Background,
     walk: &Walk,
     frame: &Frame,
     cam: Camera,
     quality: Quality,
     seed: u32,
     lights: &[Light],
-) -> Result<Vec<bool>> {
+) -> Result<Vec<Judged>> {
     let cam = Camera { noise: None, ..cam };
     let rolling = cam.shutter.readout_s;
     let exposure = frame.exposure_s();
     let (distance, traj) = frame_motion(walk, frame, rolling)?;
-    let target = Target::parse(target, distance)?;
+    let mut target = Target::parse(target, distance)?;
+    target.surround = surround;
     let mut job = bulk_job(cam, exposure, &traj, &target, quality, seed);
     job.with_maps = false;
     let out = render::render_frame(&job)?;
@@ -87,9 +104,9 @@ pub fn blobs_at_lights(
         .iter()
         .filter_map(|&p| render::project(&cam, &mid, p))
         .collect();
-    // Noise and extraction on a window around the board (the blob grid
-    // padded by WINDOW_PITCHES pitches), not the whole frame: the rest is
-    // the uniform background, and the noise is most of the cost.
+    // Noise, extraction and corners on a window around the board (the blob
+    // grid padded by WINDOW_PITCHES pitches), not the whole frame: the noise
+    // is most of the cost.
     let (w, h) = (cam.width as usize, cam.height as usize);
     let pad = WINDOW_PITCHES * super::crop::pitch_px(&expected);
     let lo = |v: f64| (v - pad).floor().max(0.0) as usize;
@@ -110,10 +127,16 @@ pub fn blobs_at_lights(
     } else {
         (x0, y0)
     };
-    let mut window = Vec::with_capacity(cw * ch * 3);
-    for y in y0..y0 + ch {
-        window.extend_from_slice(&out.rgb[3 * (y * w + x0)..3 * (y * w + x0 + cw)]);
-    }
+    let cut = |rgb: &[f32]| {
+        let mut window = Vec::with_capacity(cw * ch * 3);
+        for y in y0..y0 + ch {
+            window.extend_from_slice(&rgb[3 * (y * w + x0)..3 * (y * w + x0 + cw)]);
+        }
+        window
+    };
+    let window = cut(&out.rgb);
+    let sharp = cut(&corners::sharp_at(&job, mid)?);
+    let sharp_corners = corners::corners(&corners::luma(cw as u32, ch as u32, &sharp)?);
     let shifted: Vec<(f64, f64)> = expected
         .iter()
         .map(|&(x, y)| (x - x0 as f64, y - y0 as f64))
@@ -125,7 +148,14 @@ pub fn blobs_at_lights(
             .for_gain(frame.gain)
             .apply(&mut rgb, exposure, u64::from(seed) * 64 + k as u64)?;
         let img = to_rgb8(cw as u32, ch as u32, &rgb)?;
-        ok.push(blob_metrics(&img, &shifted).ok);
+        let b = blob_metrics(&img, &shifted);
+        let found = corners::corners(&crate::assess::luma(&img));
+        ok.push(Judged {
+            ok: b.ok,
+            false_alarms: b.false_alarms,
+            corner_rep: corners::repeatability_strongest(&sharp_corners, &found)
+                .unwrap_or(f64::NAN),
+        });
     }
     Ok(ok)
 }

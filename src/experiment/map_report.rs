@@ -4,6 +4,7 @@
 //! lines the terminal ends with.
 
 use super::benefit::{Estimate, BLOCK_S, BOOTSTRAP_SEED, RESAMPLES};
+use super::corners::{FAST_THRESHOLD, MATCH_PX, NMS_RADIUS, REPEAT_OK};
 use super::map::{BenefitMap, Cell};
 use crate::error::Result;
 use crate::io::atomic::write_atomic_path;
@@ -146,12 +147,75 @@ pub fn map_md(m: &BenefitMap, figure: Option<&str>) -> String {
         );
     }
     s += "\n";
+    s += &second_metric_md(m);
     s += &goals_md(m);
     s += &format!(
         "\nThe map rendered {} frames (each judged at all {} lights) in {:.0} s.\n\n",
         m.renders,
         m.lights.len(),
         m.seconds
+    );
+    s
+}
+
+/// The second task metric per cell, next to the blob metric: for the best
+/// `mmbm` policy, the best fixed exposure in hindsight and auto-exposure,
+/// sharp frames per second (blobs), frames usable for odometry per second
+/// (corner repeatability at least [`REPEAT_OK`]), the mean repeatability and
+/// the false alarms per frame; then, computed from the table, the policy
+/// with the most odometry frames per second in each cell.
+pub fn second_metric_md(m: &BenefitMap) -> String {
+    let mut s = format!(
+        "Second task metric (visual odometry): FAST-9 corners (threshold {}, non-maximum suppression over {} px) \
+         of each frame against those of the sharp, noiseless frame at its mid-exposure pose, in the same window; \
+         repeatability = share of the sharp frame's corners re-found within {} px by the frame's strongest corners \
+         (as many as the sharp frame has, so that noise corners do not match by chance); a frame is usable for odometry \
+         (VO) at repeatability >= {}. Per policy: sharp frames/s by the blob verdict, VO frames/s, mean \
+         repeatability, false alarms per frame (blobs found away from every board place).\n\n",
+        FAST_THRESHOLD, NMS_RADIUS, MATCH_PX, REPEAT_OK
+    );
+    s += "| light | gait, board | best `mmbm` | best fixed in hindsight | auto-exposure | most VO frames/s |\n";
+    s += "|---|---|---|---|---|---|\n";
+    let show = |c: &Cell, i: Option<usize>| {
+        i.map_or("-".into(), |i| {
+            let p = &c.policies[i];
+            format!(
+                "`{}` {:.2} sharp/s, {:.2} VO/s, rep. {:.2}, {:.2} false/frame",
+                p.policy,
+                p.sharp_fps,
+                p.vo_fps,
+                p.corner_rep,
+                p.false_alarms as f64 / p.frames.max(1) as f64
+            )
+        })
+    };
+    for c in &m.cells {
+        let vo = c
+            .policies
+            .iter()
+            .max_by(|a, b| a.vo_fps.total_cmp(&b.vo_fps))
+            .map_or("-".into(), |p| format!("`{}` {:.2}", p.policy, p.vo_fps));
+        s += &format!(
+            "| {} | {} | {} | {} | {} | {} |\n",
+            c.light,
+            column(c),
+            show(c, c.best_mmbm),
+            show(c, c.hindsight),
+            show(c, c.ae),
+            vo
+        );
+    }
+    // Where the best `mmbm` policy leads on odometry frames too.
+    let (mut lead, mut n) = (0, 0);
+    for c in &m.cells {
+        if let (Some(b), Some(h)) = (c.best_mmbm, c.hindsight) {
+            n += 1;
+            lead += usize::from(c.policies[b].vo_fps >= c.policies[h].vo_fps);
+        }
+    }
+    s += &format!(
+        "\nThe best `mmbm` policy (chosen by the blob metric) gets at least as many VO frames per second as the \
+         best fixed exposure in hindsight in {lead} of {n} cells.\n\n"
     );
     s
 }
@@ -281,7 +345,8 @@ pub fn answer(m: &BenefitMap, report: &Path) -> Vec<String> {
 
 /// The map as a heat map: rows light, columns gait x board, colour the best
 /// `mmbm` policy's ratio to the best fixed exposure in hindsight (log scale,
-/// red below 1, blue above), each cell labelled with its ratio.
+/// red below 1, blue above), each cell labelled ([`heat_labels`]) with that
+/// ratio and its 95 % interval, the ratio to auto-exposure, and the winner.
 pub fn heat_map_png(path: &Path, m: &BenefitMap) -> Result<()> {
     ensure_font()?;
     let mut cols: Vec<String> = Vec::new();
@@ -293,7 +358,7 @@ pub fn heat_map_png(path: &Path, m: &BenefitMap) -> Result<()> {
     let (nc, nr) = (cols.len().max(1), m.lights.len().max(1));
     write_atomic_path(path, |tmp| {
         let e = plot_error(path);
-        let root = BitMapBackend::new(tmp, (420 + 220 * nc as u32, 140 + 70 * nr as u32))
+        let root = BitMapBackend::new(tmp, (200 + 330 * nc as u32, 110 + 96 * nr as u32))
             .into_drawing_area();
         root.fill(&WHITE).map_err(&e)?;
         let mut chart = ChartBuilder::on(&root)
@@ -357,20 +422,95 @@ pub fn heat_map_png(path: &Path, m: &BenefitMap) -> Result<()> {
                     colour.filled(),
                 )))
                 .map_err(&e)?;
-            let label = if r.is_finite() {
-                format!("{r:.2}x{}", if lost(c) { " lost" } else { "" })
-            } else {
-                "n/a".into()
-            };
-            chart
-                .draw_series(std::iter::once(Text::new(
-                    label,
-                    (x - 0.2, y + 0.05),
-                    ("sans-serif", 18),
-                )))
-                .map_err(&e)?;
+            for (k, line) in heat_labels(c).iter().enumerate() {
+                chart
+                    .draw_series(std::iter::once(Text::new(
+                        line.clone(),
+                        (x - 0.46, y + 0.40 - 0.22 * k as f64),
+                        ("sans-serif", if k == 0 { 17 } else { 13 }),
+                    )))
+                    .map_err(&e)?;
+            }
         }
         root.present().map_err(&e)?;
         Ok(())
     })
+}
+
+/// The lines a heat-map cell is labelled with: the best `mmbm` policy over
+/// the best fixed exposure in hindsight with its 95 % interval (and `lost`
+/// where [`lost`]), over auto-exposure, and the policy with the most sharp
+/// frames per second with that rate.
+pub fn heat_labels(c: &Cell) -> Vec<String> {
+    let short = |e: &Option<Estimate>| match e {
+        Some(e) if e.value.is_finite() && e.lo.is_finite() => {
+            format!("{:.2}x [{:.2}, {:.2}]", e.value, e.lo, e.hi)
+        }
+        Some(e) if e.value.is_finite() => format!("{:.2}x", e.value),
+        _ => "n/a".into(),
+    };
+    let mut first = format!("vs hindsight {}", short(&c.vs_hindsight));
+    if lost(c) {
+        first += " lost";
+    }
+    let mut out = vec![first, format!("vs auto-exposure {}", short(&c.vs_ae))];
+    if let Some(w) = c.policies.get(c.winner) {
+        out.push(format!("won by {} ({:.2} /s)", w.policy, w.sharp_fps));
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::experiment::map::CellPolicy;
+    use crate::trigger::PolicySpec;
+
+    #[test]
+    fn heat_map_cells_carry_ratio_interval_and_winner() {
+        let p = |s: &str, fps: f64| CellPolicy {
+            policy: PolicySpec::parse(s).unwrap(),
+            sharp_fps: fps,
+            frames: 10,
+            sharp: 5,
+            mean_exposure_s: 0.01,
+            gain_capped: 0,
+            false_alarms: 0,
+            corner_rep: 0.5,
+            vo_fps: 1.0,
+        };
+        let mut c = Cell {
+            light: 1000.0,
+            gait: "moderate".into(),
+            board: "blobs:0.5".into(),
+            policies: vec![p("fixed:5", 1.0), p("deadline:5", 4.5)],
+            best_mmbm: Some(1),
+            hindsight: Some(0),
+            ae: None,
+            fixed: Some(0),
+            vs_hindsight: Some(Estimate {
+                value: 1.25,
+                lo: 1.05,
+                hi: 1.5,
+            }),
+            vs_ae: None,
+            vs_fixed: None,
+            winner: 1,
+            blocks: 8,
+        };
+        assert_eq!(
+            heat_labels(&c),
+            [
+                "vs hindsight 1.25x [1.05, 1.50]",
+                "vs auto-exposure n/a",
+                "won by deadline:5 (4.50 /s)"
+            ]
+        );
+        c.vs_hindsight = Some(Estimate {
+            value: 0.5,
+            lo: 0.4,
+            hi: 0.6,
+        });
+        assert!(heat_labels(&c)[0].ends_with("0.50x [0.40, 0.60] lost"));
+    }
 }

@@ -8,6 +8,7 @@ use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::io::images::to_rgb8;
 use crate::render::{self, Backend, Quality, RenderJob, Target, Trajectory};
+
 use crate::trigger::Frame;
 use std::time::Instant;
 
@@ -44,6 +45,9 @@ pub struct FrameMeasure {
     pub blobs_found: usize,
     /// Blobs matched to a true centre.
     pub blobs_matched: usize,
+    /// False alarms: blobs found farther than half a pitch from every board
+    /// place (clutter, noise; fragments of a true blob are not counted).
+    pub blobs_false: usize,
     /// All 16 found, each near its true centre.
     pub blobs_ok: bool,
     /// The same with the fixed redness threshold [`FIXED_BLOB_THRESHOLD`]
@@ -54,6 +58,9 @@ pub struct FrameMeasure {
     pub pose_err_m: f64,
     /// The same for the orientation, degrees.
     pub pose_err_deg: f64,
+    /// Corner repeatability (`corners.rs`): share of the sharp
+    /// frame's FAST corners re-found within 2 px; NaN without corners.
+    pub corner_rep: f64,
     /// Samples per pixel used by the renderer.
     pub samples_per_pixel: u32,
     /// Render time, ms.
@@ -126,6 +133,8 @@ pub struct BlobOutcome {
     pub matched: usize,
     /// Success (exactly 16, all matched).
     pub ok: bool,
+    /// Blobs farther than half a pitch from every expected centre.
+    pub false_alarms: usize,
     /// For each expected centre, the centre of its matched blob (px).
     pub matches: Vec<Option<(f64, f64)>>,
 }
@@ -142,6 +151,7 @@ pub fn blob_metrics(img: &image::RgbImage, expected: &[(f64, f64)]) -> BlobOutco
             found: r.found,
             matched: r.matched,
             ok: r.ok,
+            false_alarms: false_alarms(&blobs, expected, pitch),
             matches: r
                 .assignment
                 .iter()
@@ -153,9 +163,26 @@ pub fn blob_metrics(img: &image::RgbImage, expected: &[(f64, f64)]) -> BlobOutco
             found: 0,
             matched: 0,
             ok: false,
+            false_alarms: 0,
             matches: vec![None; expected.len()],
         },
     }
+}
+
+/// Blobs whose centre is at least half a pitch (px) from every expected centre.
+pub fn false_alarms(
+    blobs: &[crate::board::blobs::Blob],
+    expected: &[(f64, f64)],
+    pitch: f64,
+) -> usize {
+    blobs
+        .iter()
+        .filter(|b| {
+            expected
+                .iter()
+                .all(|e| (b.centre.0 - e.0).hypot(b.centre.1 - e.1) >= 0.5 * pitch)
+        })
+        .count()
 }
 
 /// The fixed redness threshold (8-bit sRGB `R - max(G, B)`) of the thesis-style
@@ -195,6 +222,8 @@ pub struct Rendered {
     pub backend: String,
     /// Linear RGB, interleaved.
     pub rgb: Vec<f32>,
+    /// The blob centres at mid-exposure, px (empty unless the target is a blob board).
+    pub expected_px: Vec<(f64, f64)>,
 }
 
 /// The walk at `frame`: the distance to the target at exposure start (m)
@@ -257,7 +286,7 @@ pub fn render_and_measure(
             n.gain_dn_per_e = Some(n.gain() * frame.gain);
         }
     }
-    let target = Target::parse(&cfg.target, distance)?;
+    let target = cfg.scene_target(&cfg.target, distance)?;
     let job = bulk_job(cam, exposure, &traj, &target, quality, seed);
     let t0 = Instant::now();
     let out = render::render_frame(&job)?;
@@ -286,6 +315,13 @@ pub fn render_and_measure(
     let crop = pattern_crop(&rgb8, &expected);
     let img = image_metrics(&crop);
     let blobs = blob_metrics(&rgb8, &expected);
+    // Corners of the frame against those of the sharp frame at mid-exposure.
+    let sharp = super::corners::sharp_at(&job, mid)?;
+    let corner_rep = super::corners::repeatability_strongest(
+        &super::corners::corners(&super::corners::luma(cam.width, cam.height, &sharp)?),
+        &super::corners::corners(&crate::assess::luma(&rgb8)),
+    )
+    .unwrap_or(f64::NAN);
     let (pose_err_m, pose_err_deg) = if blobs.ok {
         pose_error(&cam, &board, &blobs.matches, &frame_pl, &mid)
     } else {
@@ -307,14 +343,17 @@ pub fn render_and_measure(
             laplacian_var: img.laplacian_var,
             blobs_found: blobs.found,
             blobs_matched: blobs.matched,
+            blobs_false: blobs.false_alarms,
             blobs_ok: blobs.ok,
             blobs_ok_fixed: blob_ok_fixed(&rgb8, &expected),
             pose_err_m,
             pose_err_deg,
+            corner_rep,
             samples_per_pixel: out.samples_per_pixel,
             render_ms,
         },
         rgb: out.rgb,
+        expected_px: expected,
     })
 }
 

@@ -12,9 +12,12 @@
 //! of the truth), and the board's distance follows the log's forward velocity.
 
 pub(crate) mod benefit;
+pub(crate) mod clutter_report;
 pub(crate) mod config;
+mod corners;
 mod crop;
 pub(crate) mod figures;
+mod frame_figure;
 mod frames_csv;
 pub(crate) mod map;
 mod map_render;

@@ -426,6 +426,7 @@ pub fn report_md(
         &super::benefit::headlines(walks, records, &policies),
         &policies,
     );
+    s += &super::clutter_report::clutter_md(&cfg.background, walks, records);
     s += &findings(stats);
     s += "\n## Table 5.1: instantaneous MMBM at the trigger vs the exposure average\n\n";
     s += "Error = exposure-averaged MMBM - MMBM of the decision sample (mm/s); % relative to the exposure average.\n\n";
@@ -443,7 +444,7 @@ pub fn report_md(
     for f in figs {
         s += &format!("![{f}]({f})\n\n");
     }
-    s += "Frames figure: for each policy in configuration order, the sharpest (left) and the most blurred (right) rendered frame.\n\n";
+    s += "Frames figure: for each policy in configuration order, the sharpest (left) and the most blurred (right) rendered frame, cropped to the board with the full frame as an inset (the crop outlined), labelled with the trigger time, the ground-truth blur and the blob verdict.\n\n";
     s += "## Method and simplifications\n\n";
     s += "- Walks are simulated by `mmbm simulate` (seeded); the log is both the measurement the policies see and the true motion the renderer follows (its gyro noise included).\n";
     s += "- Policies decide on the rotation-only MMBM (thesis camera, 8x6 grid) of each gyro sample.\n";

@@ -2,7 +2,8 @@
 //! frame, then write `frames.csv`, the figures and `report.md`.
 
 use super::config::ExperimentConfig;
-use super::figures::{self, Extremes};
+use super::figures;
+use super::frame_figure::{Extremes, Shot};
 use super::measure::{image_difference, render_and_measure, FrameRecord};
 use super::report::{frames_csv, policy_stats, report_md, Outcome};
 use super::walk::{make_walk, Walk};
@@ -77,16 +78,22 @@ pub fn run(cfg: &ExperimentConfig, out: &Path, progress: bool) -> Result<Outcome
             backend = r.backend.clone();
         }
         // Keep the sharpest and the most blurred frame of each (walk, policy).
-        let b = r.measure.blur_px;
-        let e = extremes.entry((wi, pi)).or_insert_with(|| Extremes {
-            sharpest: (f64::INFINITY, Vec::new()),
-            blurriest: (f64::NEG_INFINITY, Vec::new()),
-        });
-        if b < e.sharpest.0 {
-            e.sharpest = (b, r.rgb.clone());
-        }
-        if b > e.blurriest.0 {
-            e.blurriest = (b, r.rgb.clone());
+        let m = &r.measure;
+        let shot = Shot {
+            trigger_t: frame.trigger_t,
+            blur_px: m.blur_px,
+            blobs_matched: m.blobs_matched,
+            blobs_expected: r.expected_px.len(),
+            blobs_false: m.blobs_false,
+            ok: m.blobs_ok,
+            expected_px: r.expected_px.clone(),
+            rgb: r.rgb.clone(),
+        };
+        match extremes.get_mut(&(wi, pi)) {
+            Some(e) => e.offer(shot),
+            None => {
+                extremes.insert((wi, pi), Extremes::new(shot));
+            }
         }
         measures.insert((wi, pi, fi), r.measure);
         bar.advance(1);

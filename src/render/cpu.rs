@@ -38,7 +38,7 @@ fn shade(p: &RenderParams, tex: Option<&MipTexture>, h: &GpuHomography, px: f32,
         KIND_BLOBS => {
             let (sq, pitch, half) = (p.tex[0], p.tex[1], p.tex[2]);
             if a.abs() > half || b.abs() > half {
-                return bg;
+                return poster_point(p, a, b);
             }
             let inv_pitch = p.tex[3];
             let ca = ((a * inv_pitch + 2.0).floor().clamp(0.0, 3.0) - 1.5) * pitch;
@@ -54,7 +54,7 @@ fn shade(p: &RenderParams, tex: Option<&MipTexture>, h: &GpuHomography, px: f32,
             let u = a / p.tex[0] + 0.5;
             let v = b / p.tex[1] + 0.5;
             if !(0.0..=1.0).contains(&u) || !(0.0..=1.0).contains(&v) {
-                return bg;
+                return poster_point(p, a, b);
             }
             // Footprint side (m) = sqrt(|det H| / w^3); in texels of level 0.
             let texels = (h.h2[3] * r * r * r).sqrt() * p.tex[2];
@@ -62,6 +62,45 @@ fn shade(p: &RenderParams, tex: Option<&MipTexture>, h: &GpuHomography, px: f32,
             Vec3::from(t.trilinear(u, v, lod))
         }
     }
+}
+
+/// Twin of the shader's `poster_point`: the poster (`super::poster`) at
+/// plane point `(a, b)`, or the plain background without one.
+#[inline]
+fn poster_point(p: &RenderParams, a: f32, b: f32) -> Vec3 {
+    let mut c = v3(p.background);
+    if p.lod[2] == 0.0 || a.abs() > p.poster[1][3] || b.abs() > p.poster[3][3] {
+        return c;
+    }
+    for k in 0..p.lod[2] as usize {
+        let [_, is, pa, pb] = p.poster[2 * k];
+        let sa = ((a + pa) * is).floor() as i32;
+        let sb = ((b + pb) * is).floor() as i32;
+        let v = if (sa + sb) & 1 == 0 { 1.0 } else { -1.0 };
+        c += v * v3(p.poster[2 * k + 1]);
+    }
+    c
+}
+
+/// Twin of the shader's `poster_mean`: the poster averaged over a footprint
+/// with marginal half-widths `(pa, qa)` along `a` and `(pb, qb)` along `b`.
+#[inline]
+fn poster_mean(p: &RenderParams, a: f32, b: f32, w: [f32; 4]) -> Vec3 {
+    let bg = v3(p.background);
+    let (ha, hb) = (p.poster[1][3], p.poster[3][3]);
+    // The poster's coverage of the footprint (independent axes, as the board's).
+    let cover =
+        trap_in(-ha, ha, a, w[0], w[1], TINY * ha) * trap_in(-hb, hb, b, w[2], w[3], TINY * hb);
+    if cover <= 0.0 {
+        return bg;
+    }
+    let mut c = bg;
+    for k in 0..p.lod[2] as usize {
+        let [sz, is, oa, ob] = p.poster[2 * k];
+        let m = square_mean(a + oa, w[0], w[1], sz, is) * square_mean(b + ob, w[2], w[3], sz, is);
+        c += m * v3(p.poster[2 * k + 1]);
+    }
+    bg + (c - bg) * cover
 }
 
 /// Twin of the shader's `lens_sample`: the sample through lens point `l`
@@ -396,7 +435,15 @@ fn footprint_eval(prm: &RenderParams, a: f32, b: f32, d: [f32; 4]) -> Vec3 {
     let (ba, ca) = board_axis(prm, a, pa, qa);
     let (bb, cb) = board_axis(prm, b, pb, qb);
     let (white, red) = (v3(prm.colour_b), v3(prm.colour_a));
-    bg + (white - bg) * (ba * bb) + (red - white) * (ca * cb)
+    // Behind the board: the poster where there is one (not needed where the
+    // board covers the whole footprint).
+    let board = ba * bb;
+    let bg = if prm.lod[2] > 0.0 && board < 1.0 {
+        poster_mean(prm, a, b, [pa, qa, pb, qb])
+    } else {
+        bg
+    };
+    bg + (white - bg) * board + (red - white) * (ca * cb)
 }
 
 /// Twin of the shader's `pixel_point`: sample `(sx, sy)` of a pixel through

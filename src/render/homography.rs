@@ -5,7 +5,7 @@
 //! target over the exposure.
 
 use super::layout::GpuHomography;
-use super::target::{Target, TargetKind};
+use super::target::Target;
 use super::trajectory::Trajectory;
 use crate::camera::Camera;
 use glam::{DMat3, DVec3};
@@ -220,15 +220,9 @@ pub fn pixel_maps(cam: &Camera) -> crate::error::Result<Option<Vec<GpuHomography
 /// instant, widened by one pixel against rounding.
 pub fn target_bbox(cam: &Camera, target: &Target, trajectory: &Trajectory, n: u32) -> [u32; 4] {
     let full = [0, 0, cam.width, cam.height];
-    let (ha, hb) = match &target.kind {
-        TargetKind::Checker { .. } => return full,
-        TargetKind::Blobs { .. } => {
-            let b = target.board().unwrap_or_else(crate::board::Board::thesis);
-            (b.half_width_m(), b.half_width_m())
-        }
-        TargetKind::Image {
-            width_m, texture, ..
-        } => (0.5 * width_m, 0.5 * width_m / texture.aspect()),
+    // The finite target, with the poster around it when it has one.
+    let Some((ha, hb)) = target.painted_half_extent_m() else {
+        return full;
     };
     let corners = [(-ha, -hb), (ha, -hb), (ha, hb), (-ha, hb)].map(|(a, b)| target.point(a, b));
     let (mut x0, mut y0, mut x1, mut y1) = (f64::MAX, f64::MAX, f64::MIN, f64::MIN);

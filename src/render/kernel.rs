@@ -21,7 +21,8 @@
 //!
 //! Pixels that the target never reaches during the exposure (outside the
 //! bounding box of the finite target's projections at every instant) see
-//! only the background: the kernel writes it without sampling.
+//! only the background: the kernel writes it without sampling (the box
+//! includes the poster around the target when it has one).
 
 use super::homography::line_mode;
 use super::sampling::{coprime_near, generators};
@@ -95,12 +96,17 @@ pub fn params(cam: &Camera, target: &Target, n: u32, bbox: [u32; 4], seed: u32) 
         (0, 0)
     };
     let bg = target.background;
+    // The checker covers the whole plane: nothing is behind it.
+    let (poster, layers) = match target.half_extent_m() {
+        Some(half) => super::poster::kernel_block(target.surround, half),
+        None => super::poster::kernel_block(super::poster::Background::Plain, (0.0, 0.0)),
+    };
     RenderParams {
         background: [bg[0], bg[1], bg[2], 0.0],
         tex,
         colour_a: [BLOB_RED[0], BLOB_RED[1], BLOB_RED[2], 0.0],
         colour_b: [BOARD_WHITE[0], BOARD_WHITE[1], BOARD_WHITE[2], 0.0],
-        lod: [LOD_SCALE, (1.0 / n as f64) as f32, 0.0, 0.0],
+        lod: [LOD_SCALE, (1.0 / n as f64) as f32, layers as f32, 0.0],
         dims: [cam.width, cam.height, kind, n],
         lattice: [g1, g2, 0, seed],
         range: [0, 0, n, 0],
@@ -108,6 +114,7 @@ pub fn params(cam: &Camera, target: &Target, n: u32, bbox: [u32; 4], seed: u32) 
         bbox,
         lens: lens_params(cam),
         lens_gen: [g3, g4, 0, 0],
+        poster,
     }
 }
 

@@ -28,7 +28,7 @@ pub struct RenderParams {
     pub colour_a: [f32; 4],
     /// Second colour (board white).
     pub colour_b: [f32; 4],
-    /// LOD_SCALE, 1/N, 0, 0.
+    /// LOD_SCALE, 1/N, poster layers (0: the plain background; `poster`), 0.
     pub lod: [f32; 4],
     /// width, height (full image, px), target kind, N (samples per pixel).
     pub dims: [u32; 4],
@@ -45,9 +45,12 @@ pub struct RenderParams {
     pub lens: [f32; 4],
     /// Defocus lattice dimensions: g3, g4, (k0*g3) mod N, (k0*g4) mod N.
     pub lens_gen: [u32; 4],
+    /// The poster's layers (`poster::kernel_block`): `[S, 1/S, pa, pb]`, `[r, g, b, 0]` each.
+    pub poster: [[f32; 4]; 8],
 }
 
-const _: () = assert!(std::mem::size_of::<RenderParams>() == 12 * 16);
+const _: () = assert!(std::mem::size_of::<RenderParams>() == 20 * 16);
+const _: () = assert!(std::mem::offset_of!(RenderParams, poster) == 12 * 16);
 const _: () = assert!(std::mem::offset_of!(RenderParams, lens) == 10 * 16);
 const _: () = assert!(std::mem::offset_of!(RenderParams, dims) == 5 * 16);
 const _: () = assert!(std::mem::offset_of!(RenderParams, range2) == 8 * 16);

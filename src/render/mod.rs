@@ -25,6 +25,7 @@ pub(crate) mod homography;
 pub(crate) mod kernel;
 mod layout;
 pub mod maps;
+pub mod poster;
 pub(crate) mod psf;
 mod sampling;
 pub(crate) mod target;
@@ -33,6 +34,7 @@ pub(crate) mod trajectory;
 
 pub use crate::gpu::Backend;
 pub use maps::{blur_maps, BlurMaps, BlurMeans};
+pub use poster::Background;
 pub use psf::{psf, Psf};
 pub use target::{project, Target, TargetKind, DEFAULT_BACKGROUND};
 pub use trajectory::{Pose, Trajectory};

@@ -9,6 +9,7 @@
 //! coordinates `(a, b) = ((P - O).e1, (P - O).e2)` in metres. With no tilt and
 //! no offset, `(a, b)` are SPEC's `(X, Y)`.
 
+use super::poster::Background;
 use super::texture::MipTexture;
 use super::trajectory::Pose;
 use crate::board::Board;
@@ -60,8 +61,11 @@ pub struct Target {
     pub tilt_deg: [f64; 2],
     /// Offset of the board origin in X (right) and Y (down), m.
     pub offset: [f64; 2],
-    /// Linear RGB where rays miss the target.
+    /// Linear RGB where rays miss the target (and the poster's mean level).
     pub background: [f32; 3],
+    /// What is in the plane around a blob board or an image: the plain
+    /// `background` (default) or the poster ([`super::poster`]).
+    pub surround: Background,
 }
 
 /// The plane's frame in world coordinates.
@@ -126,6 +130,7 @@ impl Target {
             tilt_deg: [0.0, 0.0],
             offset: [0.0, 0.0],
             background: DEFAULT_BACKGROUND,
+            surround: Background::Plain,
         })
     }
 
@@ -137,6 +142,7 @@ impl Target {
             tilt_deg: [0.0, 0.0],
             offset: [0.0, 0.0],
             background: DEFAULT_BACKGROUND,
+            surround: Background::Plain,
         }
     }
 
@@ -226,6 +232,30 @@ impl Target {
     pub fn point(&self, a: f64, b: f64) -> DVec3 {
         let f = self.frame();
         f.origin + f.e1 * a + f.e2 * b
+    }
+
+    /// Half extents `(a, b)` of the finite target (board or image), m; `None` for the checker.
+    pub fn half_extent_m(&self) -> Option<(f64, f64)> {
+        match &self.kind {
+            TargetKind::Checker { .. } => None,
+            TargetKind::Blobs { .. } => {
+                let h = self.board().unwrap_or_else(Board::thesis).half_width_m();
+                Some((h, h))
+            }
+            TargetKind::Image {
+                width_m, texture, ..
+            } => Some((0.5 * width_m, 0.5 * width_m / texture.aspect())),
+        }
+    }
+
+    /// Half extents of what is painted on the plane: the target's, or the
+    /// poster's around it ([`super::poster::SCALE`] times) when it has one.
+    pub fn painted_half_extent_m(&self) -> Option<(f64, f64)> {
+        let (a, b) = self.half_extent_m()?;
+        Some(match self.surround {
+            Background::Plain => (a, b),
+            Background::Poster => (super::poster::SCALE * a, super::poster::SCALE * b),
+        })
     }
 
     /// The painted board (`None` unless this is a blob board): the thesis
