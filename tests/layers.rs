@@ -34,6 +34,7 @@ const LAYERS: &[(&str, u32)] = &[
     ("trigger", 5),
     ("experiment", 6),
     ("dataset", 6),
+    ("augment", 5),
 ];
 
 fn layer(m: &str) -> Option<u32> {
