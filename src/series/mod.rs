@@ -9,6 +9,7 @@
 
 pub mod frames;
 pub mod gpu;
+pub mod lerp;
 
 use crate::error::{Error, Result};
 use crate::io::gyro::{GyroReader, GyroSample};
