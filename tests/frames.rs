@@ -36,7 +36,9 @@ fn direct(samples: &[GyroSample], cam: &Camera, f: &VideoFrame, nu: u32, nv: u32
     const SUB: usize = 48;
     let readout = f.readout_s.unwrap();
     let r = cam.sensor_rect();
-    let first = samples.partition_point(|s| s.t <= f.t_start).saturating_sub(1);
+    let first = samples
+        .partition_point(|s| s.t <= f.t_start)
+        .saturating_sub(1);
     let mut total = 0.0;
     for j in 0..nv {
         let v = r.v0 + (j as f64 + 0.5) * (r.v1 - r.v0) / nv as f64;
@@ -104,12 +106,8 @@ fn real_logs_match_direct_line_integration() {
         };
         let cam = example_camera(name);
         let (nu, nv) = (4, cam.height);
-        let (rows, outside) = frame_mmbm(
-            &samples,
-            &opts(cam, Method::Riemann { nu, nv }),
-            &frames,
-        )
-        .unwrap();
+        let (rows, outside) =
+            frame_mmbm(&samples, &opts(cam, Method::Riemann { nu, nv }), &frames).unwrap();
         assert_eq!(rows.len(), frames.len());
         assert!(outside.len() <= 2, "{name}: {outside:?}");
         let mut worst: f64 = 0.0;
@@ -122,7 +120,9 @@ fn real_logs_match_direct_line_integration() {
             worst = worst.max((m - d).abs() / d);
             checked += 1;
         }
-        eprintln!("{name}: {checked} frames, riemann:{nu}x{nv}, worst relative difference {worst:.2e}");
+        eprintln!(
+            "{name}: {checked} frames, riemann:{nu}x{nv}, worst relative difference {worst:.2e}"
+        );
         assert_eq!(checked + outside.len(), frames.len());
         assert!(worst < 1e-4, "{name}: {worst}");
     }
@@ -189,12 +189,18 @@ fn global_shutter_is_the_time_average_of_the_interpolated_series() {
             ..p
         };
         let s = mmbm_series(&[at], &scene, method).unwrap()[0];
-        assert!((r.start_mm_s.unwrap() - s).abs() < 1e-12 * s, "{r:?} vs {s}");
+        assert!(
+            (r.start_mm_s.unwrap() - s).abs() < 1e-12 * s,
+            "{r:?} vs {s}"
+        );
         n += 1;
     }
     eprintln!("{n} frames: worst {worst:.2e} from the densified series; up to {lower:.2e} below the speeds' interpolation");
     assert!(n > 500 && worst < 2e-6, "{worst}");
-    assert!(lower > 1e-3, "the flow turns within some intervals of this log: {lower}");
+    assert!(
+        lower > 1e-3,
+        "the flow turns within some intervals of this log: {lower}"
+    );
 }
 
 /// A yaw ramp w_y = c t: every point's speed is |c t| g(u, v), so a line's

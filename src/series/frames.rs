@@ -212,7 +212,8 @@ pub fn frame_mmbm(
                 // twist (so the flow poly) interpolated to `a`.
                 let k = ts.partition_point(|&s| s <= a).clamp(1, ts.len() - 1) - 1;
                 let s = ((a - ts[k]) / (ts[k + 1] - ts[k])).clamp(0.0, 1.0);
-                let lerp = |x: &[f64; 6], y: &[f64; 6]| std::array::from_fn(|i| x[i] + s * (y[i] - x[i]));
+                let lerp =
+                    |x: &[f64; 6], y: &[f64; 6]| std::array::from_fn(|i| x[i] + s * (y[i] - x[i]));
                 let p = FlowPoly {
                     du: lerp(&polys[k].du, &polys[k + 1].du),
                     dv: lerp(&polys[k].dv, &polys[k + 1].dv),

@@ -26,7 +26,11 @@ pub fn lerp_speed_integral(a: (f64, f64), d: (f64, f64), s0: f64, s1: f64) -> f6
     let x = |s: f64| (a.0 * d.0 + a.1 * d.1 + s * dd) / l;
     let prim = |x: f64| {
         let r = x.hypot(h);
-        let tail = if h > 0.0 { h * h * (x / h).asinh() } else { 0.0 };
+        let tail = if h > 0.0 {
+            h * h * (x / h).asinh()
+        } else {
+            0.0
+        };
         0.5 * (x * r + tail)
     };
     (prim(x(s1)) - prim(x(s0))) / l
@@ -118,7 +122,10 @@ mod tests {
         ];
         for (a, d, s0, s1) in cases {
             let (c, b) = (lerp_speed_integral(a, d, s0, s1), brute(a, d, s0, s1));
-            assert!((c - b).abs() <= 1e-9 * b.abs().max(1e-12), "{a:?} {d:?}: {c} vs {b}");
+            assert!(
+                (c - b).abs() <= 1e-9 * b.abs().max(1e-12),
+                "{a:?} {d:?}: {c} vs {b}"
+            );
         }
         // Where the flow turns, the interpolated speed is below the speeds' interpolation.
         let turn = lerp_speed_integral((1.0, 0.0), (-1.0, 1.0), 0.0, 1.0);
@@ -147,7 +154,13 @@ mod tests {
         let mut direct = 0.0;
         for k in 0..n {
             let x = a + (k as f64 + 0.5) * h;
-            let j = if x < 1.0 { 0 } else if x < 2.0 { 1 } else { 2 };
+            let j = if x < 1.0 {
+                0
+            } else if x < 2.0 {
+                1
+            } else {
+                2
+            };
             let s = (x - t[j]) / (t[j + 1] - t[j]);
             for i in 0..2 {
                 let (p, q) = (flows[j * 2 + i], flows[(j + 1) * 2 + i]);

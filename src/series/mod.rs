@@ -10,6 +10,7 @@
 pub mod frames;
 pub mod gpu;
 pub mod lerp;
+pub mod maps;
 
 use crate::error::{Error, Result};
 use crate::io::gyro::{GyroReader, GyroSample};
