@@ -256,7 +256,7 @@ fn maps_match_independent_line_integration() {
         };
         for k in [263, 433, 515] {
             let w = check_against_independent(&log, &opts(cam, None, false), &frames[k], k);
-            eprintln!("running_phone frame {k}: worst {w:.3} of the tolerance");
+            eprintln!("running_phone frame {k}: worst {w:.2e} of the tolerance");
         }
     }
     // Synthetic: turning rotation, forward-and-sideways velocity, depth 1.5 m.
@@ -285,7 +285,7 @@ fn maps_match_independent_line_integration() {
         readout_s: Some(0.02),
     };
     let w = check_against_independent(&log, &opts(cam, None, true), &f, 0);
-    eprintln!("synthetic with velocity: worst {w:.3} of the tolerance");
+    eprintln!("synthetic with velocity: worst {w:.2e} of the tolerance");
     // Translation matters here: the maps without it differ.
     let rot = maps(&log, &opts(cam, None, false), 0, &f, None);
     let tr = maps(&log, &opts(cam, None, true), 0, &f, None);

@@ -252,10 +252,16 @@ pub fn frame_maps(
         let c = l as f64 + 0.5;
         let t0 = shutter.delay_s(c, c, cam.width, cam.height);
         let line = Line::new(log, &traj, plane.as_ref(), &cam, a, t0, te, steps);
-        for (m, o) in out.iter_mut().enumerate() {
+        let ray = |m: usize| {
             let (i, j) = if rows { (m, l) } else { (l, m) };
-            let r = rays.rays[j * w + i];
-            if let Some(v) = line.pixel(&cam, r) {
+            rays.rays[j * w + i]
+        };
+        if cam.distortion.is_none() {
+            line.pinhole(&cam, ray, out);
+            return;
+        }
+        for (m, o) in out.iter_mut().enumerate() {
+            if let Some(v) = line.pixel(&cam, ray(m)) {
                 *o = v;
             }
         }
@@ -345,6 +351,88 @@ impl Line {
         }
     }
 
+    /// The inverse depth (1/m) of the scene point along `ray` (line start
+    /// frame); 0 for rotation only (points at infinity); `None` when the ray
+    /// misses the plane.
+    #[inline]
+    fn inv_depth(&self, ray: DVec3) -> Option<f64> {
+        match self.plane {
+            None => Some(0.0),
+            Some((n, d)) => {
+                let x = n.dot(self.start_rot * ray) / d;
+                (x > 0.0 && x.is_finite()).then_some(x)
+            }
+        }
+    }
+
+    /// [`Line::pixel`] for a whole line of a pinhole camera (`ray(m)` is
+    /// the undistorted ray of the line's pixel `m`): the pixel matrix folded
+    /// into each instant's rotation, step-major over the line's pixels so
+    /// the inner loop vectorises. The same values to rounding.
+    fn pinhole(&self, cam: &Camera, ray: impl Fn(usize) -> (f64, f64), out: &mut [[f32; 5]]) {
+        let n = out.len();
+        let kmat = DMat3::from_cols(
+            DVec3::new(cam.focal_mm / cam.pitch_x_mm, 0.0, 0.0),
+            DVec3::new(cam.skew, cam.focal_mm / cam.pitch_y_mm, 0.0),
+            DVec3::new(cam.cx, cam.cy, 1.0),
+        );
+        let mut buf = vec![0.0f64; 8 * n];
+        let (rx, rest) = buf.split_at_mut(n);
+        let (ry, rest) = rest.split_at_mut(n);
+        let (is, rest) = rest.split_at_mut(n);
+        let (x0, rest) = rest.split_at_mut(n);
+        let (y0, rest) = rest.split_at_mut(n);
+        let (px, rest) = rest.split_at_mut(n);
+        let (py, rest) = rest.split_at_mut(n);
+        let path = rest;
+        let mut bad = vec![false; n];
+        for m in 0..n {
+            let r = ray(m);
+            rx[m] = r.0;
+            ry[m] = r.1;
+            match self.inv_depth(DVec3::new(r.0, r.1, 1.0)) {
+                Some(x) if r.0.is_finite() && r.1.is_finite() => is[m] = x,
+                _ => bad[m] = true,
+            }
+        }
+        for (k, (rot, off)) in self.steps.iter().enumerate() {
+            let a = kmat * *rot;
+            let c = kmat * *off;
+            let (a0, a1, a2) = (a.x_axis, a.y_axis, a.z_axis);
+            for m in 0..n {
+                let (x, y, s) = (rx[m], ry[m], is[m]);
+                let z = a0.z * x + a1.z * y + a2.z + c.z * s;
+                bad[m] |= !(z > 1e-12);
+                let q = 1.0 / z;
+                let u = (a0.x * x + a1.x * y + a2.x + c.x * s) * q;
+                let v = (a0.y * x + a1.y * y + a2.y + c.y * s) * q;
+                if k == 0 {
+                    x0[m] = u;
+                    y0[m] = v;
+                } else {
+                    let (du, dv) = (u - px[m], v - py[m]);
+                    path[m] += (du * du + dv * dv).sqrt();
+                }
+                px[m] = u;
+                py[m] = v;
+            }
+        }
+        for m in 0..n {
+            if bad[m] {
+                continue;
+            }
+            let fl = self.flow.eval(cam.focal_mm * rx[m], cam.focal_mm * ry[m]);
+            let (fu, fv) = cam.mm_to_px_velocity(fl.0, fl.1);
+            out[m] = [
+                (px[m] - x0[m]) as f32,
+                (py[m] - y0[m]) as f32,
+                path[m] as f32,
+                fu as f32,
+                fv as f32,
+            ];
+        }
+    }
+
     /// The five channels of the pixel whose undistorted ray is `r`, or `None`.
     #[inline]
     fn pixel(&self, cam: &Camera, r: (f64, f64)) -> Option<[f32; 5]> {
@@ -352,17 +440,7 @@ impl Line {
             return None;
         }
         let ray = DVec3::new(r.0, r.1, 1.0);
-        // Inverse depth along the ray (0: rotation only, points at infinity).
-        let inv_s = match self.plane {
-            None => 0.0,
-            Some((n, d)) => {
-                let x = n.dot(self.start_rot * ray) / d;
-                if !(x > 0.0 && x.is_finite()) {
-                    return None;
-                }
-                x
-            }
-        };
+        let inv_s = self.inv_depth(ray)?;
         let project = |m: &DMat3, b: DVec3| -> Option<(f64, f64)> {
             let p = *m * ray + b * inv_s;
             (p.z > 1e-12).then(|| cam.ray_to_pixel(p.x / p.z, p.y / p.z))
@@ -371,7 +449,8 @@ impl Line {
         let (mut prev, mut path) = (first, 0.0);
         for (m, b) in &self.steps[1..] {
             let q = project(m, *b)?;
-            path += (q.0 - prev.0).hypot(q.1 - prev.1);
+            let (du, dv) = (q.0 - prev.0, q.1 - prev.1);
+            path += (du * du + dv * dv).sqrt();
             prev = q;
         }
         let (u, v) = (cam.focal_mm * r.0, cam.focal_mm * r.1);
