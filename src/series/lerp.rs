@@ -172,7 +172,7 @@ mod tests {
         assert!((got - direct).abs() < 1e-9, "{got} vs {direct}");
         // The value at an instant, and a zero-length window.
         let v = instant_speed(&t, &flows, &w, 1.5);
-        let expect = 0.25 * (-0.5f64).hypot(1.25) + 0.75 * 1.0f64.hypot(0.75);
+        let expect = 0.25 * (-0.5f64).hypot(0.75) + 0.75 * 2.0f64.hypot(0.5);
         assert!((v - expect).abs() < 1e-12);
         assert_eq!(window_speed(&t, &flows, &w, 1.5, 1.5), v);
     }

@@ -402,7 +402,7 @@ impl Line {
             for m in 0..n {
                 let (x, y, s) = (rx[m], ry[m], is[m]);
                 let z = a0.z * x + a1.z * y + a2.z + c.z * s;
-                bad[m] |= !(z > 1e-12);
+                bad[m] |= z.is_nan() || z <= 1e-12;
                 let q = 1.0 / z;
                 let u = (a0.x * x + a1.x * y + a2.x + c.x * s) * q;
                 let v = (a0.y * x + a1.y * y + a2.y + c.y * s) * q;
