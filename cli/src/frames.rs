@@ -50,6 +50,11 @@ pub struct FramesArgs {
     pub out: Option<PathBuf>,
     #[command(flatten)]
     pub choice: super::choose::ChoiceArgs,
+    /// Also write each frame's per-pixel blur fields to DIR/frame_NNNNNN.exr (float EXR: disp.u,
+    /// disp.v px, path_px, flow.u, flow.v px/s; NaN beyond the lens's radial limit), for the frames
+    /// written (all, or the --select ones) inside the log.
+    #[arg(long, value_name = "DIR")]
+    pub maps: Option<PathBuf>,
     /// Include the log's vx,vy,vz (needs a depth column, --depth or --plane).
     #[arg(long)]
     pub use_velocity: bool,
@@ -64,6 +69,9 @@ pub struct FramesArgs {
 pub fn run(a: FramesArgs) -> Result<()> {
     // The output's place, checked before any work.
     a.choice.check(a.out.as_deref())?;
+    if let Some(d) = &a.maps {
+        mmbm::io::atomic::check_output_dir(d)?;
+    }
     let method = match a.method {
         AnyMethod::Cpu(m) => m,
         AnyMethod::Gpu { .. } => {
@@ -122,6 +130,24 @@ pub fn run(a: FramesArgs) -> Result<()> {
         }
         Ok(())
     };
+    if let Some(dir) = &a.maps {
+        let done = mmbm::series::maps::write_maps(&samples, &opts, &frames, &keep, dir)?;
+        let n = done.written.len();
+        let mean = done.written.iter().map(|d| d.1).sum::<f64>() / n.max(1) as f64;
+        eprintln!(
+            "maps: {n} frame(s) to {} (mean path {mean:.3} px)",
+            dir.display()
+        );
+        if !done.skipped.is_empty() {
+            let list: Vec<String> = done.skipped.iter().take(8).map(|k| k.to_string()).collect();
+            eprintln!(
+                "warning: {} frame(s) have no maps: their span leaves the gyro log or crosses a gap in it ({}{})",
+                done.skipped.len(),
+                list.join(", "),
+                if done.skipped.len() > 8 { ", ..." } else { "" }
+            );
+        }
+    }
     mmbm::io::atomic::all_or_nothing(|| {
         match &a.out {
             Some(p) => mmbm::io::atomic::write_atomic(p, |w| write(w))?,

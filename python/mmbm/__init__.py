@@ -208,7 +208,8 @@ def frames(
     readout_s: Optional[ArrayLike] = None,
     method: str = "riemann:8x6",
     camera: Optional[Camera] = None,
-) -> Dict[str, np.ndarray]:
+    maps: bool = False,
+) -> Dict[str, Any]:
     """Exposure MMBM of every video frame (SPEC 9: each line over its own
     rolling-shutter window), as ``mmbm frames``: ``t`` (N,) s and ``omega``
     (N, 3) rad/s of the log; per frame ``t_start`` (the first line's
@@ -216,7 +217,13 @@ def frames(
     camera's ``readout_s``), broadcast to one shape. Returns
     ``{"exposure_mmbm_mm_s", "blur_px", "start_mmbm_mm_s"}`` (NaN where a
     frame's window leaves the log). ``telemetry_parser``'s
-    ``frame_readout_time()`` (ms) / 1000 is a ``readout_s``."""
+    ``frame_readout_time()`` (ms) / 1000 is a ``readout_s``.
+
+    With ``maps=True`` also ``"maps"``: per frame the per-pixel blur fields
+    of ``mmbm frames --maps`` as ``{"disp.u", "disp.v", "path_px", "flow.u",
+    "flow.v"}`` float32 arrays of the camera's (height, width) (px, px/s; NaN
+    beyond the lens's radial limit), or ``None`` where the frame's span
+    leaves the log or crosses a gap in it."""
     tt, w = _log(t, omega)
     ts = np.asarray(t_start, dtype=np.float64).ravel()
     es = np.ascontiguousarray(np.broadcast_to(np.asarray(exposure_s, dtype=np.float64), ts.shape))
@@ -225,11 +232,18 @@ def frames(
         rs = np.ascontiguousarray(np.broadcast_to(np.asarray(readout_s, dtype=np.float64), ts.shape))
     cam = camera or Camera()
     e, blur, s0 = _mmbm.frames(cam._spec(), tt, w, np.ascontiguousarray(ts), es, rs, method)
-    return {
+    out: Dict[str, Any] = {
         "exposure_mmbm_mm_s": e,
         "blur_px": blur,
         "start_mmbm_mm_s": s0,
     }
+    if maps:
+        names = ("disp.u", "disp.v", "path_px", "flow.u", "flow.v")
+        out["maps"] = [
+            None if m is None else dict(zip(names, m))
+            for m in _mmbm.frame_maps(cam._spec(), tt, w, np.ascontiguousarray(ts), es, rs)
+        ]
+    return out
 
 
 def read_gyro(

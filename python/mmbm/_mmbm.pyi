@@ -26,6 +26,9 @@ def series(
 def frames(
     cam: CamSpec, t: F64, omega: F64, t_start: F64, exposure_s: F64, readout_s: Optional[F64], method: str
 ) -> Tuple[F64, F64, F64]: ...
+def frame_maps(
+    cam: CamSpec, t: F64, omega: F64, t_start: F64, exposure_s: F64, readout_s: Optional[F64]
+) -> List[Optional[npt.NDArray[np.float32]]]: ...
 def read_gyro(
     path: str,
     time_unit: str,

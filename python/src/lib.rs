@@ -188,6 +188,69 @@ fn frames<'py>(
     ))
 }
 
+/// The per-pixel blur fields of every video frame (`mmbm frames --maps`,
+/// `series::maps`): per frame a `(5, height, width)` float32 array of the
+/// channels `disp.u, disp.v, path_px, flow.u, flow.v` (px, px/s; NaN beyond
+/// the lens's radial limit), or `None` where the frame's span leaves the log
+/// or crosses a gap in it. Rotation only.
+#[pyfunction]
+#[pyo3(signature = (cam, t, omega, t_start, exposure_s, readout_s))]
+#[allow(clippy::type_complexity)]
+fn frame_maps<'py>(
+    py: Python<'py>,
+    cam: Bound<'py, PyDict>,
+    t: PyReadonlyArray1<'py, f64>,
+    omega: PyReadonlyArray2<'py, f64>,
+    t_start: PyReadonlyArray1<'py, f64>,
+    exposure_s: PyReadonlyArray1<'py, f64>,
+    readout_s: Option<PyReadonlyArray1<'py, f64>>,
+) -> PyResult<Vec<Option<Bound<'py, numpy::PyArray3<f32>>>>> {
+    let samples = log_samples(t.as_slice()?, &rows3(&omega)?, None, None);
+    let (ts, es) = (t_start.as_slice()?, exposure_s.as_slice()?);
+    let rs = readout_s.as_ref().map(|r| r.as_slice()).transpose()?;
+    let video: Vec<mmbm::io::frames::VideoFrame> = (0..ts.len())
+        .map(|k| mmbm::io::frames::VideoFrame {
+            t_start: ts[k],
+            exposure_s: es[k],
+            readout_s: rs.map(|r| r[k]),
+        })
+        .collect();
+    let cam = camera(&cam)?;
+    let opts = mmbm::series::SeriesOptions {
+        scene: Scene {
+            camera: cam,
+            plane: None,
+        },
+        method: mmbm::Method::Riemann { nu: 8, nv: 6 },
+        use_velocity: false,
+    };
+    let maps = interruptible(py, err, || {
+        let log = mmbm::model::log::ImuLog::new(samples)?;
+        let rays = mmbm::series::maps::MapRays::new(&cam)?;
+        video
+            .iter()
+            .enumerate()
+            .map(|(k, f)| mmbm::series::maps::frame_maps(&log, &opts, &rays, k, f, None))
+            .collect::<mmbm::Result<Vec<_>>>()
+    })?;
+    let (w, h) = (cam.width as usize, cam.height as usize);
+    maps.into_iter()
+        .map(|m| {
+            m.map(|m| {
+                let data: Vec<f32> = m
+                    .channels()
+                    .iter()
+                    .flat_map(|c| c.1.iter().copied())
+                    .collect();
+                Array3::from_shape_vec((5, h, w), data)
+                    .map(|a| a.into_pyarray(py))
+                    .map_err(|e| PyValueError::new_err(e.to_string()))
+            })
+            .transpose()
+        })
+        .collect()
+}
+
 /// MMBM (mm/s) of a log: samples `t`, `omega`, optional `velocity` and `depth`.
 #[pyfunction]
 #[pyo3(signature = (cam, t, omega, velocity, depth, plane_, method))]
@@ -529,6 +592,7 @@ fn _mmbm(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(metric, m)?)?;
     m.add_function(wrap_pyfunction!(series, m)?)?;
     m.add_function(wrap_pyfunction!(frames, m)?)?;
+    m.add_function(wrap_pyfunction!(frame_maps, m)?)?;
     m.add_function(wrap_pyfunction!(read_gyro, m)?)?;
     m.add_function(wrap_pyfunction!(flow_field, m)?)?;
     m.add_function(wrap_pyfunction!(render, m)?)?;

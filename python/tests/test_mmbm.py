@@ -207,6 +207,30 @@ def test_frames_equal_cli(tmp_path):
         assert got["start_mmbm_mm_s"][k] == float(o["start_mmbm_mm_s"])
 
 
+def test_frame_maps_equal_cli(tmp_path):
+    g = ROOT.parent / "shared" / "data" / "running_phone"
+    if not g.exists():
+        pytest.skip("../shared/data is not beside the checkout")
+    cam_file = tmp_path / "cam.toml"
+    cam_file.write_text("focal_mm = 0.15118\npitch_mm = 0.001\nwidth = 192\nheight = 108\nreadout_s = 0.01598\n")
+    table = tmp_path / "frames.csv"
+    table.write_text("t_start,exposure_s\n5.258,0.0013\n99.0,0.001\n")
+    d = tmp_path / "maps"
+    cli("frames", "--gyro", str(g / "gyro.csv"), "--frames", str(table), "--camera", str(cam_file),
+        "--maps", str(d), "--out", str(tmp_path / "f.csv"))
+    log = mmbm.read_gyro(g / "gyro.csv")
+    got = mmbm.frames(log["t"], log["omega"], [5.258, 99.0], [0.0013, 0.001],
+                      camera=mmbm.Camera.from_file(cam_file), maps=True)
+    assert got["maps"][1] is None and not (d / "frame_000001.exr").exists()
+    e = mmbm.read_exr(d / "frame_000000.exr")
+    assert sorted(got["maps"][0]) == sorted(e) == sorted(["disp.u", "disp.v", "path_px", "flow.u", "flow.v"])
+    for name, a in got["maps"][0].items():
+        assert a.shape == (108, 192) and a.dtype == np.float32
+        assert np.array_equal(a, e[name]), name
+    assert np.all(got["maps"][0]["path_px"] >= np.hypot(e["disp.u"], e["disp.v"]) - 1e-6)
+    assert np.mean(got["maps"][0]["path_px"]) > 0.01
+
+
 # A 1 s log at 200 Hz for the frame cases.
 T = np.arange(200) * 0.005
 W = np.tile([0.1, 0.2, 0.3], (200, 1))

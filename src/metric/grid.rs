@@ -154,6 +154,26 @@ impl GridRule {
         self.len == 0
     }
 
+    /// The flow (mm/s, through the distortion's Jacobian when the rule has
+    /// one) at each node, with the node's weight: `(weight, (du, dv))`, in
+    /// node order, padding left out.
+    pub fn node_flows<'a>(
+        &'a self,
+        poly: &'a FlowPoly,
+    ) -> impl Iterator<Item = (f64, (f64, f64))> + 'a {
+        (0..self.len).map(move |k| {
+            let (a, b) = poly.eval(self.m[0][k], self.m[1][k]);
+            let f = match &self.jac {
+                None => (a, b),
+                Some(jac) => {
+                    let j = &jac[k];
+                    (j[0] * a + j[1] * b, j[2] * a + j[3] * b)
+                }
+            };
+            (self.w[k], f)
+        })
+    }
+
     /// The rule's estimate of the mean flow speed, mm/s.
     pub fn mean_speed(&self, poly: &FlowPoly) -> f64 {
         match &self.jac {

@@ -5,22 +5,27 @@
 //! speed averaged over its own line's window (mm/s). Blur length in pixels is
 //! that times `t_e` over the pixel pitch.
 //!
-//! Time: a point's speed is evaluated at the gyro samples and interpolated
-//! linearly between them, the convention of the trigger's exposure average,
-//! so with `t_r = 0` the result is the time average of the MMBM series.
+//! Time: the motion is the renderer's (`render::trajectory`), the twist
+//! interpolated linearly between gyro samples, so at a sensor point the flow
+//! is linear in time between samples and the speed is the length of that
+//! interpolated flow, integrated in closed form ([`super::lerp`]); it is at
+//! most the interpolation of the speeds at the samples (equal where the flow
+//! does not turn). With a log's `depth` column the flow (which has `v / z`)
+//! is interpolated, not the depth.
 //! Space: the method's rule (`riemann`, `gauss`: nodes grouped by line, each
 //! group averaged over its window; `riemann:Wx<lines>` has a node on every
 //! line). `exact` (adaptive cubature of the window-averaged speed) is for
 //! global shutters only: with a readout the integrand jumps at every line.
 
+use super::lerp::{instant_speed, window_speed};
 use super::{sample_scene, SeriesOptions};
 use crate::camera::{Camera, Shutter};
 use crate::error::{Error, Result};
 use crate::io::frames::VideoFrame;
 use crate::io::gyro::GyroSample;
-use crate::metric::{exact_with, gauss_points, point_speed, riemann_points, GridRule, Method};
+use crate::metric::{exact_with, gauss_points, riemann_points, GridRule, Method};
 use crate::model::flow::FlowPoly;
-use crate::model::log::{check_times, Integral};
+use crate::model::log::check_times;
 use std::collections::BTreeMap;
 
 /// The exposure MMBM of one frame.
@@ -48,30 +53,25 @@ impl FrameMmbm {
     }
 }
 
-/// The buffers of a frames run's window means, built once per run and
-/// reused: the values at a window's samples and their [`Integral`] (no
-/// allocation in the `exact` integrand once warm).
-#[derive(Default)]
-struct Window {
-    /// The values at the window's samples.
-    y: Vec<f64>,
-    integral: Integral,
-}
-
-impl Window {
-    /// Mean over `[a, b]` of the piecewise-linear function through
-    /// `(t[i], y[i])` (`t` increasing, covering `[a, b]`); the value at `a`
-    /// when `b <= a`.
-    fn mean(&mut self, t: &[f64], a: f64, b: f64) -> f64 {
-        self.integral.rebuild(t, &self.y);
-        self.integral.mean(a, b)
+/// The flow (mm/s on the distorted sensor) of each of `polys` at the
+/// distorted sensor point `(ud, vd)` mm, undistorted once; NaN where it does
+/// not undistort (the caller reports a non-finite result).
+fn point_flows(cam: &Camera, polys: &[FlowPoly], ud: f64, vd: f64, out: &mut Vec<(f64, f64)>) {
+    out.clear();
+    if cam.distortion.is_none() {
+        out.extend(polys.iter().map(|p| p.eval(ud, vd)));
+        return;
     }
-
-    /// [`Window::mean`] of the values `y`.
-    fn mean_of(&mut self, t: &[f64], y: impl IntoIterator<Item = f64>, a: f64, b: f64) -> f64 {
-        self.y.clear();
-        self.y.extend(y);
-        self.mean(t, a, b)
+    match cam.undistort_mm(ud, vd) {
+        Some((u, v)) => {
+            let j = cam.distortion_jacobian(u, v);
+            out.extend(
+                polys
+                    .iter()
+                    .map(|p| crate::camera::distortion::apply(&j, p.eval(u, v))),
+            );
+        }
+        None => out.extend(polys.iter().map(|_| (f64::NAN, f64::NAN))),
     }
 }
 
@@ -126,9 +126,10 @@ pub fn frame_mmbm(
     };
     let t: Vec<f64> = samples.iter().map(|s| s.t).collect();
     let (first, last) = (t[0], t[t.len() - 1]);
-    // One set of window buffers for the whole run (the `exact` integrand
-    // borrows it for each point).
-    let window = std::cell::RefCell::new(Window::default());
+    // Buffers reused by every frame: the rule's weights and flows at the
+    // samples (grid rules), one point's flows (the `exact` integrand).
+    let (mut weights, mut flows) = (Vec::new(), Vec::new());
+    let point_buf = std::cell::RefCell::new(Vec::new());
     let mut out = Vec::with_capacity(frames.len());
     let mut outside = Vec::new();
     for (k, f) in frames.iter().enumerate() {
@@ -172,17 +173,20 @@ pub fn frame_mmbm(
             .collect::<Result<Vec<FlowPoly>>>()?;
         let (exposure, start) = match &groups {
             Some(groups) => {
-                let mut total = vec![0.0; polys.len()];
-                let mut e = 0.0;
+                let (mut e, mut start) = (0.0, 0.0);
                 for (delay, rule) in groups {
-                    let y: Vec<f64> = polys.iter().map(|p| rule.mean_speed(p)).collect();
-                    for (tot, yi) in total.iter_mut().zip(&y) {
-                        *tot += yi;
+                    // Each node's flow at each sample (sample-major), once.
+                    weights.clear();
+                    weights.extend(rule.node_flows(&polys[0]).map(|(w, _)| w));
+                    flows.clear();
+                    for p in &polys {
+                        flows.extend(rule.node_flows(p).map(|(_, f)| f));
                     }
                     let w0 = a + readout * delay;
-                    e += window.borrow_mut().mean_of(ts, y, w0, w0 + f.exposure_s);
+                    e += window_speed(ts, &flows, &weights, w0, w0 + f.exposure_s);
+                    start += instant_speed(ts, &flows, &weights, a);
                 }
-                (e, window.borrow_mut().mean_of(ts, total, a, a))
+                (e, start)
             }
             None => {
                 let Method::Exact { tol } = opts.method else {
@@ -196,18 +200,26 @@ pub fn frame_mmbm(
                     |u, v| {
                         let (px, py) = cam.mm_to_pixel(u, v);
                         let w0 = a + shutter.delay_s(px, py, cam.width, cam.height);
-                        let y = polys.iter().map(|p| point_speed(&cam, p, u, v));
-                        window.borrow_mut().mean_of(ts, y, w0, w0 + f.exposure_s)
+                        let mut buf = point_buf.borrow_mut();
+                        point_flows(&cam, &polys, u, v, &mut buf);
+                        window_speed(ts, &buf, &[1.0], w0, w0 + f.exposure_s)
                     },
                     &cam.sensor_rect(),
                     tol,
                 )
                 .value;
-                let m: Vec<f64> = polys
-                    .iter()
-                    .map(|p| crate::metric::mmbm_poly(&cam, p, opts.method).map(|m| m.mm_s))
-                    .collect::<Result<_>>()?;
-                (e, window.borrow_mut().mean_of(ts, m, a, a))
+                // The MMBM of the interpolated motion at the start: the
+                // twist (so the flow poly) interpolated to `a`.
+                let k = ts.partition_point(|&s| s <= a).clamp(1, ts.len() - 1) - 1;
+                let s = ((a - ts[k]) / (ts[k + 1] - ts[k])).clamp(0.0, 1.0);
+                let lerp =
+                    |x: &[f64; 6], y: &[f64; 6]| std::array::from_fn(|i| x[i] + s * (y[i] - x[i]));
+                let p = FlowPoly {
+                    du: lerp(&polys[k].du, &polys[k + 1].du),
+                    dv: lerp(&polys[k].dv, &polys[k + 1].dv),
+                };
+                let m = crate::metric::mmbm_poly(&cam, &p, opts.method)?.mm_s;
+                (e, m)
             }
         };
         if !(exposure.is_finite() && start.is_finite()) {

@@ -9,6 +9,8 @@
 
 pub mod frames;
 pub mod gpu;
+pub mod lerp;
+pub mod maps;
 pub mod select;
 
 use crate::error::{Error, Result};

@@ -1,0 +1,520 @@
+//! Per-pixel blur fields of video frames (`mmbm frames --maps`): for every
+//! pixel of a frame, the image track of the scene point seen at its centre
+//! at its own line's exposure start, followed over that line's exposure
+//! (rolling shutter: each line its own window, SPEC 9), on the renderer's
+//! motion ([`Trajectory::from_imu_log`]: the twist interpolated linearly
+//! between gyro samples and integrated on SO(3)). No image is rendered.
+//!
+//! Per line the motion from the line's start to each of `steps + 1` instants
+//! is one rotation `M_k` (and, with the log's velocity, one offset `b_k`), so
+//! a pixel's track is `project(M_k r + b_k / s)` for its undistorted ray `r`
+//! (cached per camera, [`MapRays`]) and its scene point's depth along the ray
+//! `s`. The path is the sum of the track's chords, the displacement its end
+//! minus its start. The scene: rotation only (points at infinity) unless
+//! `use_velocity`; then a plane fixed in the world, given in the camera
+//! frame at the frame's start (the options' plane, else the log's `depth`
+//! at the frame's start as a fronto-parallel plane), as `render` has its
+//! target.
+//!
+//! Pixels beyond the camera's radial distortion limit
+//! ([`Camera::is_masked_mm`]), whose ray does not undistort, or whose scene
+//! point is lost (behind the camera or off the plane) are NaN in every
+//! channel.
+
+use super::SeriesOptions;
+use crate::camera::Camera;
+use crate::error::{Error, Result};
+use crate::io::frames::VideoFrame;
+use crate::model::flow::FlowPoly;
+use crate::model::log::ImuLog;
+use crate::model::motion::{Plane, Twist};
+use crate::render::trajectory::Trajectory;
+use glam::{DMat3, DVec3};
+use rayon::prelude::*;
+
+/// Channels of a frame's maps, in the EXR's order of [`FrameMaps::channels`].
+pub const CHANNELS: [&str; 5] = ["disp.u", "disp.v", "path_px", "flow.u", "flow.v"];
+
+/// The blur fields of one frame, row-major, top row first, `width * height`
+/// values each (NaN where a pixel has none, see the module docs).
+#[derive(Debug, Clone, PartialEq)]
+pub struct FrameMaps {
+    /// 0-based row of the frame table.
+    pub frame: usize,
+    /// Width, px.
+    pub width: u32,
+    /// Height, px.
+    pub height: u32,
+    /// Exposure of each line, s.
+    pub exposure_s: f64,
+    /// Rolling-shutter readout used, s.
+    pub readout_s: f64,
+    /// Chords per line's exposure.
+    pub steps: usize,
+    /// Displacement from the line's exposure start to its end, x (columns), px.
+    pub disp_u: Vec<f32>,
+    /// Displacement, y (rows, down), px.
+    pub disp_v: Vec<f32>,
+    /// Path length over the line's exposure, px.
+    pub path_px: Vec<f32>,
+    /// Image flow at the line's exposure start, x, px/s.
+    pub flow_u: Vec<f32>,
+    /// Image flow at the line's exposure start, y, px/s.
+    pub flow_v: Vec<f32>,
+}
+
+impl FrameMaps {
+    /// `(name, values)` of every channel ([`CHANNELS`]).
+    pub fn channels(&self) -> [(&'static str, &[f32]); 5] {
+        [
+            (CHANNELS[0], &self.disp_u),
+            (CHANNELS[1], &self.disp_v),
+            (CHANNELS[2], &self.path_px),
+            (CHANNELS[3], &self.flow_u),
+            (CHANNELS[4], &self.flow_v),
+        ]
+    }
+
+    /// Writes the maps as a float EXR (atomically: temp file and rename).
+    pub fn write_exr(&self, path: &std::path::Path) -> Result<()> {
+        crate::io::images::write_exr(
+            path,
+            self.width as usize,
+            self.height as usize,
+            &self.channels(),
+        )
+    }
+
+    /// Mean path length over the pixels that have one (px; the frame's
+    /// exposure MMBM as a blur length) and their share of the pixels.
+    pub fn mean_path_px(&self) -> (f64, f64) {
+        let (mut s, mut n) = (0.0f64, 0usize);
+        for &p in self.path_px.iter().filter(|p| p.is_finite()) {
+            s += p as f64;
+            n += 1;
+        }
+        (
+            s / n.max(1) as f64,
+            n as f64 / self.path_px.len().max(1) as f64,
+        )
+    }
+}
+
+/// The undistorted ray `(x, y)` (normalised, `z = 1`) through every pixel
+/// centre of a camera, row-major; NaN where the pixel is masked or does not
+/// undistort. Built once per video (the lens's iterative undistortion).
+#[derive(Debug, Clone)]
+pub struct MapRays {
+    camera: Camera,
+    rays: Vec<(f64, f64)>,
+}
+
+impl MapRays {
+    /// The rays of `cam` (validated).
+    pub fn new(cam: &Camera) -> Result<Self> {
+        cam.validate()?;
+        let w = cam.width as usize;
+        let rays = (0..w * cam.height as usize)
+            .into_par_iter()
+            .with_min_len(4096)
+            .map(|idx| {
+                let (x, y) = ((idx % w) as f64 + 0.5, (idx / w) as f64 + 0.5);
+                let (ud, vd) = cam.pixel_to_mm(x, y);
+                if cam.is_masked_mm(ud, vd) {
+                    return (f64::NAN, f64::NAN);
+                }
+                cam.pixel_to_ray(x, y).unwrap_or((f64::NAN, f64::NAN))
+            })
+            .collect();
+        Ok(MapRays { camera: *cam, rays })
+    }
+
+    /// The camera the rays are of.
+    pub fn camera(&self) -> &Camera {
+        &self.camera
+    }
+}
+
+/// The chords per line's exposure for `traj`'s motion: about one per pixel
+/// of the largest image motion (a bound from the largest rotation rate of
+/// the log in the frame's span, at the sensor corner, plus translation at
+/// the plane's nearest corner), 16 to 2048.
+fn auto_steps(cam: &Camera, log: &ImuLog, a: f64, b: f64, te: f64, inv_depth: f64) -> usize {
+    let lo = log.partition_point(|s| s.t <= a).saturating_sub(1);
+    let hi = log.partition_point(|s| s.t < b).min(log.len() - 1);
+    let (mut w, mut v) = (0.0f64, 0.0f64);
+    for s in &log[lo..=hi] {
+        w = w.max(s.omega.length());
+        v = v.max(s.velocity.map_or(0.0, |v| v.length()));
+    }
+    let r = cam.sensor_rect();
+    let corner2 = r.u0.abs().max(r.u1.abs()).powi(2) + r.v0.abs().max(r.v1.abs()).powi(2);
+    let fpx = cam.fx_px().max(cam.fy_px());
+    let px = (w * (1.0 + corner2 / (cam.focal_mm * cam.focal_mm)) + v * inv_depth) * fpx * te;
+    (px.ceil() as usize).clamp(16, 2048)
+}
+
+/// True when `[a, b]` lies inside the log and crosses no gap in it (an
+/// interval much longer than the median, where no motion is known: the
+/// renderer's rule, [`Trajectory::from_imu_log`]).
+fn covers(log: &ImuLog, a: f64, b: f64) -> bool {
+    match (log.first(), log.last()) {
+        (Some(f), Some(l)) if log.len() >= 2 && a >= f.t && b <= l.t => {}
+        _ => return false,
+    }
+    let median = log.median_interval().unwrap_or(0.0);
+    let lo = log.partition_point(|s| s.t <= a).saturating_sub(1);
+    let hi = log.partition_point(|s| s.t < b).min(log.len() - 1);
+    !log[lo..=hi]
+        .windows(2)
+        .any(|w| w[1].t > a && w[0].t < b && crate::model::log::is_gap(w[1].t - w[0].t, median))
+}
+
+/// The scene plane of a frame's maps (world = camera frame at `t_start`),
+/// `None` for rotation only (see the module docs).
+fn world_plane(log: &ImuLog, opts: &SeriesOptions, t_start: f64) -> Result<Option<Plane>> {
+    if !opts.use_velocity {
+        return Ok(None);
+    }
+    let k = log.partition_point(|s| s.t <= t_start).saturating_sub(1);
+    match (log[k].depth, opts.scene.plane) {
+        (_, Some(p)) => Ok(Some(p)),
+        (Some(z), None) => Ok(Some(Plane::fronto(z))),
+        (None, None) => Err(Error::invalid(
+            "depth",
+            "translation needs a scene depth: a 'depth' column in the log or --depth",
+        )),
+    }
+}
+
+/// The blur fields of `frame` (row `index` of its table) from `log` with
+/// the camera of `rays` (which must be `opts.scene.camera`) and `opts`' scene
+/// and velocity (its method is not used): `None` when the frame's span
+/// `[t_start, t_start + readout + exposure]` is not inside the log or
+/// crosses a gap in it (no motion is known there). `steps`:
+/// chords per line's exposure (`None`: about one per pixel of motion, at
+/// least 16). The readout is the frame's own, else the camera's.
+pub fn frame_maps(
+    log: &ImuLog,
+    opts: &SeriesOptions,
+    rays: &MapRays,
+    index: usize,
+    frame: &VideoFrame,
+    steps: Option<usize>,
+) -> Result<Option<FrameMaps>> {
+    let cam = opts.scene.camera;
+    if rays.camera != cam {
+        return Err(Error::invalid(
+            "maps",
+            "the rays were built for another camera than the options'",
+        ));
+    }
+    frame
+        .check()
+        .map_err(|(column, message)| Error::invalid(format!("frame {index}: {column}"), message))?;
+    let (te, readout) = (
+        frame.exposure_s,
+        frame.readout_s.unwrap_or(cam.shutter.readout_s),
+    );
+    let (a, b) = (frame.t_start, frame.t_start + readout + te);
+    if !covers(log, a, b) {
+        return Ok(None);
+    }
+    let at = |e: Error| Error::invalid(format!("frame {index} (t_start = {a} s)"), e.to_string());
+    let traj = Trajectory::from_imu_log(log, a, readout + te, opts.use_velocity).map_err(at)?;
+    let plane = world_plane(log, opts, a)?;
+    if let Some(p) = &plane {
+        p.validate_for(&cam).map_err(at)?;
+    }
+    let inv_depth = plane.map_or(0.0, |p| {
+        let r = cam.sensor_rect();
+        [(r.u0, r.v0), (r.u0, r.v1), (r.u1, r.v0), (r.u1, r.v1)]
+            .iter()
+            .map(|&(u, v)| p.inverse_depth(cam.focal_mm, u, v).abs())
+            .fold(0.0, f64::max)
+    });
+    let steps = steps
+        .unwrap_or_else(|| auto_steps(&cam, log, a, b, te, inv_depth))
+        .max(1);
+    let shutter = crate::camera::Shutter {
+        readout_s: readout,
+        direction: cam.shutter.direction,
+    };
+    let rows = cam.shutter.direction.is_rows();
+    let (w, h) = (cam.width as usize, cam.height as usize);
+    let len = if rows { w } else { h };
+    let stop = crate::cancel::current();
+    let mut vals = vec![[f32::NAN; 5]; w * h];
+    vals.par_chunks_mut(len).enumerate().for_each(|(l, out)| {
+        if stop.is_cancelled() {
+            return;
+        }
+        let c = l as f64 + 0.5;
+        let t0 = shutter.delay_s(c, c, cam.width, cam.height);
+        let line = Line::new(log, &traj, plane.as_ref(), &cam, a, t0, te, steps);
+        let ray = |m: usize| {
+            let (i, j) = if rows { (m, l) } else { (l, m) };
+            rays.rays[j * w + i]
+        };
+        if cam.distortion.is_none() {
+            line.pinhole(&cam, ray, out);
+            return;
+        }
+        for (m, o) in out.iter_mut().enumerate() {
+            if let Some(v) = line.pixel(&cam, ray(m)) {
+                *o = v;
+            }
+        }
+    });
+    crate::cancel::check()?;
+    let mut ch: [Vec<f32>; 5] = Default::default();
+    for (k, c) in ch.iter_mut().enumerate() {
+        *c = if rows {
+            vals.iter().map(|v| v[k]).collect()
+        } else {
+            (0..w * h)
+                .map(|idx| vals[(idx % w) * h + idx / w][k])
+                .collect()
+        };
+    }
+    let [disp_u, disp_v, path_px, flow_u, flow_v] = ch;
+    Ok(Some(FrameMaps {
+        frame: index,
+        width: cam.width,
+        height: cam.height,
+        exposure_s: te,
+        readout_s: readout,
+        steps,
+        disp_u,
+        disp_v,
+        path_px,
+        flow_u,
+        flow_v,
+    }))
+}
+
+/// One line's motion over its exposure.
+struct Line {
+    /// World-to-camera rotation at the line's start (camera-to-world transposed).
+    start_rot: DMat3,
+    /// Rotation from the line's start frame to each instant's, and the
+    /// offset of the start's centre in each instant's frame (m).
+    steps: Vec<(DMat3, DVec3)>,
+    /// World-frame normal and offset of the plane seen from the line's start
+    /// centre: `n . (X - c_s) = d_s`.
+    plane: Option<(DVec3, f64)>,
+    /// The flow at the line's start (mm/s, undistorted sensor).
+    flow: FlowPoly,
+}
+
+impl Line {
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        log: &ImuLog,
+        traj: &Trajectory,
+        plane: Option<&Plane>,
+        cam: &Camera,
+        t_frame: f64,
+        t0: f64,
+        te: f64,
+        steps: usize,
+    ) -> Self {
+        let (qs, cs) = traj.pose_at(t0);
+        let steps_v = (0..=steps)
+            .map(|k| {
+                let (q, c) = traj.pose_at(t0 + te * k as f64 / steps as f64);
+                let inv = q.inverse();
+                (DMat3::from_quat(inv * qs), inv * (cs - c))
+            })
+            .collect();
+        // The twist interpolated to the line's start, and the plane in the
+        // line's start frame.
+        let t = t_frame + t0;
+        let i = log.partition_point(|s| s.t <= t).clamp(1, log.len() - 1);
+        let (s0, s1) = (&log[i - 1], &log[i]);
+        let f = ((t - s0.t) / (s1.t - s0.t)).clamp(0.0, 1.0);
+        let omega = s0.omega.lerp(s1.omega, f);
+        let vel = match (s0.velocity, s1.velocity) {
+            (Some(a), Some(b)) => a.lerp(b, f),
+            _ => DVec3::ZERO,
+        };
+        let plane_w = plane.map(|p| (p.normal, p.d - p.normal.dot(cs)));
+        let plane_line = plane_w.map(|(n, d)| Plane {
+            normal: qs.inverse() * n,
+            d,
+        });
+        Line {
+            start_rot: DMat3::from_quat(qs),
+            steps: steps_v,
+            plane: plane_w,
+            flow: FlowPoly::new(cam.focal_mm, &Twist::new(omega, vel), plane_line.as_ref()),
+        }
+    }
+
+    /// The inverse depth (1/m) of the scene point along `ray` (line start
+    /// frame); 0 for rotation only (points at infinity); `None` when the ray
+    /// misses the plane.
+    #[inline]
+    fn inv_depth(&self, ray: DVec3) -> Option<f64> {
+        match self.plane {
+            None => Some(0.0),
+            Some((n, d)) => {
+                let x = n.dot(self.start_rot * ray) / d;
+                (x > 0.0 && x.is_finite()).then_some(x)
+            }
+        }
+    }
+
+    /// [`Line::pixel`] for a whole line of a pinhole camera (`ray(m)` is
+    /// the undistorted ray of the line's pixel `m`): the pixel matrix folded
+    /// into each instant's rotation, step-major over the line's pixels so
+    /// the inner loop vectorises. The same values to rounding.
+    fn pinhole(&self, cam: &Camera, ray: impl Fn(usize) -> (f64, f64), out: &mut [[f32; 5]]) {
+        let n = out.len();
+        let kmat = DMat3::from_cols(
+            DVec3::new(cam.focal_mm / cam.pitch_x_mm, 0.0, 0.0),
+            DVec3::new(cam.skew, cam.focal_mm / cam.pitch_y_mm, 0.0),
+            DVec3::new(cam.cx, cam.cy, 1.0),
+        );
+        let mut buf = vec![0.0f64; 8 * n];
+        let (rx, rest) = buf.split_at_mut(n);
+        let (ry, rest) = rest.split_at_mut(n);
+        let (is, rest) = rest.split_at_mut(n);
+        let (x0, rest) = rest.split_at_mut(n);
+        let (y0, rest) = rest.split_at_mut(n);
+        let (px, rest) = rest.split_at_mut(n);
+        let (py, rest) = rest.split_at_mut(n);
+        let path = rest;
+        let mut bad = vec![false; n];
+        for m in 0..n {
+            let r = ray(m);
+            rx[m] = r.0;
+            ry[m] = r.1;
+            match self.inv_depth(DVec3::new(r.0, r.1, 1.0)) {
+                Some(x) if r.0.is_finite() && r.1.is_finite() => is[m] = x,
+                _ => bad[m] = true,
+            }
+        }
+        for (k, (rot, off)) in self.steps.iter().enumerate() {
+            let a = kmat * *rot;
+            let c = kmat * *off;
+            let (a0, a1, a2) = (a.x_axis, a.y_axis, a.z_axis);
+            for m in 0..n {
+                let (x, y, s) = (rx[m], ry[m], is[m]);
+                let z = a0.z * x + a1.z * y + a2.z + c.z * s;
+                bad[m] |= z.is_nan() || z <= 1e-12;
+                let q = 1.0 / z;
+                let u = (a0.x * x + a1.x * y + a2.x + c.x * s) * q;
+                let v = (a0.y * x + a1.y * y + a2.y + c.y * s) * q;
+                if k == 0 {
+                    x0[m] = u;
+                    y0[m] = v;
+                } else {
+                    let (du, dv) = (u - px[m], v - py[m]);
+                    path[m] += (du * du + dv * dv).sqrt();
+                }
+                px[m] = u;
+                py[m] = v;
+            }
+        }
+        for m in 0..n {
+            if bad[m] {
+                continue;
+            }
+            let fl = self.flow.eval(cam.focal_mm * rx[m], cam.focal_mm * ry[m]);
+            let (fu, fv) = cam.mm_to_px_velocity(fl.0, fl.1);
+            out[m] = [
+                (px[m] - x0[m]) as f32,
+                (py[m] - y0[m]) as f32,
+                path[m] as f32,
+                fu as f32,
+                fv as f32,
+            ];
+        }
+    }
+
+    /// The five channels of the pixel whose undistorted ray is `r`, or `None`.
+    #[inline]
+    fn pixel(&self, cam: &Camera, r: (f64, f64)) -> Option<[f32; 5]> {
+        if !r.0.is_finite() {
+            return None;
+        }
+        let ray = DVec3::new(r.0, r.1, 1.0);
+        let inv_s = self.inv_depth(ray)?;
+        let project = |m: &DMat3, b: DVec3| -> Option<(f64, f64)> {
+            let p = *m * ray + b * inv_s;
+            (p.z > 1e-12).then(|| cam.ray_to_pixel(p.x / p.z, p.y / p.z))
+        };
+        let first = project(&self.steps[0].0, self.steps[0].1)?;
+        let (mut prev, mut path) = (first, 0.0);
+        for (m, b) in &self.steps[1..] {
+            let q = project(m, *b)?;
+            let (du, dv) = (q.0 - prev.0, q.1 - prev.1);
+            path += (du * du + dv * dv).sqrt();
+            prev = q;
+        }
+        let (u, v) = (cam.focal_mm * r.0, cam.focal_mm * r.1);
+        let fl = self.flow.eval(u, v);
+        let fl = if cam.distortion.is_none() {
+            fl
+        } else {
+            crate::camera::distortion::apply(&cam.distortion_jacobian(u, v), fl)
+        };
+        let (fu, fv) = cam.mm_to_px_velocity(fl.0, fl.1);
+        Some([
+            (prev.0 - first.0) as f32,
+            (prev.1 - first.1) as f32,
+            path as f32,
+            fu as f32,
+            fv as f32,
+        ])
+    }
+}
+
+/// The file name of frame `index`'s maps in a `--maps` directory.
+pub fn file_name(index: usize) -> String {
+    format!("frame_{index:06}.exr")
+}
+
+/// What [`write_maps`] wrote.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct MapsWritten {
+    /// Per written frame: its row, mean path (px) and share of pixels with a value.
+    pub written: Vec<(usize, f64, f64)>,
+    /// Rows without maps: their span leaves the log or crosses a gap in it.
+    pub skipped: Vec<usize>,
+}
+
+/// Writes the maps of the frames `which` (rows of `frames`) to `dir`
+/// (created if missing), one EXR each ([`file_name`]), each file
+/// atomically; a frame whose span leaves the log or crosses a gap in it
+/// gets none (listed in [`MapsWritten::skipped`]).
+pub fn write_maps(
+    log: &ImuLog,
+    opts: &SeriesOptions,
+    frames: &[VideoFrame],
+    which: &[usize],
+    dir: &std::path::Path,
+) -> Result<MapsWritten> {
+    std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
+    let rays = MapRays::new(&opts.scene.camera)?;
+    let mut out = MapsWritten::default();
+    for &k in which {
+        crate::cancel::check()?;
+        let f = frames.get(k).ok_or_else(|| {
+            Error::invalid(
+                "maps",
+                format!("frame {k} is not in the table ({} rows)", frames.len()),
+            )
+        })?;
+        match frame_maps(log, opts, &rays, k, f, None)? {
+            Some(m) => {
+                m.write_exr(&dir.join(file_name(k)))?;
+                let (mean, valid) = m.mean_path_px();
+                out.written.push((k, mean, valid));
+            }
+            None => out.skipped.push(k),
+        }
+    }
+    Ok(out)
+}
