@@ -53,7 +53,7 @@ enum Command {
     /// MMBM for every sample of a gyro log (CSV out).
     Series(series::SeriesArgs),
     /// Exposure MMBM and blur of every frame of a real video (rolling shutter), --select the sharpest.
-    Frames(frames::FramesArgs),
+    Frames(Box<frames::FramesArgs>),
     /// Regenerate the thesis sensitivity tables 4.1-4.5 and the Fig. 4.6 grid error.
     Tables(tables::TablesArgs),
     /// List GPU adapters and show which one mmbm uses.
@@ -119,7 +119,7 @@ fn run() -> i32 {
     let r = match cli.command {
         Command::Eval(a) => eval::run(a),
         Command::Series(a) => series::run(a),
-        Command::Frames(a) => frames::run(a),
+        Command::Frames(a) => frames::run(*a),
         Command::Tables(a) => tables::run(a),
         Command::Info => info::run(),
         Command::Flow(a) => flow::run(a),
