@@ -137,8 +137,8 @@ fn bad_camera_files_name_the_key() {
         ),
         (
             "model.toml",
-            format!("{base}[distortion]\nmodel = \"poly5\"\n"),
-            "poly5",
+            format!("{base}[distortion]\nmodel = \"mystery\"\n"),
+            "mystery",
         ),
         (
             "dir.toml",
@@ -152,12 +152,12 @@ fn bad_camera_files_name_the_key() {
             .to_string();
         assert!(e.contains(key) && e.contains(name), "{name}: {e}");
     }
-    let json = r#"{"calib_dimension": {"w": 100, "h": 80}, "distortion_model": "poly3",
+    let json = r#"{"calib_dimension": {"w": 100, "h": 80}, "distortion_model": "gopro",
         "fisheye_params": {"camera_matrix": [[90,0,50],[0,90,40],[0,0,1]], "distortion_coeffs": [0.1]}}"#;
     let e = Camera::load(&write_tmp("p.json", json))
         .unwrap_err()
         .to_string();
-    assert!(e.contains("distortion_model") && e.contains("poly3"), "{e}");
+    assert!(e.contains("distortion_model") && e.contains("gopro"), "{e}");
 }
 
 /// Distorted sensor point (mm) of the scene point `x` (camera frame, m).
