@@ -21,7 +21,7 @@
 //! | 2 | [`metric`], [`board`], [`plot`], [`sim`], [`assess`] | MMBM rules; the thesis board, blobs, pose; figures; gait simulation; image blur metrics |
 //! | 3 | [`field`], [`tables`] | the flow-field kernel (GPU + CPU twin); thesis tables |
 //! | 4 | [`series`], [`render`] | MMBM of a log (CPU and GPU batch); the blur renderer |
-//! | 5 | [`trigger`] | trigger policies |
+//! | 5 | [`trigger`], [`augment`] | trigger policies; motion-blur augmentation of any image |
 //! | 6 | [`experiment`], [`dataset`] | the thesis experiment end to end; blur datasets at scale |
 //!
 //! The `mmbm` command (the workspace's `cli/` crate) sits on top; the throughput benchmarks are
