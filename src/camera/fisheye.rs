@@ -29,15 +29,23 @@ pub fn slope(k: [f64; 4], th: f64) -> f64 {
 /// in `(0, THETA_MAX]` (a scan of 64 steps, then bisection to 1e-15 rad),
 /// or `THETA_MAX` when the slope stays positive.
 pub fn turning_point(k: [f64; 4]) -> f64 {
-    const STEPS: u32 = 64;
+    first_slope_zero(64, |th| slope(k, th))
+}
+
+/// The first zero of `slope` in `(0, THETA_MAX]`: a scan of `steps` equal
+/// steps to the first one where it is `<= 0` or NaN, then bisection to
+/// 1e-15 rad; `THETA_MAX` when it stays positive. Shared by every radial
+/// model's turning point.
+pub fn first_slope_zero(steps: u32, slope: impl Fn(f64) -> f64) -> f64 {
     let mut lo = 0.0;
-    for i in 1..=STEPS {
-        let hi = THETA_MAX * i as f64 / STEPS as f64;
-        if slope(k, hi) <= 0.0 || slope(k, hi).is_nan() {
+    for i in 1..=steps {
+        let hi = THETA_MAX * i as f64 / steps as f64;
+        let d = slope(hi);
+        if d <= 0.0 || d.is_nan() {
             let mut hi = hi;
             while hi - lo > 1e-15 {
                 let mid = 0.5 * (lo + hi);
-                if slope(k, mid) > 0.0 {
+                if slope(mid) > 0.0 {
                     lo = mid;
                 } else {
                     hi = mid;

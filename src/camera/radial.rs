@@ -56,26 +56,7 @@ fn slope(p: &dyn Profile, th: f64) -> f64 {
 /// zero of its slope in `(0, THETA_MAX]` (a scan of 256 steps, then
 /// bisection to 1e-15 rad), or `THETA_MAX`.
 pub fn turning_point(p: &dyn Profile) -> f64 {
-    const STEPS: u32 = 256;
-    let mut lo = 0.0;
-    for i in 1..=STEPS {
-        let hi = THETA_MAX * i as f64 / STEPS as f64;
-        let d = slope(p, hi);
-        if d <= 0.0 || d.is_nan() {
-            let mut hi = hi;
-            while hi - lo > 1e-15 {
-                let mid = 0.5 * (lo + hi);
-                if slope(p, mid) > 0.0 {
-                    lo = mid;
-                } else {
-                    hi = mid;
-                }
-            }
-            return lo;
-        }
-        lo = hi;
-    }
-    THETA_MAX
+    super::fisheye::first_slope_zero(256, |th| slope(p, th))
 }
 
 /// The radial distortion limit (normalised distorted radius): the distorted
