@@ -5,51 +5,16 @@
 //! of the `.gcsv` file and the column or header key.
 
 mod common;
+mod gcsv_fixture;
 
 use common::mmbm;
+use gcsv_fixture::*;
 use glam::{DMat3, DVec3};
 use mmbm::io::gcsv::{
     camera_matrix, is_gcsv, orientation_matrix, read_header, ReadoutDirection, GYROFLOW_TO_CAMERA,
 };
 use mmbm::io::gyro::{read_log, AngleUnit, GyroOptions, GyroSample, TimeUnit};
-use std::path::{Path, PathBuf};
-
-fn walk() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/gcsv/walk.gcsv")
-}
-
-fn walk_text() -> String {
-    std::fs::read_to_string(walk()).unwrap()
-}
-
-const TSCALE: f64 = 0.001;
-const GSCALE: f64 = 0.00122173047;
-/// The fixture's column line is line 18; samples start on line 19.
-const FIRST_ROW_LINE: usize = 19;
-
-/// The fixture's raw rows: (t, gx, gy, gz) as written.
-fn raw_rows(text: &str) -> Vec<[f64; 4]> {
-    text.lines()
-        .skip(FIRST_ROW_LINE - 1)
-        .map(|l| {
-            let f: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
-            [f[0], f[1], f[2], f[3]]
-        })
-        .collect()
-}
-
-/// `text` with line `n` (1-based) replaced.
-fn with_line(text: &str, n: usize, new: &str) -> String {
-    let mut lines: Vec<&str> = text.lines().collect();
-    lines[n - 1] = new;
-    lines.join("\n") + "\n"
-}
-
-fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
-    let p = dir.join(name);
-    std::fs::write(&p, text).unwrap();
-    p
-}
+use std::path::Path;
 
 fn err(path: &Path) -> String {
     match read_log(path, GyroOptions::default()) {

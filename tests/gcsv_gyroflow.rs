@@ -3,46 +3,13 @@
 //! scales, and Gyroflow's IMU rotation in its IMU frame.
 
 mod common;
+mod gcsv_fixture;
 
 use common::mmbm;
+use gcsv_fixture::*;
 use glam::{DMat3, DVec3};
 use mmbm::io::gcsv::{orientation_matrix, read_header, ReadoutDirection, GYROFLOW_TO_CAMERA};
 use mmbm::io::gyro::{read_log, GyroOptions};
-use std::path::{Path, PathBuf};
-
-const GSCALE: f64 = 0.00122173047;
-
-fn walk() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/gcsv/walk.gcsv")
-}
-
-fn walk_text() -> String {
-    std::fs::read_to_string(walk()).unwrap()
-}
-
-/// The fixture's raw rows (t, gx, gy, gz), from line 19 on.
-fn raw_rows(text: &str) -> Vec<[f64; 4]> {
-    text.lines()
-        .skip(18)
-        .map(|l| {
-            let f: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
-            [f[0], f[1], f[2], f[3]]
-        })
-        .collect()
-}
-
-/// `text` with line `n` (1-based) replaced.
-fn with_line(text: &str, n: usize, new: &str) -> String {
-    let mut lines: Vec<&str> = text.lines().collect();
-    lines[n - 1] = new;
-    lines.join("\n") + "\n"
-}
-
-fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
-    let p = dir.join(name);
-    std::fs::write(&p, text).unwrap();
-    p
-}
 
 /// Header lines without a comma (`version:1.3`, written by real loggers) are
 /// skipped, as telemetry-parser skips them; a negative `frame_readout_time`
