@@ -17,15 +17,16 @@
 
 use super::benefit::{Estimate, WalkBlocks, BOOTSTRAP_SEED, RESAMPLES};
 use super::config::ExperimentConfig;
-use super::map_render::{judge_at_lights, Light};
+use super::map_render::{judge_at_lights, Judged, Light};
 use super::walk::{make_walk, Walk};
 use crate::camera::Noise;
 use crate::error::Result;
 use crate::metric::Scene;
 use crate::render::Quality;
 use crate::stats::percentile;
-use crate::trigger::{PolicyFamily, PolicySpec};
+use crate::trigger::{Frame, PolicyFamily, PolicySpec};
 use rand::{Rng, SeedableRng};
+use rayon::prelude::*;
 
 /// One policy in one cell.
 #[derive(Debug, Clone, PartialEq)]
@@ -244,20 +245,33 @@ pub fn benefit_map(
                     });
                 }
                 for (pi, (_, frames)) in w.runs.iter().enumerate() {
-                    for f in frames.iter().filter(|f| f.kept) {
+                    // The policy's kept frames are judged in parallel (each
+                    // frame's seed is its place in the serial order, so the
+                    // result does not depend on the thread count), then
+                    // tallied in order.
+                    let kept: Vec<&Frame> = frames.iter().filter(|f| f.kept).collect();
+                    if let Some(f) = kept.first() {
                         bar.message(&format!("{g} {board} {}", f.policy));
-                        let judged = judge_at_lights(
-                            board,
-                            surround,
-                            w,
-                            f,
-                            cam,
-                            quality,
-                            renders as u32,
-                            &lights,
-                        )?;
-                        renders += 1;
-                        bar.advance(1);
+                    }
+                    let judged: Vec<Vec<Judged>> = kept
+                        .par_iter()
+                        .enumerate()
+                        .map(|(j, f)| {
+                            judge_at_lights(
+                                board,
+                                surround,
+                                w,
+                                f,
+                                cam,
+                                quality,
+                                (renders + j) as u32,
+                                &lights,
+                            )
+                        })
+                        .collect::<Result<_>>()?;
+                    renders += kept.len();
+                    bar.advance(kept.len() as u64);
+                    for (f, judged) in kept.iter().zip(&judged) {
                         let b = wb.index(f.trigger_t);
                         for (li, j) in judged.iter().enumerate() {
                             let k = li * np + pi;

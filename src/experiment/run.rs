@@ -12,6 +12,7 @@ use crate::io::atomic::write_atomic;
 use crate::metric::Scene;
 use crate::render::Quality;
 use crate::trigger::Frame;
+use rayon::prelude::*;
 use std::collections::HashMap;
 use std::path::Path;
 use std::str::FromStr;
@@ -69,34 +70,51 @@ pub fn run(cfg: &ExperimentConfig, out: &Path, progress: bool) -> Result<Outcome
     let mut measures = HashMap::new();
     let mut extremes: HashMap<(usize, usize), Extremes> = HashMap::new();
     let mut backend = String::new();
-    for (k, &(wi, pi, fi)) in plan.iter().enumerate() {
-        let w = &walks[wi];
-        let frame = &w.runs[pi].1[fi];
-        bar.message(&format!("{} {}", w.name, frame.policy));
-        let r = render_and_measure(cfg, w, frame, cfg.camera(), quality, k as u32)?;
-        if backend.is_empty() {
-            backend = r.backend.clone();
+    // Frames are rendered and measured in parallel, a chunk at a time (each
+    // frame's seed is its place in the plan, so the results do not depend on
+    // the thread count), then taken in the plan's order.
+    let chunk = 4 * rayon::current_num_threads();
+    for (c, part) in plan.chunks(chunk).enumerate() {
+        if let Some(&(wi, pi, fi)) = part.first() {
+            let w = &walks[wi];
+            bar.message(&format!("{} {}", w.name, w.runs[pi].1[fi].policy));
         }
-        // Keep the sharpest and the most blurred frame of each (walk, policy).
-        let m = &r.measure;
-        let shot = Shot {
-            trigger_t: frame.trigger_t,
-            blur_px: m.blur_px,
-            blobs_matched: m.blobs_matched,
-            blobs_expected: r.expected_px.len(),
-            blobs_false: m.blobs_false,
-            ok: m.blobs_ok,
-            expected_px: r.expected_px.clone(),
-            rgb: r.rgb.clone(),
-        };
-        match extremes.get_mut(&(wi, pi)) {
-            Some(e) => e.offer(shot),
-            None => {
-                extremes.insert((wi, pi), Extremes::new(shot));
+        let rendered: Vec<Result<_>> = part
+            .par_iter()
+            .enumerate()
+            .map(|(j, &(wi, pi, fi))| {
+                let w = &walks[wi];
+                let k = c * chunk + j;
+                render_and_measure(cfg, w, &w.runs[pi].1[fi], cfg.camera(), quality, k as u32)
+            })
+            .collect();
+        for (&(wi, pi, fi), r) in part.iter().zip(rendered) {
+            let r = r?;
+            let frame = &walks[wi].runs[pi].1[fi];
+            if backend.is_empty() {
+                backend = r.backend.clone();
             }
+            // Keep the sharpest and the most blurred frame of each (walk, policy).
+            let m = &r.measure;
+            let shot = Shot {
+                trigger_t: frame.trigger_t,
+                blur_px: m.blur_px,
+                blobs_matched: m.blobs_matched,
+                blobs_expected: r.expected_px.len(),
+                blobs_false: m.blobs_false,
+                ok: m.blobs_ok,
+                expected_px: r.expected_px.clone(),
+                rgb: r.rgb.clone(),
+            };
+            match extremes.get_mut(&(wi, pi)) {
+                Some(e) => e.offer(shot),
+                None => {
+                    extremes.insert((wi, pi), Extremes::new(shot));
+                }
+            }
+            measures.insert((wi, pi, fi), r.measure);
+            bar.advance(1);
         }
-        measures.insert((wi, pi, fi), r.measure);
-        bar.advance(1);
     }
     drop(bar);
     let sweep = super::sweep::exposure_sweep(cfg, &walks, quality)?;
