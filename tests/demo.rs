@@ -56,6 +56,8 @@ fn demo_report_matches_the_docs() {
         );
     }
     assert!(report.contains("so no policy at that rate can exceed"));
+    // The map's goals state the frame-rate ceiling against the baseline.
+    assert!(report.contains("frames/s no policy can get more than"));
     assert!(report.contains("`phase:0.4` recovers"));
     assert!(report.contains("## Image metrics against the ground truth"));
     // Every kept frame of the demo's policies rendered, with the new columns.

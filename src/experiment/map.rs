@@ -105,6 +105,8 @@ pub struct BenefitMap {
     pub max_gain_x: f64,
     /// The fixed-exposure grid, ms.
     pub grid_ms: Vec<f64>,
+    /// The frame rate of `fixed` and of the grid, frames/s.
+    pub fps: f64,
     /// Frames rendered (each judged at every light).
     pub renders: usize,
     /// Wall time, s.
@@ -321,6 +323,7 @@ pub fn benefit_map(
         t_ref_s: cfg.exposure_s,
         max_gain_x: m.max_gain_x,
         grid_ms: m.grid_ms.clone(),
+        fps: m.fps,
         renders,
         seconds: t_start.elapsed().as_secs_f64(),
     }))
