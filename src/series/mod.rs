@@ -11,6 +11,9 @@ pub mod frames;
 pub mod gpu;
 pub mod lerp;
 pub mod maps;
+pub mod maps_gpu;
+pub mod maps_kernel;
+mod maps_line;
 pub mod select;
 
 use crate::error::{Error, Result};
