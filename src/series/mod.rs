@@ -197,7 +197,9 @@ pub fn run<W: Write>(
     exposure_s: Option<f64>,
     out: W,
 ) -> Result<u64> {
-    let mut out = std::io::BufWriter::with_capacity(1 << 20, out);
+    // Rows come formatted in blocks of FORMAT_CHUNK (about 100 KB): a
+    // buffer smaller than a block passes them straight to `out`, uncopied.
+    let mut out = std::io::BufWriter::with_capacity(1 << 16, out);
     let werr = |e: std::io::Error| Error::io("<series output>", e);
     out.write_all(match exposure_s {
         Some(_) => b"t,mmbm_mm_s,mmbm_px_s,blur_px\n".as_slice(),
