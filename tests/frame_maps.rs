@@ -18,7 +18,6 @@ use mmbm::series::frames::frame_mmbm;
 use mmbm::series::maps::{frame_maps, FrameMaps, MapRays};
 use mmbm::series::SeriesOptions;
 use mmbm::{Camera, Method, Plane};
-use std::path::PathBuf;
 
 fn maps(
     log: &ImuLog,
@@ -334,10 +333,9 @@ fn cli_frames_maps() {
         "t_start,exposure_s\n2.0,0.004\n5.258,0.0013\n99.0,0.001\n",
     )
     .unwrap();
-    let cam_file =
-        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("examples/cameras/running_phone.toml");
     let dir = tmp.join("maps");
-    let out = frames_maps(&gyro, &table, &dir, &tmp.join("f.csv"), &[]);
+    let cam_file = running_phone_camera();
+    let out = frames_maps(&gyro, &table, &cam_file, &dir, &tmp.join("f.csv"), &[]);
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{err}");
     assert!(err.contains("maps: 2 frame(s)"), "{err}");

@@ -36,17 +36,21 @@ pub fn path(p: &std::path::Path) -> &str {
     p.to_str().unwrap()
 }
 
-/// `mmbm frames --gyro GYRO --frames TABLE` with the running phone's camera
-/// at 192x108, `--maps DIR --out OUT` and `extra`.
+/// The running phone's camera file.
+pub fn running_phone_camera() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("examples/cameras/running_phone.toml")
+}
+
+/// `mmbm frames --gyro GYRO --frames TABLE --camera CAMERA --scale-to
+/// 192x108 --maps DIR --out OUT` and `extra`.
 pub fn frames_maps(
     gyro: &Path,
     table: &Path,
+    camera: &Path,
     dir: &Path,
     out: &Path,
     extra: &[&str],
 ) -> std::process::Output {
-    let cam_file =
-        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("examples/cameras/running_phone.toml");
     let mut args = vec![
         "frames",
         "--gyro",
@@ -54,7 +58,7 @@ pub fn frames_maps(
         "--frames",
         path(table),
         "--camera",
-        path(&cam_file),
+        path(camera),
         "--scale-to",
         "192x108",
         "--maps",
