@@ -136,7 +136,8 @@ pub fn run(a: FramesArgs) -> Result<()> {
         Ok(())
     };
     if let Some(dir) = &a.maps {
-        let done = mmbm::series::maps::write_maps(&samples, &opts, &frames, &keep, dir, a.backend)?;
+        let done =
+            mmbm::series::maps_write::write_maps(&samples, &opts, &frames, &keep, dir, a.backend)?;
         let n = done.written.len();
         let mean = done.written.iter().map(|d| d.1).sum::<f64>() / n.max(1) as f64;
         eprintln!(

@@ -21,15 +21,14 @@
 //! point is lost (behind the camera or off the plane) are NaN in every
 //! channel.
 
+use super::maps_line::LineMotion;
 use super::SeriesOptions;
 use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::io::frames::VideoFrame;
-use crate::model::flow::FlowPoly;
 use crate::model::log::ImuLog;
-use crate::model::motion::{Plane, Twist};
+use crate::model::motion::Plane;
 use crate::render::trajectory::Trajectory;
-use glam::{DQuat, DVec3};
 use rayon::prelude::*;
 
 /// Channels of a frame's maps, in the EXR's order of [`FrameMaps::channels`].
@@ -393,133 +392,4 @@ pub fn frame_maps(
         };
     }
     Ok(Some(plan.finish(index, ch)))
-}
-
-/// One line's motion over its exposure, as rotations (the GPU path uploads
-/// these; the f64 path turns them into matrices, [`Line`]).
-pub(crate) struct LineMotion {
-    /// Camera-to-world rotation at the line's start.
-    pub start: DQuat,
-    /// Rotation from the line's start frame to each of `steps + 1` instants'
-    /// frames, and the offset of the start's centre in each instant's frame (m).
-    pub steps: Vec<(DQuat, DVec3)>,
-    /// World-frame normal and offset of the plane seen from the line's start
-    /// centre: `n . (X - c_s) = d_s`.
-    pub plane: Option<(DVec3, f64)>,
-    /// The flow at the line's start (mm/s, undistorted sensor).
-    pub flow: FlowPoly,
-}
-
-impl LineMotion {
-    #[allow(clippy::too_many_arguments)]
-    fn new(
-        log: &ImuLog,
-        traj: &Trajectory,
-        plane: Option<&Plane>,
-        cam: &Camera,
-        t_frame: f64,
-        t0: f64,
-        te: f64,
-        steps: usize,
-    ) -> Self {
-        let (qs, cs) = traj.pose_at(t0);
-        let steps_v = (0..=steps)
-            .map(|k| {
-                let (q, c) = traj.pose_at(t0 + te * k as f64 / steps as f64);
-                let inv = q.inverse();
-                (inv * qs, inv * (cs - c))
-            })
-            .collect();
-        // The twist interpolated to the line's start, and the plane in the
-        // line's start frame.
-        let t = t_frame + t0;
-        let i = log.partition_point(|s| s.t <= t).clamp(1, log.len() - 1);
-        let (s0, s1) = (&log[i - 1], &log[i]);
-        let f = ((t - s0.t) / (s1.t - s0.t)).clamp(0.0, 1.0);
-        let omega = s0.omega.lerp(s1.omega, f);
-        let vel = match (s0.velocity, s1.velocity) {
-            (Some(a), Some(b)) => a.lerp(b, f),
-            _ => DVec3::ZERO,
-        };
-        let plane_w = plane.map(|p| (p.normal, p.d - p.normal.dot(cs)));
-        let plane_line = plane_w.map(|(n, d)| Plane {
-            normal: qs.inverse() * n,
-            d,
-        });
-        LineMotion {
-            start: qs,
-            steps: steps_v,
-            plane: plane_w,
-            flow: FlowPoly::new(cam.focal_mm, &Twist::new(omega, vel), plane_line.as_ref()),
-        }
-    }
-}
-
-/// The file name of frame `index`'s maps in a `--maps` directory.
-pub fn file_name(index: usize) -> String {
-    format!("frame_{index:06}.exr")
-}
-
-/// What [`write_maps`] wrote.
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct MapsWritten {
-    /// Per written frame: its row, mean path (px) and share of pixels with a value.
-    pub written: Vec<(usize, f64, f64)>,
-    /// Rows without maps: their span leaves the log or crosses a gap in it.
-    pub skipped: Vec<usize>,
-    /// The GPU adapter that computed them, `None` for the CPU path.
-    pub adapter: Option<String>,
-}
-
-/// Writes the maps of the frames `which` (rows of `frames`) to `dir`
-/// (created if missing), one EXR each ([`file_name`]), each file
-/// atomically; a frame whose span leaves the log or crosses a gap in it
-/// gets none (listed in [`MapsWritten::skipped`]). `backend`: where the
-/// maps are computed ([`super::maps_gpu::resolve`]: the GPU kernel or this
-/// module's f64 path).
-pub fn write_maps(
-    log: &ImuLog,
-    opts: &SeriesOptions,
-    frames: &[VideoFrame],
-    which: &[usize],
-    dir: &std::path::Path,
-    backend: crate::gpu::Backend,
-) -> Result<MapsWritten> {
-    std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
-    let rays = MapRays::new(&opts.scene.camera)?;
-    let mut gpu = super::maps_gpu::resolve(backend, &opts.scene.camera)?;
-    let mut out = MapsWritten {
-        adapter: gpu.as_ref().map(|g| g.adapter().to_string()),
-        ..Default::default()
-    };
-    for &k in which {
-        crate::cancel::check()?;
-        let f = frames.get(k).ok_or_else(|| {
-            Error::invalid(
-                "maps",
-                format!("frame {k} is not in the table ({} rows)", frames.len()),
-            )
-        })?;
-        let job = MapsJob {
-            log,
-            opts,
-            rays: &rays,
-            index: k,
-            frame: f,
-            steps: None,
-        };
-        let maps = match &mut gpu {
-            Some(g) => g.frame_maps(&job)?,
-            None => frame_maps(log, opts, &rays, k, f, None)?,
-        };
-        match maps {
-            Some(m) => {
-                m.write_exr(&dir.join(file_name(k)))?;
-                let (mean, valid) = m.mean_path_px();
-                out.written.push((k, mean, valid));
-            }
-            None => out.skipped.push(k),
-        }
-    }
-    Ok(out)
 }

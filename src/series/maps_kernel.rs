@@ -7,7 +7,8 @@
 //! The f64 reference is [`super::maps::frame_maps`]; the twin and the kernel
 //! agree with it to f32 rounding of the track (see `tests/maps_gpu.rs`).
 
-use super::maps::{plan, FrameMaps, LineMotion, MapRays, MapsJob, Plan};
+use super::maps::{plan, FrameMaps, MapRays, MapsJob, Plan};
+use super::maps_line::LineMotion;
 use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::field::FlowParams;

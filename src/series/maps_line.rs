@@ -1,10 +1,77 @@
-//! One line's track in f64, the CPU path of [`super::maps::frame_maps`]:
-//! the line's motion as matrices, each pixel projected through them.
+//! One line of a frame's maps: its motion over its exposure ([`LineMotion`],
+//! which the GPU path packs) and its track in f64, the CPU path of
+//! [`super::maps::frame_maps`] (the motion as matrices, each pixel
+//! projected through them).
 
-use super::maps::LineMotion;
 use crate::camera::Camera;
 use crate::model::flow::FlowPoly;
-use glam::{DMat3, DVec3};
+use crate::model::log::ImuLog;
+use crate::model::motion::{Plane, Twist};
+use crate::render::trajectory::Trajectory;
+use glam::{DMat3, DQuat, DVec3};
+
+/// One line's motion over its exposure, as rotations (the GPU path uploads
+/// these; the f64 path turns them into matrices, [`Line`]).
+pub(crate) struct LineMotion {
+    /// Camera-to-world rotation at the line's start.
+    pub start: DQuat,
+    /// Rotation from the line's start frame to each of `steps + 1` instants'
+    /// frames, and the offset of the start's centre in each instant's frame (m).
+    pub steps: Vec<(DQuat, DVec3)>,
+    /// World-frame normal and offset of the plane seen from the line's start
+    /// centre: `n . (X - c_s) = d_s`.
+    pub plane: Option<(DVec3, f64)>,
+    /// The flow at the line's start (mm/s, undistorted sensor).
+    pub flow: FlowPoly,
+}
+
+impl LineMotion {
+    /// The motion of the line whose exposure starts `t0` after the frame's
+    /// start `t_frame` (log clock), over `te` in `steps` chords, on `traj`
+    /// (which starts at the frame's start).
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        log: &ImuLog,
+        traj: &Trajectory,
+        plane: Option<&Plane>,
+        cam: &Camera,
+        t_frame: f64,
+        t0: f64,
+        te: f64,
+        steps: usize,
+    ) -> Self {
+        let (qs, cs) = traj.pose_at(t0);
+        let steps_v = (0..=steps)
+            .map(|k| {
+                let (q, c) = traj.pose_at(t0 + te * k as f64 / steps as f64);
+                let inv = q.inverse();
+                (inv * qs, inv * (cs - c))
+            })
+            .collect();
+        // The twist interpolated to the line's start, and the plane in the
+        // line's start frame.
+        let t = t_frame + t0;
+        let i = log.partition_point(|s| s.t <= t).clamp(1, log.len() - 1);
+        let (s0, s1) = (&log[i - 1], &log[i]);
+        let f = ((t - s0.t) / (s1.t - s0.t)).clamp(0.0, 1.0);
+        let omega = s0.omega.lerp(s1.omega, f);
+        let vel = match (s0.velocity, s1.velocity) {
+            (Some(a), Some(b)) => a.lerp(b, f),
+            _ => DVec3::ZERO,
+        };
+        let plane_w = plane.map(|p| (p.normal, p.d - p.normal.dot(cs)));
+        let plane_line = plane_w.map(|(n, d)| Plane {
+            normal: qs.inverse() * n,
+            d,
+        });
+        LineMotion {
+            start: qs,
+            steps: steps_v,
+            plane: plane_w,
+            flow: FlowPoly::new(cam.focal_mm, &Twist::new(omega, vel), plane_line.as_ref()),
+        }
+    }
+}
 
 /// One line's motion over its exposure, in matrices (the f64 path).
 pub(crate) struct Line {
