@@ -2,7 +2,10 @@
 //! maps of one 1920x1080 rolling-shutter frame (`series::maps::frame_maps`,
 //! what `mmbm frames --maps` computes before writing each EXR), pinhole and
 //! through a wide-angle lens, on one thread and on all cores, and the
-//! throughput for a minute of 60 fps video. The motion is the shared
+//! throughput for a minute of 60 fps video; then the GPU path
+//! (`series::maps_gpu`, `shaders/maps.wgsl`) where an adapter exists, with
+//! its largest difference per pixel from its CPU twin and from the f64
+//! maps at full size. The motion is the shared
 //! running log's (`../shared/data/running_phone`, its blurriest frames) when
 //! present beside the checkout, else a synthetic log of similar rates.
 //! Times are printed, never asserted.
@@ -15,7 +18,9 @@ use mmbm::error::{Error, Result};
 use mmbm::io::frames::VideoFrame;
 use mmbm::io::gyro::{read_log, GyroOptions, GyroSample};
 use mmbm::model::log::ImuLog;
-use mmbm::series::maps::{frame_maps, MapRays};
+use mmbm::series::maps::{frame_maps, FrameMaps, MapRays, MapsJob};
+use mmbm::series::maps_gpu::MapsRunner;
+use mmbm::series::maps_kernel::frame_maps_twin;
 use mmbm::series::SeriesOptions;
 use mmbm::{Method, Scene};
 use std::path::PathBuf;
@@ -86,14 +91,7 @@ fn run() -> Result<()> {
         ..base
     };
     for (name, cam) in [("pinhole", base), ("wide-angle", lens)] {
-        let opts = SeriesOptions {
-            scene: Scene {
-                camera: cam,
-                plane: None,
-            },
-            method: Method::Riemann { nu: 8, nv: 6 },
-            use_velocity: false,
-        };
+        let opts = rotation_only(cam);
         for threads in [1, cores] {
             let p = pool(threads)?;
             let t0 = Instant::now();
@@ -101,22 +99,9 @@ fn run() -> Result<()> {
             let t_rays = t0.elapsed().as_secs_f64();
             // One warm-up, then every frame twice.
             p.install(|| frame_maps(&log, &opts, &rays, 0, &frames[0], None))?;
-            let (t0, c0) = (Instant::now(), cpu_s());
-            let mut n = 0;
-            for _ in 0..2 {
-                for (k, f) in frames.iter().enumerate() {
-                    let m = p.install(|| frame_maps(&log, &opts, &rays, k, f, None))?;
-                    std::hint::black_box(
-                        m.ok_or_else(|| Error::invalid("bench", "frame outside the log"))?,
-                    );
-                    n += 1;
-                }
-            }
-            let per = t0.elapsed().as_secs_f64() / n as f64;
-            let cpu = match (c0, cpu_s()) {
-                (Some(a), Some(b)) => format!("{:.3} s", (b - a) / n as f64),
-                _ => "?".into(),
-            };
+            let (per, cpu) = timed(&frames, 2, |k, f| {
+                p.install(|| frame_maps(&log, &opts, &rays, k, f, None))
+            })?;
             println!(
                 "| {name} | {threads} | {:.3} s | {:.3} s | {cpu} | {:.1} | {:.0} s |",
                 t_rays,
@@ -126,7 +111,102 @@ fn run() -> Result<()> {
             );
         }
     }
+    gpu(&log, &frames, base, lens)
+}
+
+/// The GPU path on the same frames, and its agreement at full size.
+fn gpu(log: &ImuLog, frames: &[VideoFrame], base: Camera, lens: Camera) -> Result<()> {
+    let mut runner = match MapsRunner::new() {
+        Ok(r) => r,
+        Err(e) => {
+            println!("GPU path: not measured ({e})");
+            return Ok(());
+        }
+    };
+    println!(
+        "\nGPU path on {} (host side on rayon's pool)",
+        runner.adapter()
+    );
+    println!("| lens | per frame (wall) | per frame (CPU, all threads) | a 60 fps minute (wall) | max GPU - twin | max GPU - f64 |");
+    println!("|---|---|---|---|---|---|");
+    for (name, cam) in [("pinhole", base), ("wide-angle", lens)] {
+        let opts = rotation_only(cam);
+        let rays = MapRays::new(&cam)?;
+        let job = |index: usize, frame| MapsJob {
+            log,
+            opts: &opts,
+            rays: &rays,
+            index,
+            frame,
+            steps: None,
+        };
+        let some = |m: Option<FrameMaps>| {
+            m.ok_or_else(|| Error::invalid("bench", "frame outside the log"))
+        };
+        // Warm-up (shader build, rays upload) and the agreement on the first frame.
+        let g = some(runner.frame_maps(&job(0, &frames[0]))?)?;
+        let twin = some(frame_maps_twin(&job(0, &frames[0]))?)?;
+        let cpu = some(frame_maps(log, &opts, &rays, 0, &frames[0], None)?)?;
+        let (per, cpu_t) = timed(frames, 1, |k, f| runner.frame_maps(&job(k, f)))?;
+        println!(
+            "| {name} | {per:.3} s | {cpu_t} | {:.0} s | {:.1e} px | {:.1e} px |",
+            3600.0 * per,
+            max_diff(&g, &twin),
+            max_diff(&g, &cpu)
+        );
+    }
     Ok(())
+}
+
+/// Options for the maps of `cam`, rotation only (the method is not used).
+fn rotation_only(cam: Camera) -> SeriesOptions {
+    SeriesOptions {
+        scene: Scene {
+            camera: cam,
+            plane: None,
+        },
+        method: Method::Riemann { nu: 8, nv: 6 },
+        use_velocity: false,
+    }
+}
+
+/// Computes every frame's maps `reps` times with `one`: wall seconds per
+/// frame and the CPU time per frame (all threads), printed.
+fn timed<'f>(
+    frames: &'f [VideoFrame],
+    reps: usize,
+    mut one: impl FnMut(usize, &'f VideoFrame) -> Result<Option<FrameMaps>>,
+) -> Result<(f64, String)> {
+    let (t0, c0) = (Instant::now(), cpu_s());
+    let mut n = 0;
+    for _ in 0..reps {
+        for (k, f) in frames.iter().enumerate() {
+            let m = one(k, f)?;
+            std::hint::black_box(
+                m.ok_or_else(|| Error::invalid("bench", "frame outside the log"))?,
+            );
+            n += 1;
+        }
+    }
+    let per = t0.elapsed().as_secs_f64() / n as f64;
+    let cpu = match (c0, cpu_s()) {
+        (Some(a), Some(b)) => format!("{:.3} s", (b - a) / n as f64),
+        _ => "?".into(),
+    };
+    Ok((per, cpu))
+}
+
+/// The largest |a - b| over the displacement and path channels (px).
+fn max_diff(a: &FrameMaps, b: &FrameMaps) -> f64 {
+    let mut w: f64 = 0.0;
+    for (x, y) in a.channels().iter().zip(b.channels()).take(3) {
+        for (p, q) in x.1.iter().zip(y.1) {
+            if p.is_finite() && q.is_finite() {
+                w = w.max((p - q).abs() as f64);
+            }
+        }
+    }
+    w
 }
 
 /// CPU time of this process so far (user + system, all threads), s, from

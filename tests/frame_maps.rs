@@ -4,10 +4,12 @@
 //! frames' exposure MMBM.
 
 mod common;
+mod maps_fixture;
 
 use glam::{DQuat, DVec3};
+use maps_fixture::*;
 use mmbm::camera::Distortion;
-use mmbm::io::frames::{read_frames, VideoFrame};
+use mmbm::io::frames::VideoFrame;
 use mmbm::io::gyro::{read_log, GyroOptions, GyroSample};
 use mmbm::model::log::ImuLog;
 use mmbm::render::maps::blur_maps;
@@ -15,27 +17,7 @@ use mmbm::render::{Target, Trajectory};
 use mmbm::series::frames::frame_mmbm;
 use mmbm::series::maps::{frame_maps, FrameMaps, MapRays};
 use mmbm::series::SeriesOptions;
-use mmbm::{Camera, Method, Plane, Scene};
-use std::path::PathBuf;
-
-fn opts(camera: Camera, plane: Option<Plane>, use_velocity: bool) -> SeriesOptions {
-    SeriesOptions {
-        scene: Scene { camera, plane },
-        method: Method::Riemann { nu: 8, nv: 6 },
-        use_velocity,
-    }
-}
-
-fn example_camera(name: &str) -> Camera {
-    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(format!("examples/cameras/{name}.toml"));
-    Camera::load(&p).unwrap()
-}
-
-fn shared(name: &str) -> Option<(ImuLog, Vec<VideoFrame>)> {
-    let gyro = common::shared_log(name)?;
-    let frames = read_frames(&gyro.with_file_name("frames.csv")).unwrap();
-    Some((read_log(&gyro, GyroOptions::default()).unwrap(), frames))
-}
+use mmbm::{Camera, Method, Plane};
 
 fn maps(
     log: &ImuLog,
@@ -260,18 +242,7 @@ fn maps_match_independent_line_integration() {
         }
     }
     // Synthetic: turning rotation, forward-and-sideways velocity, depth 1.5 m.
-    let samples: Vec<GyroSample> = (0..400)
-        .map(|i| {
-            let t = i as f64 * 0.005;
-            GyroSample {
-                t,
-                omega: DVec3::new(0.8 * (9.0 * t).sin(), 0.5 * (5.0 * t).cos(), 0.3),
-                velocity: Some(DVec3::new(0.6, -0.2, 1.2 * (3.0 * t).cos())),
-                depth: Some(1.5),
-            }
-        })
-        .collect();
-    let log = ImuLog::new(samples).unwrap();
+    let log = synthetic_log(Some(1.5));
     let cam = Camera {
         shutter: mmbm::camera::Shutter {
             readout_s: 0.02,
@@ -343,10 +314,6 @@ fn mean_path_is_the_exposure_mmbm_on_every_frame() {
     }
 }
 
-fn path(p: &std::path::Path) -> &str {
-    p.to_str().unwrap()
-}
-
 /// `mmbm frames --maps DIR` writes one EXR per frame inside the log, equal to
 /// the library's maps, and agreeing per pixel with `mmbm render --gyro --at
 /// --maps` on the same frame (its own chord count: 1e-3 x (1 + path));
@@ -366,24 +333,9 @@ fn cli_frames_maps() {
         "t_start,exposure_s\n2.0,0.004\n5.258,0.0013\n99.0,0.001\n",
     )
     .unwrap();
-    let cam_file =
-        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("examples/cameras/running_phone.toml");
     let dir = tmp.join("maps");
-    let out = common::mmbm(&[
-        "frames",
-        "--gyro",
-        path(&gyro),
-        "--frames",
-        path(&table),
-        "--camera",
-        path(&cam_file),
-        "--scale-to",
-        "192x108",
-        "--maps",
-        path(&dir),
-        "--out",
-        path(&tmp.join("f.csv")),
-    ]);
+    let cam_file = running_phone_camera();
+    let out = frames_maps(&gyro, &table, &cam_file, &dir, &tmp.join("f.csv"), &[]);
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{err}");
     assert!(err.contains("maps: 2 frame(s)"), "{err}");

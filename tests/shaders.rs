@@ -29,7 +29,7 @@ fn all_shaders_validate() {
         .filter(|p| p.extension().is_some_and(|e| e == "wgsl"))
         .collect();
     files.sort();
-    for name in ["field.wgsl", "render.wgsl", "texture.wgsl"] {
+    for name in ["field.wgsl", "maps.wgsl", "render.wgsl", "texture.wgsl"] {
         assert!(
             files.iter().any(|p| p.ends_with(name)),
             "shaders/{name} not found in {files:?}"

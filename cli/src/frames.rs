@@ -55,6 +55,11 @@ pub struct FramesArgs {
     /// written (all, or the --select ones) inside the log.
     #[arg(long, value_name = "DIR")]
     pub maps: Option<PathBuf>,
+    /// Where --maps computes: cpu (f64, all cores), gpu (the maps kernel, or an error), auto
+    /// (GPU if any adapter, else CPU) or bulk (a hardware GPU, else CPU). Lens models the
+    /// kernel lacks run on the CPU (auto, bulk) or are an error (gpu).
+    #[arg(long, default_value = "bulk")]
+    pub backend: mmbm::gpu::Backend,
     /// Include the log's vx,vy,vz (needs a depth column, --depth or --plane).
     #[arg(long)]
     pub use_velocity: bool,
@@ -131,12 +136,14 @@ pub fn run(a: FramesArgs) -> Result<()> {
         Ok(())
     };
     if let Some(dir) = &a.maps {
-        let done = mmbm::series::maps::write_maps(&samples, &opts, &frames, &keep, dir)?;
+        let done =
+            mmbm::series::maps_write::write_maps(&samples, &opts, &frames, &keep, dir, a.backend)?;
         let n = done.written.len();
         let mean = done.written.iter().map(|d| d.1).sum::<f64>() / n.max(1) as f64;
         eprintln!(
-            "maps: {n} frame(s) to {} (mean path {mean:.3} px)",
-            dir.display()
+            "maps: {n} frame(s) to {} (mean path {mean:.3} px) on {}",
+            dir.display(),
+            done.adapter.as_deref().unwrap_or("the CPU")
         );
         if !done.skipped.is_empty() {
             let list: Vec<String> = done.skipped.iter().take(8).map(|k| k.to_string()).collect();

@@ -98,6 +98,20 @@ pub fn build(
     Ok(Pipelines { bgl, pipelines })
 }
 
+/// The shared device and a kernel compiled once per process into `cell` by
+/// `build`; a failed build is cached and returned to every caller.
+pub fn compiled<K>(
+    cell: &'static std::sync::OnceLock<std::result::Result<K, String>>,
+    build: impl FnOnce(&GpuContext) -> Result<K>,
+) -> Result<(&'static GpuContext, &'static K)> {
+    let ctx = super::gpu()?;
+    let k = cell
+        .get_or_init(|| build(ctx).map_err(|e| e.to_string()))
+        .as_ref()
+        .map_err(|e| Error::Gpu(e.trim_start_matches("GPU: ").to_string()))?;
+    Ok((ctx, k))
+}
+
 /// A device buffer and its size in bytes.
 pub struct Buf {
     /// The buffer.

@@ -5,9 +5,11 @@
 //! tables ([`frames`]; a phone's image list and IMU rows in [`phone`],
 //! ffprobe's frames in [`ffprobe`]); [`input`]: the kind and size checks every reader
 //! shares (regular files and pipes only, capped lines, headers and image
-//! sizes). This layer imports nothing above `error`.
+//! sizes); [`decimal`]: the numbers of text logs, read fast and to the bit as
+//! `str::parse` reads them. This layer imports nothing above `error`.
 
 pub mod atomic;
+pub mod decimal;
 pub mod ffprobe;
 pub mod frames;
 pub mod gcsv;

@@ -21,15 +21,14 @@
 //! point is lost (behind the camera or off the plane) are NaN in every
 //! channel.
 
+use super::maps_line::LineMotion;
 use super::SeriesOptions;
 use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::io::frames::VideoFrame;
-use crate::model::flow::FlowPoly;
 use crate::model::log::ImuLog;
-use crate::model::motion::{Plane, Twist};
+use crate::model::motion::Plane;
 use crate::render::trajectory::Trajectory;
-use glam::{DMat3, DVec3};
 use rayon::prelude::*;
 
 /// Channels of a frame's maps, in the EXR's order of [`FrameMaps::channels`].
@@ -133,6 +132,11 @@ impl MapRays {
     pub fn camera(&self) -> &Camera {
         &self.camera
     }
+
+    /// The rays, row-major (NaN: none).
+    pub fn rays(&self) -> &[(f64, f64)] {
+        &self.rays
+    }
 }
 
 /// The chords per line's exposure for `traj`'s motion: about one per pixel
@@ -187,23 +191,48 @@ fn world_plane(log: &ImuLog, opts: &SeriesOptions, t_start: f64) -> Result<Optio
     }
 }
 
-/// The blur fields of `frame` (row `index` of its table) from `log` with
-/// the camera of `rays` (which must be `opts.scene.camera`) and `opts`' scene
-/// and velocity (its method is not used): `None` when the frame's span
-/// `[t_start, t_start + readout + exposure]` is not inside the log or
-/// crosses a gap in it (no motion is known there). `steps`:
-/// chords per line's exposure (`None`: about one per pixel of motion, at
-/// least 16). The readout is the frame's own, else the camera's.
-pub fn frame_maps(
-    log: &ImuLog,
-    opts: &SeriesOptions,
-    rays: &MapRays,
-    index: usize,
-    frame: &VideoFrame,
-    steps: Option<usize>,
-) -> Result<Option<FrameMaps>> {
+/// What every line of a frame's maps shares: the frame's motion, scene
+/// and chord count ([`plan`]).
+pub(crate) struct Plan {
+    pub cam: Camera,
+    /// Frame start (s, log clock), exposure and readout (s).
+    pub t_start: f64,
+    pub exposure_s: f64,
+    pub readout_s: f64,
+    pub traj: Trajectory,
+    pub plane: Option<Plane>,
+    /// Chords per line's exposure.
+    pub steps: usize,
+    /// Lines are rows (else columns).
+    pub rows: bool,
+}
+
+/// One frame's maps to compute: the arguments of [`frame_maps`], as the
+/// GPU path and its twin take them
+/// ([`super::maps_gpu::MapsRunner::frame_maps`],
+/// [`super::maps_kernel::frame_maps_twin`]).
+#[derive(Clone, Copy)]
+pub struct MapsJob<'a> {
+    /// The motion.
+    pub log: &'a ImuLog,
+    /// Camera, scene and velocity (the method is not used).
+    pub opts: &'a SeriesOptions,
+    /// The camera's rays (built for `opts.scene.camera`).
+    pub rays: &'a MapRays,
+    /// Row of the frame in its table.
+    pub index: usize,
+    /// The frame.
+    pub frame: &'a VideoFrame,
+    /// Chords per line's exposure (`None`: about one per pixel of motion).
+    pub steps: Option<usize>,
+}
+
+/// The plan of a job's frame (see [`frame_maps`]), `None` when its span is
+/// not inside the log or crosses a gap in it.
+pub(crate) fn plan(job: &MapsJob) -> Result<Option<Plan>> {
+    let (log, opts, index, frame) = (job.log, job.opts, job.index, job.frame);
     let cam = opts.scene.camera;
-    if rays.camera != cam {
+    if job.rays.camera != cam {
         return Err(Error::invalid(
             "maps",
             "the rays were built for another camera than the options'",
@@ -233,25 +262,110 @@ pub fn frame_maps(
             .map(|&(u, v)| p.inverse_depth(cam.focal_mm, u, v).abs())
             .fold(0.0, f64::max)
     });
-    let steps = steps
+    let steps = job
+        .steps
         .unwrap_or_else(|| auto_steps(&cam, log, a, b, te, inv_depth))
         .max(1);
-    let shutter = crate::camera::Shutter {
+    Ok(Some(Plan {
+        cam,
+        t_start: a,
+        exposure_s: te,
         readout_s: readout,
-        direction: cam.shutter.direction,
+        traj,
+        plane,
+        steps,
+        rows: cam.shutter.direction.is_rows(),
+    }))
+}
+
+impl Plan {
+    /// Lines of the frame and pixels per line.
+    pub fn lines(&self) -> (usize, usize) {
+        let (w, h) = (self.cam.width as usize, self.cam.height as usize);
+        if self.rows {
+            (h, w)
+        } else {
+            (w, h)
+        }
+    }
+
+    /// The motion of line `l` over its exposure.
+    pub fn line(&self, log: &ImuLog, l: usize) -> LineMotion {
+        let shutter = crate::camera::Shutter {
+            readout_s: self.readout_s,
+            direction: self.cam.shutter.direction,
+        };
+        let c = l as f64 + 0.5;
+        let t0 = shutter.delay_s(c, c, self.cam.width, self.cam.height);
+        LineMotion::new(
+            log,
+            &self.traj,
+            self.plane.as_ref(),
+            &self.cam,
+            self.t_start,
+            t0,
+            self.exposure_s,
+            self.steps,
+        )
+    }
+
+    /// The maps of frame `index` from its channels, row-major.
+    pub fn finish(&self, index: usize, ch: [Vec<f32>; 5]) -> FrameMaps {
+        let [disp_u, disp_v, path_px, flow_u, flow_v] = ch;
+        FrameMaps {
+            frame: index,
+            width: self.cam.width,
+            height: self.cam.height,
+            exposure_s: self.exposure_s,
+            readout_s: self.readout_s,
+            steps: self.steps,
+            disp_u,
+            disp_v,
+            path_px,
+            flow_u,
+            flow_v,
+        }
+    }
+}
+
+/// The blur fields of `frame` (row `index` of its table) from `log` with
+/// the camera of `rays` (which must be `opts.scene.camera`) and `opts`' scene
+/// and velocity (its method is not used): `None` when the frame's span
+/// `[t_start, t_start + readout + exposure]` is not inside the log or
+/// crosses a gap in it (no motion is known there). `steps`:
+/// chords per line's exposure (`None`: about one per pixel of motion, at
+/// least 16). The readout is the frame's own, else the camera's. In f64 on
+/// the CPU (rayon); the GPU path is [`super::maps_gpu`].
+pub fn frame_maps(
+    log: &ImuLog,
+    opts: &SeriesOptions,
+    rays: &MapRays,
+    index: usize,
+    frame: &VideoFrame,
+    steps: Option<usize>,
+) -> Result<Option<FrameMaps>> {
+    let job = MapsJob {
+        log,
+        opts,
+        rays,
+        index,
+        frame,
+        steps,
     };
-    let rows = cam.shutter.direction.is_rows();
+    let Some(plan) = plan(&job)? else {
+        return Ok(None);
+    };
+    let cam = plan.cam;
+    let rows = plan.rows;
     let (w, h) = (cam.width as usize, cam.height as usize);
-    let len = if rows { w } else { h };
+    let len = plan.lines().1;
     let stop = crate::cancel::current();
     let mut vals = vec![[f32::NAN; 5]; w * h];
     vals.par_chunks_mut(len).enumerate().for_each(|(l, out)| {
         if stop.is_cancelled() {
             return;
         }
-        let c = l as f64 + 0.5;
-        let t0 = shutter.delay_s(c, c, cam.width, cam.height);
-        let line = Line::new(log, &traj, plane.as_ref(), &cam, a, t0, te, steps);
+        let line = super::maps_line::Line::from(plan.line(log, l));
         let ray = |m: usize| {
             let (i, j) = if rows { (m, l) } else { (l, m) };
             rays.rays[j * w + i]
@@ -277,244 +391,5 @@ pub fn frame_maps(
                 .collect()
         };
     }
-    let [disp_u, disp_v, path_px, flow_u, flow_v] = ch;
-    Ok(Some(FrameMaps {
-        frame: index,
-        width: cam.width,
-        height: cam.height,
-        exposure_s: te,
-        readout_s: readout,
-        steps,
-        disp_u,
-        disp_v,
-        path_px,
-        flow_u,
-        flow_v,
-    }))
-}
-
-/// One line's motion over its exposure.
-struct Line {
-    /// World-to-camera rotation at the line's start (camera-to-world transposed).
-    start_rot: DMat3,
-    /// Rotation from the line's start frame to each instant's, and the
-    /// offset of the start's centre in each instant's frame (m).
-    steps: Vec<(DMat3, DVec3)>,
-    /// World-frame normal and offset of the plane seen from the line's start
-    /// centre: `n . (X - c_s) = d_s`.
-    plane: Option<(DVec3, f64)>,
-    /// The flow at the line's start (mm/s, undistorted sensor).
-    flow: FlowPoly,
-}
-
-impl Line {
-    #[allow(clippy::too_many_arguments)]
-    fn new(
-        log: &ImuLog,
-        traj: &Trajectory,
-        plane: Option<&Plane>,
-        cam: &Camera,
-        t_frame: f64,
-        t0: f64,
-        te: f64,
-        steps: usize,
-    ) -> Self {
-        let (qs, cs) = traj.pose_at(t0);
-        let steps_v = (0..=steps)
-            .map(|k| {
-                let (q, c) = traj.pose_at(t0 + te * k as f64 / steps as f64);
-                let inv = q.inverse();
-                (DMat3::from_quat(inv * qs), inv * (cs - c))
-            })
-            .collect();
-        // The twist interpolated to the line's start, and the plane in the
-        // line's start frame.
-        let t = t_frame + t0;
-        let i = log.partition_point(|s| s.t <= t).clamp(1, log.len() - 1);
-        let (s0, s1) = (&log[i - 1], &log[i]);
-        let f = ((t - s0.t) / (s1.t - s0.t)).clamp(0.0, 1.0);
-        let omega = s0.omega.lerp(s1.omega, f);
-        let vel = match (s0.velocity, s1.velocity) {
-            (Some(a), Some(b)) => a.lerp(b, f),
-            _ => DVec3::ZERO,
-        };
-        let plane_w = plane.map(|p| (p.normal, p.d - p.normal.dot(cs)));
-        let plane_line = plane_w.map(|(n, d)| Plane {
-            normal: qs.inverse() * n,
-            d,
-        });
-        Line {
-            start_rot: DMat3::from_quat(qs),
-            steps: steps_v,
-            plane: plane_w,
-            flow: FlowPoly::new(cam.focal_mm, &Twist::new(omega, vel), plane_line.as_ref()),
-        }
-    }
-
-    /// The inverse depth (1/m) of the scene point along `ray` (line start
-    /// frame); 0 for rotation only (points at infinity); `None` when the ray
-    /// misses the plane.
-    #[inline]
-    fn inv_depth(&self, ray: DVec3) -> Option<f64> {
-        match self.plane {
-            None => Some(0.0),
-            Some((n, d)) => {
-                let x = n.dot(self.start_rot * ray) / d;
-                (x > 0.0 && x.is_finite()).then_some(x)
-            }
-        }
-    }
-
-    /// [`Line::pixel`] for a whole line of a pinhole camera (`ray(m)` is
-    /// the undistorted ray of the line's pixel `m`): the pixel matrix folded
-    /// into each instant's rotation, step-major over the line's pixels so
-    /// the inner loop vectorises. The same values to rounding.
-    fn pinhole(&self, cam: &Camera, ray: impl Fn(usize) -> (f64, f64), out: &mut [[f32; 5]]) {
-        let n = out.len();
-        let kmat = DMat3::from_cols(
-            DVec3::new(cam.focal_mm / cam.pitch_x_mm, 0.0, 0.0),
-            DVec3::new(cam.skew, cam.focal_mm / cam.pitch_y_mm, 0.0),
-            DVec3::new(cam.cx, cam.cy, 1.0),
-        );
-        let mut buf = vec![0.0f64; 8 * n];
-        let (rx, rest) = buf.split_at_mut(n);
-        let (ry, rest) = rest.split_at_mut(n);
-        let (is, rest) = rest.split_at_mut(n);
-        let (x0, rest) = rest.split_at_mut(n);
-        let (y0, rest) = rest.split_at_mut(n);
-        let (px, rest) = rest.split_at_mut(n);
-        let (py, rest) = rest.split_at_mut(n);
-        let path = rest;
-        let mut bad = vec![false; n];
-        for m in 0..n {
-            let r = ray(m);
-            rx[m] = r.0;
-            ry[m] = r.1;
-            match self.inv_depth(DVec3::new(r.0, r.1, 1.0)) {
-                Some(x) if r.0.is_finite() && r.1.is_finite() => is[m] = x,
-                _ => bad[m] = true,
-            }
-        }
-        for (k, (rot, off)) in self.steps.iter().enumerate() {
-            let a = kmat * *rot;
-            let c = kmat * *off;
-            let (a0, a1, a2) = (a.x_axis, a.y_axis, a.z_axis);
-            for m in 0..n {
-                let (x, y, s) = (rx[m], ry[m], is[m]);
-                let z = a0.z * x + a1.z * y + a2.z + c.z * s;
-                bad[m] |= z.is_nan() || z <= 1e-12;
-                let q = 1.0 / z;
-                let u = (a0.x * x + a1.x * y + a2.x + c.x * s) * q;
-                let v = (a0.y * x + a1.y * y + a2.y + c.y * s) * q;
-                if k == 0 {
-                    x0[m] = u;
-                    y0[m] = v;
-                } else {
-                    let (du, dv) = (u - px[m], v - py[m]);
-                    path[m] += (du * du + dv * dv).sqrt();
-                }
-                px[m] = u;
-                py[m] = v;
-            }
-        }
-        for m in 0..n {
-            if bad[m] {
-                continue;
-            }
-            let fl = self.flow.eval(cam.focal_mm * rx[m], cam.focal_mm * ry[m]);
-            let (fu, fv) = cam.mm_to_px_velocity(fl.0, fl.1);
-            out[m] = [
-                (px[m] - x0[m]) as f32,
-                (py[m] - y0[m]) as f32,
-                path[m] as f32,
-                fu as f32,
-                fv as f32,
-            ];
-        }
-    }
-
-    /// The five channels of the pixel whose undistorted ray is `r`, or `None`.
-    #[inline]
-    fn pixel(&self, cam: &Camera, r: (f64, f64)) -> Option<[f32; 5]> {
-        if !r.0.is_finite() {
-            return None;
-        }
-        let ray = DVec3::new(r.0, r.1, 1.0);
-        let inv_s = self.inv_depth(ray)?;
-        let project = |m: &DMat3, b: DVec3| -> Option<(f64, f64)> {
-            let p = *m * ray + b * inv_s;
-            (p.z > 1e-12).then(|| cam.ray_to_pixel(p.x / p.z, p.y / p.z))
-        };
-        let first = project(&self.steps[0].0, self.steps[0].1)?;
-        let (mut prev, mut path) = (first, 0.0);
-        for (m, b) in &self.steps[1..] {
-            let q = project(m, *b)?;
-            let (du, dv) = (q.0 - prev.0, q.1 - prev.1);
-            path += (du * du + dv * dv).sqrt();
-            prev = q;
-        }
-        let (u, v) = (cam.focal_mm * r.0, cam.focal_mm * r.1);
-        let fl = self.flow.eval(u, v);
-        let fl = if cam.distortion.is_none() {
-            fl
-        } else {
-            crate::camera::distortion::apply(&cam.distortion_jacobian(u, v), fl)
-        };
-        let (fu, fv) = cam.mm_to_px_velocity(fl.0, fl.1);
-        Some([
-            (prev.0 - first.0) as f32,
-            (prev.1 - first.1) as f32,
-            path as f32,
-            fu as f32,
-            fv as f32,
-        ])
-    }
-}
-
-/// The file name of frame `index`'s maps in a `--maps` directory.
-pub fn file_name(index: usize) -> String {
-    format!("frame_{index:06}.exr")
-}
-
-/// What [`write_maps`] wrote.
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct MapsWritten {
-    /// Per written frame: its row, mean path (px) and share of pixels with a value.
-    pub written: Vec<(usize, f64, f64)>,
-    /// Rows without maps: their span leaves the log or crosses a gap in it.
-    pub skipped: Vec<usize>,
-}
-
-/// Writes the maps of the frames `which` (rows of `frames`) to `dir`
-/// (created if missing), one EXR each ([`file_name`]), each file
-/// atomically; a frame whose span leaves the log or crosses a gap in it
-/// gets none (listed in [`MapsWritten::skipped`]).
-pub fn write_maps(
-    log: &ImuLog,
-    opts: &SeriesOptions,
-    frames: &[VideoFrame],
-    which: &[usize],
-    dir: &std::path::Path,
-) -> Result<MapsWritten> {
-    std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
-    let rays = MapRays::new(&opts.scene.camera)?;
-    let mut out = MapsWritten::default();
-    for &k in which {
-        crate::cancel::check()?;
-        let f = frames.get(k).ok_or_else(|| {
-            Error::invalid(
-                "maps",
-                format!("frame {k} is not in the table ({} rows)", frames.len()),
-            )
-        })?;
-        match frame_maps(log, opts, &rays, k, f, None)? {
-            Some(m) => {
-                m.write_exr(&dir.join(file_name(k)))?;
-                let (mean, valid) = m.mean_path_px();
-                out.written.push((k, mean, valid));
-            }
-            None => out.skipped.push(k),
-        }
-    }
-    Ok(out)
+    Ok(Some(plan.finish(index, ch)))
 }

@@ -11,6 +11,10 @@ pub mod frames;
 pub mod gpu;
 pub mod lerp;
 pub mod maps;
+pub mod maps_gpu;
+pub mod maps_kernel;
+mod maps_line;
+pub mod maps_write;
 pub mod select;
 
 use crate::error::{Error, Result};
@@ -194,7 +198,9 @@ pub fn run<W: Write>(
     exposure_s: Option<f64>,
     out: W,
 ) -> Result<u64> {
-    let mut out = std::io::BufWriter::with_capacity(1 << 20, out);
+    // Rows come formatted in blocks of FORMAT_CHUNK (about 100 KB): a
+    // buffer smaller than a block passes them straight to `out`, uncopied.
+    let mut out = std::io::BufWriter::with_capacity(1 << 16, out);
     let werr = |e: std::io::Error| Error::io("<series output>", e);
     out.write_all(match exposure_s {
         Some(_) => b"t,mmbm_mm_s,mmbm_px_s,blur_px\n".as_slice(),

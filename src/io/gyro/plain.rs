@@ -7,7 +7,7 @@
 use crate::error::{quote, Error, Result};
 use crate::io::input::{LineCap, MAX_LINE_BYTES};
 use glam::DVec3;
-use std::io::{BufReader, Read};
+use std::io::Read;
 use std::path::{Path, PathBuf};
 
 /// One sample as a source reads it: the file's units and axes, before the
@@ -26,7 +26,7 @@ pub(super) struct Raw {
     pub depth: Option<f64>,
 }
 
-type Records = csv::Reader<BufReader<LineCap<Box<dyn Read + Send>>>>;
+type Records = csv::Reader<LineCap<Box<dyn Read + Send>>>;
 
 /// A gyro CSV, record by record.
 pub(super) struct CsvSource {
@@ -49,7 +49,10 @@ impl CsvSource {
         let mut reader = csv::ReaderBuilder::new()
             .comment(Some(b'#'))
             .flexible(false)
-            .from_reader(BufReader::with_capacity(1 << 18, capped));
+            // The reader's own buffer reads the capped stream directly (a
+            // second buffer below it would copy every byte once more).
+            .buffer_capacity(1 << 18)
+            .from_reader(capped);
         let names: Vec<String> = match reader.headers() {
             Ok(h) => h.iter().map(|s| s.trim().to_string()).collect(),
             Err(e) => return Err(csv_error(&mut reader, path, e, "header")),
@@ -128,9 +131,7 @@ impl CsvSource {
         let raw = &self.record[idx];
         let col = &self.names[idx];
         // Bytes: only the columns read need be text (and numbers).
-        let fast = std::str::from_utf8(raw.trim_ascii())
-            .ok()
-            .and_then(|s| s.parse::<f64>().ok());
+        let fast = crate::io::decimal::parse_f64(raw.trim_ascii());
         let text = || String::from_utf8_lossy(raw);
         let x: f64 = match fast {
             Some(x) => x,
@@ -215,7 +216,7 @@ impl Columns {
 /// position.
 fn csv_error(reader: &mut Records, path: &Path, e: csv::Error, what: &str) -> Error {
     if let csv::ErrorKind::Io(_) = e.kind() {
-        if let Some(capped) = reader.get_mut().get_mut().take_error() {
+        if let Some(capped) = reader.get_mut().take_error() {
             return capped;
         }
     }

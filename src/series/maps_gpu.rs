@@ -1,0 +1,243 @@
+//! The GPU path of `frames --maps`: the compiled `shaders/maps.wgsl` and a
+//! runner that keeps the camera's rays on the device and dispatches a
+//! frame's lines. CPU twin: [`super::maps_kernel::frame_maps_twin`]; the
+//! packing and the dispatch loop are shared with it
+//! ([`super::maps_kernel`]).
+
+use super::maps::{FrameMaps, MapsJob};
+use super::maps_kernel::{self as mk, LineGpu, MapsParams, StepGpu, PLANES};
+use crate::camera::Camera;
+use crate::error::{Error, Result};
+use crate::gpu::compute::{
+    self, ensure, read_back, storage_entry, uniform_entry, Buf, READ, STORAGE_DST, STORAGE_SRC,
+};
+use crate::gpu::{Backend, GpuContext, Resolved};
+use std::sync::atomic::AtomicBool;
+use std::sync::OnceLock;
+
+/// The WGSL source of the maps kernel.
+pub const MAPS_WGSL: &str = include_str!("../../shaders/maps.wgsl");
+
+struct Kernel {
+    bgl: wgpu::BindGroupLayout,
+    pipeline: wgpu::ComputePipeline,
+}
+
+fn build(ctx: &GpuContext) -> Result<Kernel> {
+    let layout = [
+        uniform_entry(0),
+        storage_entry(1, true),
+        storage_entry(2, true),
+        storage_entry(3, true),
+        storage_entry(4, false),
+    ];
+    let p = compute::build(ctx, "maps.wgsl", MAPS_WGSL, Some(&layout), &["maps"])?;
+    let pipeline = p
+        .pipelines
+        .into_iter()
+        .next()
+        .ok_or_else(|| Error::Gpu("shaders/maps.wgsl: pipeline missing".into()))?;
+    Ok(Kernel {
+        bgl: p.bgl,
+        pipeline,
+    })
+}
+
+static KERNEL: OnceLock<std::result::Result<Kernel, String>> = OnceLock::new();
+
+/// Computes frames' maps on the GPU, reusing its buffers (the rays stay on
+/// the device while the camera is the same).
+pub struct MapsRunner {
+    ctx: &'static GpuContext,
+    k: &'static Kernel,
+    params: wgpu::Buffer,
+    rays_of: Option<Camera>,
+    rays: Option<Buf>,
+    lines: Option<Buf>,
+    steps: Option<Buf>,
+    out: Option<Buf>,
+    read: Option<Buf>,
+    step_bytes: usize,
+}
+
+impl MapsRunner {
+    /// A runner on the shared device (errors when there is no adapter).
+    pub fn new() -> Result<Self> {
+        let (ctx, k) = compute::compiled(&KERNEL, build)?;
+        let params = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("maps params"),
+            size: std::mem::size_of::<MapsParams>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        Ok(MapsRunner {
+            ctx,
+            k,
+            params,
+            rays_of: None,
+            rays: None,
+            lines: None,
+            steps: None,
+            out: None,
+            read: None,
+            step_bytes: mk::STEP_BYTES,
+        })
+    }
+
+    /// Splits a frame's lines into dispatches of at most `bytes` of motion
+    /// samples (at least one line each; default [`mk::STEP_BYTES`]).
+    pub fn set_step_bytes(&mut self, bytes: usize) {
+        self.step_bytes = bytes;
+    }
+
+    /// `name (backend, type)` of the adapter.
+    pub fn adapter(&self) -> &str {
+        &self.ctx.description
+    }
+
+    /// Checks that the kernel takes `cam`: its lens model
+    /// ([`mk::check_lens`]) and its buffers within the device's limits.
+    pub fn check(&self, cam: &Camera) -> Result<()> {
+        mk::check_lens(cam)?;
+        let n = cam.width as u64 * cam.height as u64;
+        let lim = self.ctx.device.limits();
+        let most = lim.max_storage_buffer_binding_size.min(lim.max_buffer_size);
+        let need = (n * 16).max(n * 4 * PLANES as u64);
+        if need > most {
+            return Err(Error::Gpu(format!(
+                "maps of {}x{} need a {:.1} MiB buffer; {} allows {:.1} MiB: use --backend cpu",
+                cam.width,
+                cam.height,
+                need as f64 / 1048576.0,
+                self.ctx.description,
+                most as f64 / 1048576.0
+            )));
+        }
+        Ok(())
+    }
+
+    /// The maps of a frame on the GPU, as [`super::maps::frame_maps`]
+    /// (f32 throughout; the lens must be one [`mk::check_lens`] accepts).
+    pub fn frame_maps(&mut self, job: &MapsJob) -> Result<Option<FrameMaps>> {
+        let cam = job.opts.scene.camera;
+        self.check(&cam)?;
+        let ctx = self.ctx;
+        let n = cam.width as u64 * cam.height as u64;
+        if self.rays_of != Some(*job.rays.camera()) {
+            let packed = mk::pack_rays(job.rays);
+            let bytes: &[u8] = bytemuck::cast_slice(&packed);
+            let buf = ensure(
+                ctx,
+                &mut self.rays,
+                bytes.len() as u64,
+                STORAGE_DST,
+                "maps rays",
+            )?;
+            ctx.queue.write_buffer(buf, 0, bytes);
+            self.rays_of = Some(*job.rays.camera());
+        }
+        let out_bytes = n * 4 * PLANES as u64;
+        ensure(ctx, &mut self.out, out_bytes, STORAGE_SRC, "maps output")?;
+        ensure(ctx, &mut self.read, out_bytes, READ, "maps readback")?;
+        let Some(plan) = mk::drive(job, self.step_bytes, |p, l, s| self.dispatch(p, l, s))? else {
+            return Ok(None);
+        };
+        let (out, read) = match (&self.out, &self.read) {
+            (Some(o), Some(r)) => (&o.buf, &r.buf),
+            _ => return Err(Error::Gpu("maps buffers missing".into())),
+        };
+        let mut enc = ctx
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("maps readback"),
+            });
+        enc.copy_buffer_to_buffer(out, 0, read, 0, out_bytes);
+        ctx.queue.submit([enc.finish()]);
+        let planes: Vec<f32> =
+            bytemuck::pod_collect_to_vec(&read_back(ctx, read, out_bytes, "maps kernel")?);
+        Ok(Some(mk::unpack(&plan, job.index, &planes)))
+    }
+
+    /// One dispatch of `maps` over the lines of `p`.
+    fn dispatch(&mut self, p: &MapsParams, lines: &[LineGpu], steps: &[StepGpu]) -> Result<()> {
+        let ctx = self.ctx;
+        let lb: &[u8] = bytemuck::cast_slice(lines);
+        let sb: &[u8] = bytemuck::cast_slice(steps);
+        ensure(
+            ctx,
+            &mut self.lines,
+            lb.len() as u64,
+            STORAGE_DST,
+            "maps lines",
+        )?;
+        ensure(
+            ctx,
+            &mut self.steps,
+            sb.len() as u64,
+            STORAGE_DST,
+            "maps steps",
+        )?;
+        let (rays, lbuf, sbuf, out) = match (&self.rays, &self.lines, &self.steps, &self.out) {
+            (Some(a), Some(b), Some(c), Some(d)) => (&a.buf, &b.buf, &c.buf, &d.buf),
+            _ => return Err(Error::Gpu("maps buffers missing".into())),
+        };
+        ctx.queue
+            .write_buffer(&self.params, 0, bytemuck::bytes_of(p));
+        ctx.queue.write_buffer(lbuf, 0, lb);
+        ctx.queue.write_buffer(sbuf, 0, sb);
+        let entries: Vec<wgpu::BindGroupEntry> = [&self.params, rays, lbuf, sbuf, out]
+            .iter()
+            .enumerate()
+            .map(|(k, b)| wgpu::BindGroupEntry {
+                binding: k as u32,
+                resource: b.as_entire_binding(),
+            })
+            .collect();
+        let bg = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("maps"),
+            layout: &self.k.bgl,
+            entries: &entries,
+        });
+        let groups = (p.n_lines as u64 * p.line_len as u64).div_ceil(mk::WG as u64);
+        let gy = groups.div_ceil(p.groups_x as u64) as u32;
+        let mut enc = ctx
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("maps"),
+            });
+        {
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("maps"),
+                timestamp_writes: None,
+            });
+            pass.set_pipeline(&self.k.pipeline);
+            pass.set_bind_group(0, &bg, &[]);
+            pass.dispatch_workgroups(p.groups_x, gy, 1);
+        }
+        ctx.queue.submit([enc.finish()]);
+        Ok(())
+    }
+}
+
+/// Where `frames --maps` computes: `Some(runner)` for the GPU, `None` for
+/// the f64 CPU path. `Gpu` errors without an adapter or when the kernel
+/// cannot take the camera ([`MapsRunner::check`]); `Auto` and `Bulk` fall
+/// back to the CPU then, saying why on the log ([`Backend::resolve`] for
+/// the adapter; `MMBM_REQUIRE_GPU=1` makes a missing adapter an error).
+pub fn resolve(backend: Backend, cam: &Camera) -> Result<Option<MapsRunner>> {
+    static ANNOUNCED: AtomicBool = AtomicBool::new(false);
+    match backend.resolve("frames --maps", "path", &ANNOUNCED)? {
+        Resolved::Cpu(_) => Ok(None),
+        Resolved::Gpu(_) => {
+            let r = MapsRunner::new()?;
+            match r.check(cam) {
+                Ok(()) => Ok(Some(r)),
+                Err(e) if backend == Backend::Gpu => Err(e),
+                Err(e) => {
+                    log::warn!("frames --maps: {e}; using the CPU path");
+                    Ok(None)
+                }
+            }
+        }
+    }
+}
