@@ -378,14 +378,10 @@ fn docs_frames_table_is_current() {
     )
     .unwrap();
     let mut inside: Vec<_> = rows.iter().filter(|r| r.exposure_mm_s.is_some()).collect();
-    inside.sort_by(|a, b| {
-        a.blur_px(&cam)
-            .unwrap()
-            .total_cmp(&b.blur_px(&cam).unwrap())
-    });
+    inside.sort_by(|a, b| a.blur_px().unwrap().total_cmp(&b.blur_px().unwrap()));
     let n = inside.len();
     let median = {
-        let b: Vec<f64> = inside.iter().map(|r| r.blur_px(&cam).unwrap()).collect();
+        let b: Vec<f64> = inside.iter().map(|r| r.blur_px().unwrap()).collect();
         0.5 * (b[(n - 1) / 2] + b[n / 2])
     };
     let mut expect: Vec<String> = inside[..5]
@@ -397,7 +393,7 @@ fn docs_frames_table_is_current() {
                 r.frame,
                 r.t_start,
                 r.exposure_mm_s.unwrap(),
-                r.blur_px(&cam).unwrap(),
+                r.blur_px().unwrap(),
                 r.start_mm_s.unwrap()
             )
         })

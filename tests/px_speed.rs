@@ -163,3 +163,72 @@ fn series_px_s_is_evals() {
         assert_eq!(f[3], m.px_s * 0.01, "{row}");
     }
 }
+
+/// `frames`' blur_px is the same true pixel speed times the exposure: on
+/// an anamorphic camera with a constant rotation, the exposure MMBM in px/s
+/// of a frame is the flow field's mean pixel speed (and `riemann`'s px/s
+/// on the same cells), not mm/s over the horizontal pitch; with square
+/// pixels it is mm/s over the pitch, exactly as before. Every method and a
+/// rolling shutter give the same (the flow does not change in time).
+#[test]
+fn frames_blur_px_is_the_true_pixel_speed_times_the_exposure() {
+    use glam::DVec3;
+    use mmbm::io::frames::VideoFrame;
+    use mmbm::io::gyro::GyroSample;
+    use mmbm::series::frames::frame_mmbm;
+    use mmbm::series::SeriesOptions;
+    let w = DVec3::new(1.0, 0.2, -0.3);
+    let samples: Vec<GyroSample> = (0..=100)
+        .map(|k| GyroSample {
+            t: k as f64 * 0.01,
+            omega: w,
+            velocity: None,
+            depth: None,
+        })
+        .collect();
+    let te = 0.02;
+    let frame = [VideoFrame {
+        t_start: 0.3,
+        exposure_s: te,
+        readout_s: None,
+    }];
+    let tw = Twist::rotation(w.x, w.y, w.z);
+    for cam in [anamorphic(), Camera::new(4.0, 0.004, 64, 48)] {
+        let scene = Scene {
+            camera: cam,
+            plane: None,
+        };
+        let field = flow_field(&scene, &tw, 0, 0, Backend::Cpu { threads: None }).unwrap();
+        let riemann = Method::Riemann { nu: 64, nv: 48 };
+        let m = mmbm(&scene, &tw, riemann).unwrap();
+        for method in [
+            riemann,
+            Method::Gauss { nu: 8, nv: 6 },
+            Method::Exact { tol: 1e-9 },
+        ] {
+            let opts = SeriesOptions {
+                scene,
+                method,
+                use_velocity: false,
+            };
+            let (rows, _) = frame_mmbm(&samples, &opts, &frame).unwrap();
+            let r = rows[0];
+            let blur = r.blur_px().unwrap();
+            let mm = r.exposure_mm_s.unwrap();
+            let tol = if method == riemann { 1e-12 } else { 1e-3 };
+            assert!(
+                rel(blur, m.px_s * te) < tol,
+                "{method}: {blur} vs {}",
+                m.px_s * te
+            );
+            assert!(rel(blur, field.mmbm.px_s * te) < tol.max(1e-5), "{method}");
+            if mmbm::metric::pixel_map(&cam).is_none() {
+                assert_eq!(blur, mm / cam.pitch_x_mm * te, "{method}");
+            } else {
+                // The old definition, mm/s over pitch_x, is 20 % off here.
+                let old = mm / cam.pitch_x_mm * te;
+                assert!(rel(old, blur) > 0.1, "{method}: {old} vs {blur}");
+            }
+        }
+    }
+}

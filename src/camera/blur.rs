@@ -39,6 +39,25 @@ pub fn checked_blur_px(mmbm_mm_s: f64, exposure_s: f64, pitch_mm: f64) -> Result
     }
 }
 
+/// Blur length over an exposure, px, from an MMBM in px/s (the true pixel
+/// speed, `Mmbm::px_s`: the one px/s of every door, which is `mm/s / pitch`
+/// with square, unskewed pixels, where this equals [`checked_blur_px`]),
+/// refusing a result that is not a finite number.
+pub fn checked_blur_of_px_s(px_s: f64, exposure_s: f64) -> Result<f64> {
+    let b = px_s * exposure_s;
+    if b.is_finite() {
+        Ok(b)
+    } else {
+        Err(Error::invalid(
+            "blur",
+            format!(
+                "{px_s:?} px/s over {exposure_s:?} s is {b} px, not a finite number (an \
+                 exposure or a speed too large?)"
+            ),
+        ))
+    }
+}
+
 /// An MMBM `mmbm_mm_s` (mm/s) in px/s on pixels of pitch `pitch_mm` (mm),
 /// refusing a result that is not a finite number.
 pub fn checked_px_s(mmbm_mm_s: f64, pitch_mm: f64) -> Result<f64> {
@@ -98,6 +117,13 @@ mod tests {
             );
         }
         assert!(checked_px_s(1e308, 1e-308).is_err());
+        assert!(checked_blur_of_px_s(1e300, 1e10).is_err());
+        // Square pixels: the same number as from mm/s and the pitch.
+        let (m, te, p) = (0.4, 0.07, 0.00465);
+        assert_eq!(
+            checked_blur_of_px_s(checked_px_s(m, p).unwrap(), te).unwrap(),
+            blur_px(m, te, p)
+        );
         assert!(checked_px_s(f64::NAN, 0.005).is_err());
     }
 }
