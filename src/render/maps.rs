@@ -3,7 +3,8 @@
 //! its image path length (px), end-to-start displacement (px) and
 //! time-averaged image speed (px/s = path / duration). Their sensor means are
 //! the "exposure MMBM". Pixels whose scene point is missing (ray misses the
-//! target, or the point goes behind the camera) are NaN and left out of the means.
+//! target, or the point goes behind the camera, or the pixel lies beyond the
+//! lens's radial distortion limit) are NaN and left out of the means.
 
 use super::target::Target;
 use super::trajectory::{Pose, Trajectory};
@@ -132,6 +133,13 @@ fn track_from(
     x: f64,
     y: f64,
 ) -> Option<Vec<(f64, f64)>> {
+    if !cam.distortion.is_none() {
+        // Beyond the lens's radial distortion limit no ray is seen.
+        let (ud, vd) = cam.pixel_to_mm(x, y);
+        if cam.is_masked_mm(ud, vd) {
+            return None;
+        }
+    }
     let id: Pose = (glam::DQuat::IDENTITY, DVec3::ZERO);
     let p0 = target.intersect(cam, &id, x, y)?;
     poses.iter().map(|p| proj(cam, p, p0)).collect()
