@@ -423,8 +423,20 @@ impl Stream {
                 return Ok(None);
             }
         };
+        // Pixels not square: the sample's px/s for the pixel budgets.
+        let px = match crate::series::sample_px(s, &self.series, &self.eval, m) {
+            Ok(px) => px,
+            Err(e) => {
+                let e = at.error(e);
+                if self.opts.strict {
+                    return Ok(Some(StreamEnd::Strict(e)));
+                }
+                log::warn!("{e}; {} skipped", at.unit());
+                return Ok(None);
+            }
+        };
         self.last_t = s.t;
-        self.decide(s, m, out)?;
+        self.decide(s, m, px, out)?;
         self.samples += 1;
         if self.opts.stats {
             self.control.add_latency(read_at.elapsed());
@@ -434,10 +446,16 @@ impl Stream {
 
     /// Gives sample `s` with MMBM `m` to every policy and writes the lines
     /// it produces.
-    fn decide(&mut self, s: &GyroSample, m: f64, out: &mut dyn Write) -> Result<()> {
+    fn decide(
+        &mut self,
+        s: &GyroSample,
+        m: f64,
+        px: Option<f64>,
+        out: &mut dyn Write,
+    ) -> Result<()> {
         let mut text = String::new();
         for live in self.runs.iter_mut() {
-            let events = live.push(s.t, m)?;
+            let events = live.push_px(s.t, m, px)?;
             let triggered = events.iter().any(|e| matches!(e, Event::Trigger(..)));
             for e in events {
                 let v = match e {
