@@ -420,3 +420,62 @@ fn docs_frames_table_is_current() {
         "docs/cli.md should say: {sentence}"
     );
 }
+
+/// Through a lens, and one masked beyond its radial distortion limit,
+/// every method of `frames` gives the mean over the unmasked sensor, as
+/// `eval` does (a constant rotation: the exposure MMBM is the instantaneous
+/// one). The grid rules used to sum each line's own mean (a lens rescales
+/// a line's weights to 1), and `exact` reached the masked corners and
+/// failed as not finite.
+#[test]
+fn masked_lens_frames_are_the_mean_over_the_unmasked_sensor() {
+    use mmbm::camera::Distortion;
+    let masked = Camera {
+        distortion: Distortion::Fisheye {
+            k1: 1.0,
+            k2: -0.8,
+            k3: 0.0,
+            k4: 0.0,
+        },
+        ..Camera::new(0.26, 0.01, 64, 48)
+    };
+    assert!(masked.masked_fraction() > 0.05);
+    let wide = Camera {
+        distortion: Distortion::WIDE_ANGLE,
+        ..Camera::new(1.0, 0.01, 64, 48)
+    };
+    let w = DVec3::new(0.3, -0.5, 0.8);
+    let samples: Vec<GyroSample> = (0..=10)
+        .map(|k| GyroSample {
+            t: k as f64 * 0.01,
+            omega: w,
+            velocity: None,
+            depth: None,
+        })
+        .collect();
+    let frame = [VideoFrame {
+        t_start: 0.02,
+        exposure_s: 0.03,
+        readout_s: None,
+    }];
+    let tw = mmbm::Twist::rotation(w.x, w.y, w.z);
+    for cam in [masked, wide] {
+        let scene = Scene {
+            camera: cam,
+            plane: None,
+        };
+        for method in [
+            Method::Exact { tol: 1e-8 },
+            Method::Riemann { nu: 64, nv: 48 },
+            Method::Gauss { nu: 8, nv: 6 },
+        ] {
+            let (rows, _) = frame_mmbm(&samples, &opts(cam, method), &frame).unwrap();
+            let got = rows[0].exposure_mm_s.unwrap();
+            let want = mmbm::mmbm(&scene, &tw, method).unwrap().mm_s;
+            assert!(
+                (got - want).abs() < 1e-6 * want,
+                "{method}: {got} vs {want}"
+            );
+        }
+    }
+}

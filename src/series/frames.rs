@@ -80,8 +80,11 @@ fn point_flows(cam: &Camera, polys: &[FlowPoly], ud: f64, vd: f64, out: &mut Vec
 }
 
 /// The rule's nodes grouped by line: (delay per second of readout, rule of
-/// that line's nodes with their share of the weights).
-fn line_groups(cam: &Camera, method: Method) -> Result<Vec<(f64, GridRule)>> {
+/// that line's nodes, and the factor that gives its weights their share of
+/// the unmasked sensor's: [`GridRule::distorted`] rescales a lens's line to
+/// weights summing to 1, so its factor is the line's unmasked weight over
+/// every line's; 1 without a lens). Lines masked whole are left out.
+fn line_groups(cam: &Camera, method: Method) -> Result<Vec<(f64, GridRule, f64)>> {
     let rect = cam.sensor_rect();
     let (pts, w) = match method {
         Method::Riemann { nu, nv } => riemann_points(&rect, nu, nv),
@@ -102,10 +105,32 @@ fn line_groups(cam: &Camera, method: Method) -> Result<Vec<(f64, GridRule)>> {
         g.1.push((u, v));
         g.2.push(wk);
     }
-    groups
-        .into_values()
-        .map(|(d, p, w)| Ok((d, GridRule::from_points(&p, &w).distorted(cam)?)))
-        .collect()
+    let lens = !cam.distortion.is_none();
+    let mut out = Vec::with_capacity(groups.len());
+    let mut total = 0.0;
+    for (d, p, w) in groups.into_values() {
+        let kept: f64 = p
+            .iter()
+            .zip(&w)
+            .filter(|(&(u, v), _)| !cam.is_masked_mm(u, v))
+            .map(|(_, &x)| x)
+            .sum();
+        if lens && kept == 0.0 {
+            continue;
+        }
+        total += kept;
+        out.push((d, GridRule::from_points(&p, &w).distorted(cam)?, kept));
+    }
+    if lens && total <= 0.0 {
+        return Err(Error::invalid(
+            "distortion",
+            "every node of the rule lies beyond the lens's radial distortion limit",
+        ));
+    }
+    for g in &mut out {
+        g.2 = if lens { g.2 / total } else { 1.0 };
+    }
+    Ok(out)
 }
 
 /// Exposure MMBM (and the instantaneous MMBM at the start) of every frame.
@@ -184,10 +209,10 @@ pub fn frame_mmbm(
         let (exposure, exposure_px, start) = match &groups {
             Some(groups) => {
                 let (mut e, mut e_px, mut start) = (0.0, 0.0, 0.0);
-                for (delay, rule) in groups {
+                for (delay, rule, share) in groups {
                     // Each node's flow at each sample (sample-major), once.
                     weights.clear();
-                    weights.extend(rule.node_flows(&polys[0]).map(|(w, _)| w));
+                    weights.extend(rule.node_flows(&polys[0]).map(|(w, _)| w * share));
                     flows.clear();
                     for p in &polys {
                         flows.extend(rule.node_flows(p).map(|(_, f)| f));
@@ -210,9 +235,15 @@ pub fn frame_mmbm(
                     readout_s: readout,
                     direction: cam.shutter.direction,
                 };
+                // Beyond the lens's radial distortion limit no ray: 0 there,
+                // and the mean over the unmasked share (as `exact` does).
+                let valid = cam.valid_fraction();
                 let window = |m: Option<[f64; 4]>| {
                     exact_with(
                         |u, v| {
+                            if cam.is_masked_mm(u, v) {
+                                return 0.0;
+                            }
                             let (px, py) = cam.mm_to_pixel(u, v);
                             let w0 = a + shutter.delay_s(px, py, cam.width, cam.height);
                             let mut buf = point_buf.borrow_mut();
@@ -226,6 +257,7 @@ pub fn frame_mmbm(
                         tol,
                     )
                     .value
+                        / valid
                 };
                 let e = window(None);
                 let e_px = map.map_or(0.0, |m| window(Some(m)));
