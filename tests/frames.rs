@@ -430,29 +430,14 @@ fn docs_frames_table_is_current() {
 #[test]
 fn masked_lens_frames_are_the_mean_over_the_unmasked_sensor() {
     use mmbm::camera::Distortion;
-    let masked = Camera {
-        distortion: Distortion::Fisheye {
-            k1: 1.0,
-            k2: -0.8,
-            k3: 0.0,
-            k4: 0.0,
-        },
-        ..Camera::new(0.26, 0.01, 64, 48)
-    };
+    let masked = common::turning_fisheye();
     assert!(masked.masked_fraction() > 0.05);
     let wide = Camera {
         distortion: Distortion::WIDE_ANGLE,
         ..Camera::new(1.0, 0.01, 64, 48)
     };
     let w = DVec3::new(0.3, -0.5, 0.8);
-    let samples: Vec<GyroSample> = (0..=10)
-        .map(|k| GyroSample {
-            t: k as f64 * 0.01,
-            omega: w,
-            velocity: None,
-            depth: None,
-        })
-        .collect();
+    let samples = common::steady_rotation(w, 10, 0.01);
     let frame = [VideoFrame {
         t_start: 0.02,
         exposure_s: 0.03,

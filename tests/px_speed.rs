@@ -168,24 +168,16 @@ fn series_px_s_is_evals() {
 /// an anamorphic camera with a constant rotation, the exposure MMBM in px/s
 /// of a frame is the flow field's mean pixel speed (and `riemann`'s px/s
 /// on the same cells), not mm/s over the horizontal pitch; with square
-/// pixels it is mm/s over the pitch, exactly as before. Every method and a
-/// rolling shutter give the same (the flow does not change in time).
+/// pixels it is mm/s over the pitch, exactly as before. Every method gives
+/// the same (the flow does not change in time).
 #[test]
 fn frames_blur_px_is_the_true_pixel_speed_times_the_exposure() {
     use glam::DVec3;
     use mmbm::io::frames::VideoFrame;
-    use mmbm::io::gyro::GyroSample;
     use mmbm::series::frames::frame_mmbm;
     use mmbm::series::SeriesOptions;
     let w = DVec3::new(1.0, 0.2, -0.3);
-    let samples: Vec<GyroSample> = (0..=100)
-        .map(|k| GyroSample {
-            t: k as f64 * 0.01,
-            omega: w,
-            velocity: None,
-            depth: None,
-        })
-        .collect();
+    let samples = common::steady_rotation(w, 100, 0.01);
     let te = 0.02;
     let frame = [VideoFrame {
         t_start: 0.3,
@@ -231,4 +223,68 @@ fn frames_blur_px_is_the_true_pixel_speed_times_the_exposure() {
             }
         }
     }
+}
+
+/// Exposure control on anamorphic pixels (pitch_y = 1.5 pitch_x): `mmbm
+/// live` chooses the same exposures as `mmbm trigger` (both convert each
+/// decision sample's mm/s with its own true pixel speed; the library test
+/// `pixel_budgets_use_the_true_pixel_speed` checks the px budget itself).
+#[test]
+fn anamorphic_exposure_control_live_equals_offline() {
+    let d = tempfile::tempdir().unwrap();
+    let log = d.path().join("walk.csv");
+    let log_s = log.to_str().unwrap();
+    let sim = [
+        "simulate",
+        "--gait",
+        "moderate",
+        "--duration",
+        "20",
+        "--seed",
+        "7",
+        "--out",
+        log_s,
+    ];
+    assert!(common::mmbm(&sim).status.success());
+    let cam = d.path().join("ana.toml");
+    std::fs::write(
+        &cam,
+        "focal_mm = 4.2548\npitch_x_mm = 0.00465\npitch_y_mm = 0.006975\nwidth = 640\nheight = 480\n",
+    )
+    .unwrap();
+    let cam = cam.to_str().unwrap();
+    let policy = "fixed:5+exp:0.5";
+    let o = common::mmbm(&[
+        "trigger", "--policy", policy, "--camera", cam, "--gyro", log_s,
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let mut r = csv::Reader::from_reader(&o.stdout[..]);
+    let h = r.headers().unwrap().clone();
+    let col = |n: &str| h.iter().position(|x| x == n).unwrap();
+    let (ct, ce) = (col("trigger_t"), col("exposure_end"));
+    let offline: Vec<(f64, f64)> = r
+        .records()
+        .map(|x| {
+            let x = x.unwrap();
+            (x[ct].parse().unwrap(), x[ce].parse().unwrap())
+        })
+        .collect();
+    assert!(offline.len() > 10);
+    let input = std::fs::read(&log).unwrap();
+    let args = ["live", "--policy", policy, "--camera", cam];
+    let o = common::mmbm_within(d.path(), &args, input, 120);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let live: Vec<(f64, f64)> = String::from_utf8(o.stdout)
+        .unwrap()
+        .lines()
+        .map(|l| serde_json::from_str::<serde_json::Value>(l).unwrap())
+        .filter(|v| v["trigger"] == true)
+        .map(|v| {
+            (
+                v["t"].as_f64().unwrap(),
+                v["exposure_end"].as_f64().unwrap(),
+            )
+        })
+        .collect();
+    assert_eq!(&live[..offline.len()], &offline[..]);
 }

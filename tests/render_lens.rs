@@ -12,18 +12,9 @@ use mmbm::camera::Distortion;
 use mmbm::render::{render_frame, Backend, Integrator, Quality, RenderJob, Target, Trajectory};
 use mmbm::{Camera, Twist};
 
-/// A fisheye whose polynomial turns back at 1.2 (`theta + theta^3 - 0.8
-/// theta^5`), f = 26 px on 64 x 48: the corners lie beyond its limit.
+/// The masked fisheye of the tests (`common::turning_fisheye`).
 fn masked() -> Camera {
-    Camera {
-        distortion: Distortion::Fisheye {
-            k1: 1.0,
-            k2: -0.8,
-            k3: 0.0,
-            k4: 0.0,
-        },
-        ..Camera::new(0.26, 0.01, 64, 48)
-    }
+    common::turning_fisheye()
 }
 
 fn job(cam: Camera, backend: Backend) -> RenderJob {
@@ -123,14 +114,7 @@ fn gpu_renders_every_model_as_its_twin() {
         };
         let (g, c) = (run(Backend::Gpu), run(Backend::Cpu { threads: None }));
         let n = g.samples_per_pixel as f32;
-        let diffs: Vec<f32> = g
-            .rgb
-            .iter()
-            .zip(&c.rgb)
-            .map(|(a, b)| (a - b).abs())
-            .collect();
-        let max = diffs.iter().cloned().fold(0.0, f32::max);
-        let mean = diffs.iter().sum::<f32>() / diffs.len() as f32;
+        let (max, mean) = common::abs_diff_max_mean(&g.rgb, &c.rgb);
         let name = cam.distortion.name();
         eprintln!("{name} ({integrator}): N {n}, max |gpu - cpu| {max:.2e}, mean {mean:.2e}");
         assert!(max <= 3.0 / n + 1e-3, "{name}: max {max}");

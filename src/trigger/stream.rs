@@ -410,22 +410,13 @@ impl Stream {
             );
             return Ok(None);
         }
-        let m = match sample_mmbm(s, &self.series, &self.eval)
+        // The MMBM and, on pixels that are not square, its px/s (for the
+        // pixel budgets).
+        let values = sample_mmbm(s, &self.series, &self.eval)
             .and_then(|m| check_values(std::slice::from_ref(s), &[m]).map(|_| m))
-        {
-            Ok(m) => m,
-            Err(e) => {
-                let e = at.error(e);
-                if self.opts.strict {
-                    return Ok(Some(StreamEnd::Strict(e)));
-                }
-                log::warn!("{e}; {} skipped", at.unit());
-                return Ok(None);
-            }
-        };
-        // Pixels not square: the sample's px/s for the pixel budgets.
-        let px = match crate::series::sample_px(s, &self.series, &self.eval, m) {
-            Ok(px) => px,
+            .and_then(|m| crate::series::sample_px(s, &self.series, &self.eval, m).map(|p| (m, p)));
+        let (m, px) = match values {
+            Ok(v) => v,
             Err(e) => {
                 let e = at.error(e);
                 if self.opts.strict {
