@@ -288,3 +288,37 @@ fn anamorphic_exposure_control_live_equals_offline() {
         .collect();
     assert_eq!(&live[..offline.len()], &offline[..]);
 }
+
+/// The renderer's blur maps on anamorphic pixels: their mean speed in px/s
+/// is the true pixel speed and in mm/s the sensor speed (a short exposure
+/// of a steady rotation: both the instantaneous MMBM on the same pixels),
+/// so the dataset's `mmbm_exposure_mm_s` is not px/s times pitch_x.
+#[test]
+fn blur_maps_give_both_speeds_on_anamorphic_pixels() {
+    use mmbm::render::maps::blur_maps;
+    use mmbm::render::{Target, Trajectory};
+    let cam = anamorphic();
+    let tw = Twist::rotation(0.9, -0.3, 0.4);
+    let te = 1e-3;
+    let traj = Trajectory::from_twist(tw, te).unwrap();
+    let maps = blur_maps(&cam, &Target::checker(0.05, 1.5), &traj, te, 64);
+    let m = maps.means();
+    let scene = Scene {
+        camera: cam,
+        plane: None,
+    };
+    let want = mmbm(&scene, &tw, Method::Riemann { nu: 64, nv: 48 }).unwrap();
+    assert!(
+        rel(m.speed_mm_s, want.mm_s) < 2e-3,
+        "{} vs {}",
+        m.speed_mm_s,
+        want.mm_s
+    );
+    assert!(
+        rel(m.speed_px_s, want.px_s) < 2e-3,
+        "{} vs {}",
+        m.speed_px_s,
+        want.px_s
+    );
+    assert!(rel(m.speed_px_s * cam.pitch_x_mm, want.mm_s) > 0.05);
+}
