@@ -88,13 +88,13 @@ fn run() -> Result<()> {
         })?;
         let c1 = one.install(|| {
             per_call(secs, || {
-                black_box(flow_cpu::flow_tiles(&grid, &tw, true));
+                black_box(flow_cpu::flow_tiles(&grid, &tw, true)?);
                 Ok(())
             })
         })?;
         let cn = all.install(|| {
             per_call(secs, || {
-                black_box(flow_cpu::flow_tiles(&grid, &tw, true));
+                black_box(flow_cpu::flow_tiles(&grid, &tw, true)?);
                 Ok(())
             })
         })?;
@@ -125,13 +125,13 @@ fn run() -> Result<()> {
         })?;
         let c1 = one.install(|| {
             per_call(1.0, || {
-                black_box(flow_cpu::batch_means(&grid, t));
+                black_box(flow_cpu::batch_means(&grid, t)?);
                 Ok(())
             })
         })?;
         let cn = all.install(|| {
             per_call(1.0, || {
-                black_box(flow_cpu::batch_means(&grid, t));
+                black_box(flow_cpu::batch_means(&grid, t)?);
                 Ok(())
             })
         })?;

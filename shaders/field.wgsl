@@ -1,6 +1,7 @@
 // Per-pixel image-plane flow (SPEC section 2, thesis eq. 3.20) and its mean
 // over the sensor (MMBM, thesis eq. 3.11). The CPU twin of every function and
-// entry point is in src/gpu/flow_cpu.rs; the host structs in src/gpu/flow_params.rs.
+// entry point is in src/field/cpu.rs; the host structs in src/field/kernel.rs
+// and src/field/table.rs.
 //
 // Units: sensor coordinates u, v in mm; focal length f in mm; angular
 // velocity rad/s; linear velocity m/s; inverse depth 1/m. The flow is mm/s on
@@ -23,7 +24,7 @@ struct Params {
     tiles: u32,         // tiles per twist (flow_tiles)
     tiles_x: u32,       // workgroups along x per dispatch row
     write_field: u32,   // 1: write the field (one twist only)
-    dist_model: u32,    // lens distortion: 0 none, 1 OpenCV (k1 k2 p1 p2 | k3), 2 fisheye (k1..k4)
+    dist_model: u32,    // lens distortion: 0 none, 1 OpenCV (k1 k2 p1 p2 | k3), 2 fisheye (k1..k4), 3 lens table
     pad0: u32,
     dist: vec4<f32>,    // OpenCV: k1, k2, p1, p2; fisheye: k1, k2, k3, k4
     dist_k3: f32,       // OpenCV: k3
@@ -39,10 +40,21 @@ struct Twist {
     inv_depth: vec4<f32>, // 1/z = x + y*u + z*v (1/m; zero for rotation only)
 }
 
+// Lens table mode (dist_model 3): per grid sample, its undistorted normalised
+// point q and the rows of the distortion chain's Jacobian at q, computed on
+// the host (src/field/table.rs; all zero for a masked sample, whose flow is
+// then 0). Must match `LensSample` (24 bytes). One dummy entry otherwise.
+struct LensSample {
+    q: vec2<f32>,
+    j0: vec2<f32>,
+    j1: vec2<f32>,
+}
+
 @group(0) @binding(0) var<uniform> params: Params;
 @group(0) @binding(1) var<storage, read> twists: array<Twist>;
 @group(0) @binding(2) var<storage, read_write> field: array<vec2<f32>>;
 @group(0) @binding(3) var<storage, read_write> partials: array<f32>;
+@group(0) @binding(4) var<storage, read> lens: array<LensSample>;
 
 // Workgroup size and samples per thread of flow_tiles: a tile is WG * CHUNK
 // consecutive samples (row-major); sample k of thread t is tile*TILE + k*WG + t.
@@ -181,7 +193,13 @@ fn undistort(qd: vec2<f32>) -> vec2<f32> {
 
 // The flow (mm/s on the distorted sensor) at the centre of grid cell (i, j):
 // the pinhole flow of its undistorted point through the distortion's Jacobian.
+// Table mode: the pinhole flow at the sample's q through its Jacobian.
 fn sample_flow(i: u32, j: u32, tw: Twist) -> vec2<f32> {
+    if (params.dist_model == 3u) {
+        let s = lens[j * params.grid_w + i];
+        let fl = flow_mm(s.q * params.f_mm, tw);
+        return vec2<f32>(dot(s.j0, fl), dot(s.j1, fl));
+    }
     let pd = sensor_point(i, j);
     if (params.dist_model == 0u) {
         return flow_mm(pd, tw);

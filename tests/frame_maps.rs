@@ -284,7 +284,7 @@ fn mean_path_is_the_exposure_mmbm_on_every_frame() {
         let (mut worst, mut n, mut gaps): (f64, usize, usize) = (0.0, 0, 0);
         for (k, f) in frames.iter().enumerate() {
             let m = frame_maps(&log, &o, &rays, k, f, None).unwrap();
-            let Some(blur) = rows[k].blur_px(&cam) else {
+            let Some(blur) = rows[k].blur_px() else {
                 assert!(outside.contains(&k) && m.is_none(), "{name} frame {k}");
                 continue;
             };

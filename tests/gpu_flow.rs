@@ -42,7 +42,7 @@ fn check_field(scene: &Scene, tw: &Twist) {
     let f = flow_field_gpu(scene, tw, 0, 0).unwrap();
     let grid = Grid::new(&scene.camera, 0, 0).unwrap();
     let g = TwistGpu::new(scene.camera.focal_mm, tw, scene.plane.as_ref());
-    let twin = flow_cpu::flow_tiles(&grid, &g, true);
+    let twin = flow_cpu::flow_tiles(&grid, &g, true).unwrap();
     let (reff, mean) = flow_cpu::reference_f64(&grid, tw, scene.plane.as_ref());
     assert_eq!(f.u.len(), grid.len());
     let max = reff.iter().map(|a| a[0].hypot(a[1])).fold(0.0, f64::max);
@@ -256,7 +256,7 @@ fn batched_matches_single_and_cpu() {
     for (w, h) in [(8u32, 6u32), (64, 48), (160, 120)] {
         let grid = Grid::new(&cam, w, h).unwrap();
         let batch = r.batch_means(&grid, &gtw).unwrap();
-        let twin = flow_cpu::batch_means(&grid, &gtw);
+        let twin = flow_cpu::batch_means(&grid, &gtw).unwrap();
         assert_eq!(batch.len(), tws.len());
         for (k, (tw, plane)) in tws.iter().enumerate() {
             let s = Scene {

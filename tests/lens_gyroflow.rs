@@ -150,19 +150,22 @@ fn every_model_and_digital_lens_maps_and_measures_as_gyroflow() {
 }
 
 #[test]
-fn gpu_kernel_refuses_the_models_it_lacks_by_name() {
+fn gpu_kernel_takes_the_other_models_through_its_lens_table() {
+    // Per pixel against the twin and the CPU metric: tests/gpu_lens.rs.
     let p = profile("poly5", &[-0.05, 0.004], json!({}));
     let c = resolve(&write_tmp("g.json", &p.to_string()), None, None).unwrap();
-    let e = mmbm::field::Grid::new(&c, 0, 0).unwrap_err().to_string();
-    assert!(e.contains("poly5") && e.contains("GPU kernel"), "{e}");
+    assert!(mmbm::field::Grid::new(&c, 0, 0).unwrap().uses_table());
     let p = profile(
         "opencv_fisheye",
         &[0.03],
         json!({"digital_lens": "gopro_superview"}),
     );
     let c = resolve(&write_tmp("g.json", &p.to_string()), None, None).unwrap();
-    let e = mmbm::field::Grid::new(&c, 0, 0).unwrap_err().to_string();
-    assert!(e.contains("gopro_superview over opencv_fisheye"), "{e}");
+    assert!(mmbm::field::Grid::new(&c, 0, 0).unwrap().uses_table());
+    // The analytic fisheye without a mask needs none.
+    let p = profile("opencv_fisheye", &[0.03, -0.01, 0.004, -0.001], json!({}));
+    let c = resolve(&write_tmp("g.json", &p.to_string()), None, None).unwrap();
+    assert!(!mmbm::field::Grid::new(&c, 0, 0).unwrap().uses_table());
 }
 
 #[test]

@@ -163,3 +163,162 @@ fn series_px_s_is_evals() {
         assert_eq!(f[3], m.px_s * 0.01, "{row}");
     }
 }
+
+/// `frames`' blur_px is the same true pixel speed times the exposure: on
+/// an anamorphic camera with a constant rotation, the exposure MMBM in px/s
+/// of a frame is the flow field's mean pixel speed (and `riemann`'s px/s
+/// on the same cells), not mm/s over the horizontal pitch; with square
+/// pixels it is mm/s over the pitch, exactly as before. Every method gives
+/// the same (the flow does not change in time).
+#[test]
+fn frames_blur_px_is_the_true_pixel_speed_times_the_exposure() {
+    use glam::DVec3;
+    use mmbm::io::frames::VideoFrame;
+    use mmbm::series::frames::frame_mmbm;
+    use mmbm::series::SeriesOptions;
+    let w = DVec3::new(1.0, 0.2, -0.3);
+    let samples = common::steady_rotation(w, 100, 0.01);
+    let te = 0.02;
+    let frame = [VideoFrame {
+        t_start: 0.3,
+        exposure_s: te,
+        readout_s: None,
+    }];
+    let tw = Twist::rotation(w.x, w.y, w.z);
+    for cam in [anamorphic(), Camera::new(4.0, 0.004, 64, 48)] {
+        let scene = Scene {
+            camera: cam,
+            plane: None,
+        };
+        let field = flow_field(&scene, &tw, 0, 0, Backend::Cpu { threads: None }).unwrap();
+        let riemann = Method::Riemann { nu: 64, nv: 48 };
+        let m = mmbm(&scene, &tw, riemann).unwrap();
+        for method in [
+            riemann,
+            Method::Gauss { nu: 8, nv: 6 },
+            Method::Exact { tol: 1e-9 },
+        ] {
+            let opts = SeriesOptions {
+                scene,
+                method,
+                use_velocity: false,
+            };
+            let (rows, _) = frame_mmbm(&samples, &opts, &frame).unwrap();
+            let r = rows[0];
+            let blur = r.blur_px().unwrap();
+            let mm = r.exposure_mm_s.unwrap();
+            let tol = if method == riemann { 1e-12 } else { 1e-3 };
+            assert!(
+                rel(blur, m.px_s * te) < tol,
+                "{method}: {blur} vs {}",
+                m.px_s * te
+            );
+            assert!(rel(blur, field.mmbm.px_s * te) < tol.max(1e-5), "{method}");
+            if mmbm::metric::pixel_map(&cam).is_none() {
+                assert_eq!(blur, mm / cam.pitch_x_mm * te, "{method}");
+            } else {
+                // The old definition, mm/s over pitch_x, is 20 % off here.
+                let old = mm / cam.pitch_x_mm * te;
+                assert!(rel(old, blur) > 0.1, "{method}: {old} vs {blur}");
+            }
+        }
+    }
+}
+
+/// Exposure control on anamorphic pixels (pitch_y = 1.5 pitch_x): `mmbm
+/// live` chooses the same exposures as `mmbm trigger` (both convert each
+/// decision sample's mm/s with its own true pixel speed; the library test
+/// `pixel_budgets_use_the_true_pixel_speed` checks the px budget itself).
+#[test]
+fn anamorphic_exposure_control_live_equals_offline() {
+    let d = tempfile::tempdir().unwrap();
+    let log = d.path().join("walk.csv");
+    let log_s = log.to_str().unwrap();
+    let sim = [
+        "simulate",
+        "--gait",
+        "moderate",
+        "--duration",
+        "20",
+        "--seed",
+        "7",
+        "--out",
+        log_s,
+    ];
+    assert!(common::mmbm(&sim).status.success());
+    let cam = d.path().join("ana.toml");
+    std::fs::write(
+        &cam,
+        "focal_mm = 4.2548\npitch_x_mm = 0.00465\npitch_y_mm = 0.006975\nwidth = 640\nheight = 480\n",
+    )
+    .unwrap();
+    let cam = cam.to_str().unwrap();
+    let policy = "fixed:5+exp:0.5";
+    let o = common::mmbm(&[
+        "trigger", "--policy", policy, "--camera", cam, "--gyro", log_s,
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let mut r = csv::Reader::from_reader(&o.stdout[..]);
+    let h = r.headers().unwrap().clone();
+    let col = |n: &str| h.iter().position(|x| x == n).unwrap();
+    let (ct, ce) = (col("trigger_t"), col("exposure_end"));
+    let offline: Vec<(f64, f64)> = r
+        .records()
+        .map(|x| {
+            let x = x.unwrap();
+            (x[ct].parse().unwrap(), x[ce].parse().unwrap())
+        })
+        .collect();
+    assert!(offline.len() > 10);
+    let input = std::fs::read(&log).unwrap();
+    let args = ["live", "--policy", policy, "--camera", cam];
+    let o = common::mmbm_within(d.path(), &args, input, 120);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let live: Vec<(f64, f64)> = String::from_utf8(o.stdout)
+        .unwrap()
+        .lines()
+        .map(|l| serde_json::from_str::<serde_json::Value>(l).unwrap())
+        .filter(|v| v["trigger"] == true)
+        .map(|v| {
+            (
+                v["t"].as_f64().unwrap(),
+                v["exposure_end"].as_f64().unwrap(),
+            )
+        })
+        .collect();
+    assert_eq!(&live[..offline.len()], &offline[..]);
+}
+
+/// The renderer's blur maps on anamorphic pixels: their mean speed in px/s
+/// is the true pixel speed and in mm/s the sensor speed (a short exposure
+/// of a steady rotation: both the instantaneous MMBM on the same pixels),
+/// so the dataset's `mmbm_exposure_mm_s` is not px/s times pitch_x.
+#[test]
+fn blur_maps_give_both_speeds_on_anamorphic_pixels() {
+    use mmbm::render::maps::blur_maps;
+    use mmbm::render::{Target, Trajectory};
+    let cam = anamorphic();
+    let tw = Twist::rotation(0.9, -0.3, 0.4);
+    let te = 1e-3;
+    let traj = Trajectory::from_twist(tw, te).unwrap();
+    let maps = blur_maps(&cam, &Target::checker(0.05, 1.5), &traj, te, 64);
+    let m = maps.means();
+    let scene = Scene {
+        camera: cam,
+        plane: None,
+    };
+    let want = mmbm(&scene, &tw, Method::Riemann { nu: 64, nv: 48 }).unwrap();
+    assert!(
+        rel(m.speed_mm_s, want.mm_s) < 2e-3,
+        "{} vs {}",
+        m.speed_mm_s,
+        want.mm_s
+    );
+    assert!(
+        rel(m.speed_px_s, want.px_s) < 2e-3,
+        "{} vs {}",
+        m.speed_px_s,
+        want.px_s
+    );
+    assert!(rel(m.speed_px_s * cam.pitch_x_mm, want.mm_s) > 0.05);
+}

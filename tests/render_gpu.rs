@@ -161,14 +161,7 @@ fn gpu_matches_cpu_twin_per_pixel() {
             job.backend = Backend::Cpu { threads: None };
             let c = render::render_frame(&job).unwrap();
             let n = g.samples_per_pixel as f32;
-            let diffs: Vec<f32> = g
-                .rgb
-                .iter()
-                .zip(&c.rgb)
-                .map(|(a, b)| (a - b).abs())
-                .collect();
-            let max = diffs.iter().cloned().fold(0.0, f32::max);
-            let mean = diffs.iter().sum::<f32>() / diffs.len() as f32;
+            let (max, mean) = common::abs_diff_max_mean(&g.rgb, &c.rgb);
             eprintln!("{name} ({integrator}): N {n}, max |gpu - cpu| {max:.2e}, mean {mean:.2e}");
             // Lattice: f32 rounding may flip a few samples that lie on an edge
             // (each flip is 1/N) and texture filtering rounds differently: 3

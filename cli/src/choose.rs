@@ -7,7 +7,6 @@ use clap::Args;
 use mmbm::error::{Error, Result};
 use mmbm::series::frames::FrameMmbm;
 use mmbm::series::select::{blurriest, choose, ffmpeg_select, image_list, Choice, FrameName};
-use mmbm::Camera;
 use std::path::{Path, PathBuf};
 
 /// Frames chosen for the next tool.
@@ -98,23 +97,23 @@ impl ChoiceArgs {
     }
 
     /// The rows the table keeps: the chosen frames, or all.
-    pub fn keep(&self, rows: &[FrameMmbm], cam: &Camera) -> Result<Vec<usize>> {
+    pub fn keep(&self, rows: &[FrameMmbm]) -> Result<Vec<usize>> {
         if self.select.is_none() && self.max_blur.is_none() {
             return Ok((0..rows.len()).collect());
         }
-        choose(rows, cam, &self.choice())
+        choose(rows, &self.choice())
     }
 
     /// Writes the lists asked for (`keep`: the chosen rows) and says on
     /// stderr what they hold. Call inside `all_or_nothing` with the table.
-    pub fn write(&self, rows: &[FrameMmbm], cam: &Camera, keep: &[usize]) -> Result<()> {
+    pub fn write(&self, rows: &[FrameMmbm], keep: &[usize]) -> Result<()> {
         let text = |p: &Path, s: String| {
             mmbm::io::atomic::write_atomic(p, |w| {
                 w.write_all(s.as_bytes()).map_err(|e| Error::io(p, e))
             })
         };
         let blur_range = |ks: &[usize]| -> String {
-            let b: Vec<f64> = ks.iter().filter_map(|&k| rows[k].blur_px(cam)).collect();
+            let b: Vec<f64> = ks.iter().filter_map(|&k| rows[k].blur_px()).collect();
             match (
                 b.iter().copied().reduce(f64::min),
                 b.iter().copied().reduce(f64::max),
@@ -134,7 +133,7 @@ impl ChoiceArgs {
             eprintln!("chosen: {} frames ({})", keep.len(), blur_range(keep));
         }
         if self.worst_list.is_some() || self.worst_ffmpeg_select.is_some() {
-            let worst = blurriest(rows, cam, self.worst.flatten());
+            let worst = blurriest(rows, self.worst.flatten());
             if let Some(p) = &self.worst_list {
                 text(p, image_list(&worst, &self.frame_name, self.frame_start))?;
             }

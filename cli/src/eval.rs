@@ -3,7 +3,7 @@
 use super::args::{parse_vec3, CameraArgs, SceneArgs};
 use clap::Args;
 use glam::DVec3;
-use mmbm::camera::checked_blur_px;
+use mmbm::camera::checked_blur_of_px_s;
 use mmbm::error::Result;
 use mmbm::{AnyMethod, Scene, Twist};
 
@@ -58,7 +58,7 @@ pub fn run(a: EvalArgs) -> Result<()> {
     // Checked before anything is printed: a blur that is not a finite
     // number is an error, not "inf" or a JSON null.
     let blur = match a.exposure {
-        Some(te) => Some((te, checked_blur_px(m.mm_s, te, scene.camera.pitch_x_mm)?)),
+        Some(te) => Some((te, checked_blur_of_px_s(m.px_s, te)?)),
         None => None,
     };
     // The share of the sensor beyond the lens's radial distortion limit,

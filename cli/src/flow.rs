@@ -1,6 +1,7 @@
 //! `mmbm flow`: the per-pixel flow field at sensor resolution on the GPU,
 //! written as a float EXR (`flow.u`, `flow.v`, `flow.speed` in px/s), with an
-//! optional quiver PNG.
+//! optional quiver PNG. Pixels beyond a lens's radial distortion limit are
+//! NaN in the EXR and out of the mean.
 
 use super::args::{parse_vec3, CameraArgs, SceneArgs};
 use clap::Args;
@@ -83,6 +84,13 @@ pub fn run(a: FlowArgs) -> Result<()> {
         "MMBM = {:.10} mm/s = {:.6} px/s ({}x{} pixels on {desc})",
         f.mmbm.mm_s, f.mmbm.px_s, f.width, f.height
     );
+    if f.masked > 0.0 {
+        println!(
+            "masked: {:.4} % of the pixels (beyond the lens's radial distortion limit: NaN in \
+             the field, out of the mean)",
+            100.0 * f.masked
+        );
+    }
     println!("wrote {}", a.out.display());
     if let Some(q) = &a.quiver {
         println!("wrote {}", q.display());

@@ -108,7 +108,7 @@ pub fn run(a: FramesArgs) -> Result<()> {
             if outside.len() > 8 { ", ..." } else { "" }
         );
     }
-    let keep = a.choice.keep(&rows, &camera)?;
+    let keep = a.choice.keep(&rows)?;
     let write = |w: &mut dyn Write| -> Result<()> {
         let werr = |e: std::io::Error| mmbm::Error::io("<frames output>", e);
         writeln!(
@@ -126,7 +126,7 @@ pub fn run(a: FramesArgs) -> Result<()> {
                 r.frame,
                 ryu::Buffer::new().format(r.t_start),
                 opt(r.exposure_mm_s),
-                opt(r.blur_px(&camera)),
+                opt(r.blur_px()),
                 opt(r.start_mm_s),
                 ryu::Buffer::new().format(r.exposure_s),
                 ryu::Buffer::new().format(r.readout_s),
@@ -160,7 +160,7 @@ pub fn run(a: FramesArgs) -> Result<()> {
             Some(p) => mmbm::io::atomic::write_atomic(p, |w| write(w))?,
             None => write(&mut std::io::stdout().lock())?,
         }
-        a.choice.write(&rows, &camera, &keep)
+        a.choice.write(&rows, &keep)
     })?;
     eprintln!(
         "{} frames ({} written), method {method}, camera readout {} s",

@@ -62,7 +62,9 @@ pub struct TriggerArgs {
     pub camera: CameraArgs,
 }
 
-fn summary_text(frames: &[Frame], spec: &str, duration: f64, pitch_mm: f64) -> String {
+/// `pitch_mm`: the pixel pitch that turns the mean blur (mm) into px, `None`
+/// for pixels that are not square (no single one: the blur is given in um).
+fn summary_text(frames: &[Frame], spec: &str, duration: f64, pitch_mm: Option<f64>) -> String {
     let s = trigger::summary_over(frames, duration);
     let t = trigger::prediction_error(frames);
     // Statistics of no frames are undefined: "n/a", never "NaN".
@@ -75,7 +77,7 @@ fn summary_text(frames: &[Frame], spec: &str, duration: f64, pitch_mm: f64) -> S
     };
     format!(
         "{spec}: {} frames, {} kept, {} fps over {} s; exposure MMBM mean {} p95 {} max {} mm/s (trigger mean {})\n  \
-         blur over the exposure mean {} px, exposure mean {} ms\n  \
+         blur over the exposure mean {}, exposure mean {} ms\n  \
          Table 5.1 (exposure - trigger): min {} max {} mean {} abs mean {} std {} mm/s; \
          % min {} max {} mean {} abs mean {} std {}\n",
         s.frames,
@@ -86,7 +88,10 @@ fn summary_text(frames: &[Frame], spec: &str, duration: f64, pitch_mm: f64) -> S
         n(s.p95_mm_s, 4),
         n(s.max_mm_s, 4),
         n(s.mean_trigger_mm_s, 4),
-        n(s.mean_blur_mm / pitch_mm, 2),
+        match pitch_mm {
+            Some(p) => n(s.mean_blur_mm / p, 2) + " px",
+            None => n(s.mean_blur_mm * 1e3, 3) + " um (pixels not square: no single px/mm)",
+        },
         n(s.mean_exposure_s * 1e3, 2),
         n(t.abs.min, 4),
         n(t.abs.max, 4),
@@ -127,7 +132,9 @@ pub fn run(a: TriggerArgs) -> Result<()> {
             frames,
             spec.as_str(),
             run.duration_s,
-            session.timing().pitch_mm,
+            mmbm::metric::pixel_map(session.camera())
+                .is_none()
+                .then_some(session.timing().pitch_mm),
         ));
     }
     let all = run.frames;

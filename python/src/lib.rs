@@ -175,7 +175,7 @@ fn frames<'py>(
         .collect();
     let blur: Vec<f64> = rows
         .iter()
-        .map(|r| r.blur_px(&cam).unwrap_or(f64::NAN))
+        .map(|r| r.blur_px().unwrap_or(f64::NAN))
         .collect();
     let s0: Vec<f64> = rows
         .iter()

@@ -25,15 +25,31 @@ pub fn blur_px(mmbm_mm_s: f64, exposure_s: f64, pitch_mm: f64) -> f64 {
 /// assert!(mmbm::camera::checked_blur_px(0.4, 0.07, 0.00465).is_ok());
 /// ```
 pub fn checked_blur_px(mmbm_mm_s: f64, exposure_s: f64, pitch_mm: f64) -> Result<f64> {
-    let b = blur_px(mmbm_mm_s, exposure_s, pitch_mm);
+    finite_blur(blur_px(mmbm_mm_s, exposure_s, pitch_mm), || {
+        format!("{mmbm_mm_s:?} mm/s over {exposure_s:?} s on {pitch_mm:?} mm pixels")
+    })
+}
+
+/// Blur length over an exposure, px, from an MMBM in px/s (the true pixel
+/// speed, `Mmbm::px_s`: the one px/s of every door, which is `mm/s / pitch`
+/// with square, unskewed pixels, where this equals [`checked_blur_px`]),
+/// refusing a result that is not a finite number.
+pub fn checked_blur_of_px_s(px_s: f64, exposure_s: f64) -> Result<f64> {
+    finite_blur(px_s * exposure_s, || {
+        format!("{px_s:?} px/s over {exposure_s:?} s")
+    })
+}
+
+/// `b` px, or an error saying that `what` (built only then) is not a finite blur.
+fn finite_blur(b: f64, what: impl FnOnce() -> String) -> Result<f64> {
     if b.is_finite() {
         Ok(b)
     } else {
         Err(Error::invalid(
             "blur",
             format!(
-                "{mmbm_mm_s:?} mm/s over {exposure_s:?} s on {pitch_mm:?} mm pixels is {b} px, \
-                 not a finite number (an exposure or a speed too large?)"
+                "{} is {b} px, not a finite number (an exposure or a speed too large?)",
+                what()
             ),
         ))
     }
@@ -98,6 +114,13 @@ mod tests {
             );
         }
         assert!(checked_px_s(1e308, 1e-308).is_err());
+        assert!(checked_blur_of_px_s(1e300, 1e10).is_err());
+        // Square pixels: the same number as from mm/s and the pitch.
+        let (m, te, p) = (0.4, 0.07, 0.00465);
+        assert_eq!(
+            checked_blur_of_px_s(checked_px_s(m, p).unwrap(), te).unwrap(),
+            blur_px(m, te, p)
+        );
         assert!(checked_px_s(f64::NAN, 0.005).is_err());
     }
 }

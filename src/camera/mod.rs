@@ -27,7 +27,7 @@ pub(crate) mod radial;
 pub(crate) mod shutter;
 pub(crate) mod sony;
 
-pub use blur::{blur_px, checked_blur_px, checked_px_s, exposure_for_blur};
+pub use blur::{blur_px, checked_blur_of_px_s, checked_blur_px, checked_px_s, exposure_for_blur};
 pub use digital::{Lens as DigitalLens, Warp};
 pub use distortion::Distortion;
 pub use file::{CameraFile, CameraOverrides, MAX_CAMERA_BYTES};

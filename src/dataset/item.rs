@@ -393,7 +393,12 @@ pub fn make(p: &ItemParams, src: &Sources, dir: &Path) -> Result<ItemMeasures> {
         mmbm_start_mm_s: start.mm_s,
         mmbm_start_px_s: start.px_s,
         mmbm_exposure_px_s: m.speed_px_s,
-        mmbm_exposure_mm_s: m.speed_px_s * cam.pitch_x_mm,
+        // mm/s: the maps' own with pixels that are not square (no single
+        // pitch turns px into mm), else px/s times the pitch.
+        mmbm_exposure_mm_s: match crate::metric::pixel_map(&cam) {
+            None => m.speed_px_s * cam.pitch_x_mm,
+            Some(_) => m.speed_mm_s,
+        },
         blur_path_px: m.path_px,
     })
 }

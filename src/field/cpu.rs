@@ -3,7 +3,9 @@
 //! built from the library's own [`crate::model::flow::flow_distorted`] and [`Camera`] maps.
 
 use super::kernel::{FlowParams, Grid, TwistGpu, CHUNK, TILE, WG};
+use super::table::{valid_len, LensSample, LensTable};
 use crate::camera::Camera;
+use crate::error::Result;
 use crate::model::flow::flow_distorted;
 use crate::model::motion::{Plane, Twist};
 use rayon::prelude::*;
@@ -153,9 +155,22 @@ pub fn undistort(p: &FlowParams, xd: f32, yd: f32) -> (f32, f32) {
 }
 
 /// Twin of the shader's `sample_flow`: the flow (mm/s on the distorted
-/// sensor) at the centre of grid cell `(i, j)`.
+/// sensor) at the centre of grid cell `(i, j)`; in table mode (model 3) the
+/// pinhole flow at the sample's `q` through its Jacobian, from `lens`
+/// (the grid's [`LensTable::samples`]; unused by the other models).
 #[inline(always)]
-pub fn sample_flow(p: &FlowParams, tw: &TwistGpu, i: u32, j: u32) -> (f32, f32) {
+pub fn sample_flow(
+    p: &FlowParams,
+    lens: &[LensSample],
+    tw: &TwistGpu,
+    i: u32,
+    j: u32,
+) -> (f32, f32) {
+    if p.dist_model == 3 {
+        let s = &lens[(j * p.grid_w + i) as usize];
+        let (a, b) = flow_mm(p, tw, s.q[0] * p.f_mm, s.q[1] * p.f_mm);
+        return (s.j0[0] * a + s.j0[1] * b, s.j1[0] * a + s.j1[1] * b);
+    }
     let (u, v) = sensor_point(p, i, j);
     if p.dist_model == 0 {
         return flow_mm(p, tw, u, v);
@@ -177,7 +192,13 @@ pub fn px_velocity(p: &FlowParams, du: f32, dv: f32) -> [f32; 2] {
 /// into `field` (the tile's slice, or empty to skip) and returns its sum of speeds (mm/s).
 /// Samples are visited in memory order; thread `lid`'s register sum gets the
 /// same terms in the same order as on the GPU.
-fn tile(p: &FlowParams, tw: &TwistGpu, tile: u32, field: &mut [[f32; 2]]) -> f32 {
+fn tile(
+    p: &FlowParams,
+    lens: &[LensSample],
+    tw: &TwistGpu,
+    tile: u32,
+    field: &mut [[f32; 2]],
+) -> f32 {
     let n = p.grid_w * p.grid_h;
     let base = tile * TILE;
     let mut sums = [0f32; WG as usize];
@@ -188,7 +209,7 @@ fn tile(p: &FlowParams, tw: &TwistGpu, tile: u32, field: &mut [[f32; 2]]) -> f32
             if base + off >= n {
                 break 'chunk;
             }
-            let (du, dv) = sample_flow(p, tw, i, j);
+            let (du, dv) = sample_flow(p, lens, tw, i, j);
             *acc += (du * du + dv * dv).sqrt();
             if let Some(f) = field.get_mut(off as usize) {
                 *f = px_velocity(p, du, dv);
@@ -208,13 +229,19 @@ fn tile(p: &FlowParams, tw: &TwistGpu, tile: u32, field: &mut [[f32; 2]]) -> f32
 pub struct FieldMean {
     /// Per-sample flow `[u, v]` in px/s; empty when not requested.
     pub field: Vec<[f32; 2]>,
-    /// Mean speed, mm/s (partials summed in f64).
+    /// Mean speed, mm/s (partials summed in f64, over the valid samples).
     pub mean_mm_s: f64,
 }
 
-/// Twin of `flow_tiles` for one twist, on the current rayon pool (tiles in parallel).
-pub fn flow_tiles(grid: &Grid, tw: &TwistGpu, with_field: bool) -> FieldMean {
+/// Twin of `flow_tiles` for one twist, on the current rayon pool (tiles in
+/// parallel), with the grid's lens table when it uses one
+/// ([`LensTable::cached`]; its errors are this function's): masked samples
+/// are 0 in the field (as on the GPU) and out of the mean.
+pub fn flow_tiles(grid: &Grid, tw: &TwistGpu, with_field: bool) -> Result<FieldMean> {
+    let lens = LensTable::cached(grid)?;
+    let lens = lens.as_deref();
     let p = grid.params(1, with_field);
+    let table = lens.map_or(&[][..], |t| &t.samples);
     let n = grid.len();
     let mut field = if with_field {
         vec![[0f32; 2]; n]
@@ -232,29 +259,30 @@ pub fn flow_tiles(grid: &Grid, tw: &TwistGpu, with_field: bool) -> FieldMean {
                 if stop.is_cancelled() {
                     return 0.0;
                 }
-                tile(&p, tw, t as u32, f)
+                tile(&p, table, tw, t as u32, f)
             })
             .collect()
     } else {
         (0..p.tiles)
             .into_par_iter()
-            .map(|t| tile(&p, tw, t, &mut []))
+            .map(|t| tile(&p, table, tw, t, &mut []))
             .collect()
     };
     let total: f64 = partials.iter().map(|&x| x as f64).sum();
-    FieldMean {
+    Ok(FieldMean {
         field,
-        mean_mm_s: total / n as f64,
-    }
+        mean_mm_s: total / valid_len(grid, lens) as f64,
+    })
 }
 
-/// Twin of `rows_per_twist`: the row sums of speeds (mm/s) of one twist.
-pub fn rows_per_twist(p: &FlowParams, tw: &TwistGpu) -> Vec<f32> {
+/// Twin of `rows_per_twist`: the row sums of speeds (mm/s) of one twist
+/// (`lens`: the grid's [`LensTable::samples`] in table mode).
+pub fn rows_per_twist(p: &FlowParams, lens: &[LensSample], tw: &TwistGpu) -> Vec<f32> {
     (0..p.grid_h)
         .map(|j| {
             let mut row = 0f32;
             for i in 0..p.grid_w {
-                let (du, dv) = sample_flow(p, tw, i, j);
+                let (du, dv) = sample_flow(p, lens, tw, i, j);
                 row += (du * du + dv * dv).sqrt();
             }
             row
@@ -262,34 +290,46 @@ pub fn rows_per_twist(p: &FlowParams, tw: &TwistGpu) -> Vec<f32> {
         .collect()
 }
 
-/// Batched means (mm/s) like the GPU batch path, f32 twin, rayon over twists.
-pub fn batch_means(grid: &Grid, twists: &[TwistGpu]) -> Vec<f64> {
+/// Batched means (mm/s) like the GPU batch path, f32 twin, rayon over
+/// twists; the lens table as in [`flow_tiles`].
+pub fn batch_means(grid: &Grid, twists: &[TwistGpu]) -> Result<Vec<f64>> {
+    let lens = LensTable::cached(grid)?;
+    let lens = lens.as_deref();
     let p = grid.params(twists.len() as u32, false);
-    let n = grid.len() as f64;
-    twists
+    let table = lens.map_or(&[][..], |t| &t.samples);
+    let n = valid_len(grid, lens) as f64;
+    Ok(twists
         .par_iter()
         .map(|tw| {
-            rows_per_twist(&p, tw)
+            rows_per_twist(&p, table, tw)
                 .iter()
                 .map(|&x| x as f64)
                 .sum::<f64>()
                 / n
         })
-        .collect()
+        .collect())
 }
 
 /// f64 reference: the field (px/s) at the grid's cell centres from
 /// [`Camera::pixel_to_mm`], [`flow_distorted`] (the library's f64 undistortion
-/// and Jacobian) and [`Camera::mm_to_px_velocity`], and the mean speed (mm/s).
+/// and Jacobian) and [`Camera::mm_to_px_velocity`], and the mean speed (mm/s)
+/// over the samples within the radial distortion limit (NaN in the field
+/// beyond it).
 pub fn reference_f64(grid: &Grid, tw: &Twist, plane: Option<&Plane>) -> (Vec<[f64; 2]>, f64) {
     let c: &Camera = &grid.camera;
     let (sx, sy) = grid.step();
     let mut field = Vec::with_capacity(grid.len());
     let mut sum = 0.0;
+    let mut n = 0usize;
     for j in 0..grid.height {
         let mut row = 0.0;
         for i in 0..grid.width {
             let (ud, vd) = c.pixel_to_mm((i as f64 + 0.5) * sx, (j as f64 + 0.5) * sy);
+            if c.is_masked_mm(ud, vd) {
+                field.push([f64::NAN; 2]);
+                continue;
+            }
+            n += 1;
             let (du, dv) = flow_distorted(c, ud, vd, tw, plane).unwrap_or((f64::NAN, f64::NAN));
             row += du.hypot(dv);
             let (a, b) = c.mm_to_px_velocity(du, dv);
@@ -297,7 +337,7 @@ pub fn reference_f64(grid: &Grid, tw: &Twist, plane: Option<&Plane>) -> (Vec<[f6
         }
         sum += row;
     }
-    (field, sum / grid.len() as f64)
+    (field, sum / n as f64)
 }
 
 #[cfg(test)]
@@ -328,7 +368,7 @@ mod tests {
             d: 1.5,
         };
         let g = TwistGpu::new(cam.focal_mm, &tw, Some(&plane));
-        let twin = flow_tiles(&grid, &g, true);
+        let twin = flow_tiles(&grid, &g, true).unwrap();
         let (reff, mean) = reference_f64(&grid, &tw, Some(&plane));
         let max = reff.iter().map(|a| a[0].hypot(a[1])).fold(0.0, f64::max);
         for (a, b) in twin.field.iter().zip(&reff) {
@@ -336,7 +376,7 @@ mod tests {
             assert!((a[1] as f64 - b[1]).abs() < 1e-6 * max, "{a:?} {b:?}");
         }
         assert!((twin.mean_mm_s - mean).abs() < 1e-6 * mean);
-        let rows = batch_means(&grid, &[g]);
+        let rows = batch_means(&grid, &[g]).unwrap();
         assert!((rows[0] - mean).abs() < 1e-6 * mean);
     }
 }

@@ -2,12 +2,13 @@
 //! buffers and dispatches them. CPU twins: [`super::cpu`].
 
 use super::kernel::{FlowParams, Grid, TwistGpu, MAX_DISPATCH, WG};
+use super::table::{valid_len, LensTable};
 use crate::error::{Error, Result};
 use crate::gpu::compute::{
     self, ensure, read_back, storage_entry, uniform_entry, Buf, READ, STORAGE_DST, STORAGE_SRC,
 };
 use crate::gpu::{gpu, GpuContext};
-use std::sync::OnceLock;
+use std::sync::{Arc, OnceLock};
 
 /// The WGSL source of the flow kernels.
 pub const FIELD_WGSL: &str = include_str!("../../shaders/field.wgsl");
@@ -29,6 +30,7 @@ fn build(ctx: &GpuContext) -> Result<Kernels> {
         storage_entry(1, true),
         storage_entry(2, false),
         storage_entry(3, false),
+        storage_entry(4, true),
     ];
     let p = compute::build(
         ctx,
@@ -70,6 +72,10 @@ pub struct FlowRunner {
     partials: Option<Buf>,
     field_read: Option<Buf>,
     partials_read: Option<Buf>,
+    /// The lens table on the device (one dummy entry without a table) and
+    /// the grid it is for.
+    lens: Option<Buf>,
+    lens_for: Option<Grid>,
 }
 
 impl FlowRunner {
@@ -91,7 +97,36 @@ impl FlowRunner {
             partials: None,
             field_read: None,
             partials_read: None,
+            lens: None,
+            lens_for: None,
         })
+    }
+
+    /// The lens table of `grid` when it uses one ([`LensTable::cached`]),
+    /// uploaded to the device once per grid and camera; without one a dummy
+    /// entry is bound.
+    pub fn lens(&mut self, grid: &Grid) -> Result<Option<Arc<LensTable>>> {
+        let table = LensTable::cached(grid)?;
+        let uploaded = self.lens.is_some() && (table.is_none() || self.lens_for == Some(*grid));
+        if !uploaded {
+            let bytes: &[u8] = match &table {
+                Some(t) => bytemuck::cast_slice(&t.samples),
+                None => &[0u8; 24],
+            };
+            self.lens_for = None;
+            let buf = ensure(
+                self.ctx,
+                &mut self.lens,
+                bytes.len() as u64,
+                STORAGE_DST,
+                "flow lens table",
+            )?;
+            self.ctx.queue.write_buffer(buf, 0, bytes);
+            if table.is_some() {
+                self.lens_for = Some(*grid);
+            }
+        }
+        Ok(table)
     }
 
     /// `name (backend, type)` of the adapter.
@@ -148,10 +183,11 @@ impl FlowRunner {
                 "flow field readback",
             )?;
         }
-        let (tw_buf, part, field) = match (&self.twists, &self.partials, &self.field) {
-            (Some(a), Some(b), Some(c)) => (&a.buf, &b.buf, &c.buf),
-            _ => return Err(Error::Gpu("flow buffers missing".into())),
-        };
+        let (tw_buf, part, field, lens) =
+            match (&self.twists, &self.partials, &self.field, &self.lens) {
+                (Some(a), Some(b), Some(c), Some(d)) => (&a.buf, &b.buf, &c.buf, &d.buf),
+                _ => return Err(Error::Gpu("flow buffers missing".into())),
+            };
         ctx.queue
             .write_buffer(&self.params, 0, bytemuck::bytes_of(p));
         ctx.queue.write_buffer(tw_buf, 0, tw_bytes);
@@ -174,6 +210,10 @@ impl FlowRunner {
                 wgpu::BindGroupEntry {
                     binding: 3,
                     resource: part.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 4,
+                    resource: lens.as_entire_binding(),
                 },
             ],
         });
@@ -210,7 +250,7 @@ impl FlowRunner {
     }
 
     /// `flow_tiles` for up to `MAX_DISPATCH` twists: per twist the sum of
-    /// speeds (mm/s) over the grid, as f32 tile partials summed in f64, and
+    /// speeds (mm/s) over the grid (masked samples add 0: [`FlowRunner::lens`]), as f32 tile partials summed in f64, and
     /// (one twist, `with_field`) the field in px/s.
     pub fn tiles(
         &mut self,
@@ -237,6 +277,7 @@ impl FlowRunner {
                 format!("{n} twists: need 1..={MAX_DISPATCH}, and exactly 1 with a field"),
             ));
         }
+        self.lens(grid)?;
         let p = grid.params(n, with_field);
         let n_partials = n as u64 * p.tiles as u64;
         if n_partials >= u32::MAX as u64 {
@@ -268,6 +309,7 @@ impl FlowRunner {
                 format!("{n} twists: need 1..={}", MAX_DISPATCH * WG),
             ));
         }
+        self.lens(grid)?;
         let p = grid.params(n as u32, false);
         let n_partials = n * grid.height as u64;
         let groups = (n as u32).div_ceil(WG);
@@ -278,10 +320,11 @@ impl FlowRunner {
             .collect())
     }
 
-    /// Mean speed (mm/s) per twist over `grid`, any number of twists: small
-    /// grids with `rows_per_twist`, larger ones with `flow_tiles`, in chunks.
+    /// Mean speed (mm/s) per twist over `grid` (its valid samples: masked
+    /// ones are out of the mean), any number of twists: small grids with
+    /// `rows_per_twist`, larger ones with `flow_tiles`, in chunks.
     pub fn batch_means(&mut self, grid: &Grid, twists: &[TwistGpu]) -> Result<Vec<f64>> {
-        let n = grid.len() as f64;
+        let n = valid_len(grid, self.lens(grid)?.as_deref()) as f64;
         let mut out = Vec::with_capacity(twists.len());
         if grid.len() <= ROWS_KERNEL_MAX_SAMPLES {
             for c in twists.chunks(16_384) {

@@ -1,5 +1,6 @@
-//! Host-side structs shared with `shaders/field.wgsl` (`Params`, `Twist`), with
-//! layout asserts, and the sample grid they describe.
+//! Host-side structs shared with `shaders/field.wgsl` (`Params`, `Twist`;
+//! `LensSample` is in [`super::table`]), with layout asserts, and the sample
+//! grid they describe.
 
 use crate::camera::Camera;
 use crate::error::{Error, Result};
@@ -47,7 +48,8 @@ pub struct FlowParams {
     pub tiles_x: u32,
     /// 1 to write the field (one twist), else 0.
     pub write_field: u32,
-    /// Lens distortion model: 0 none, 1 OpenCV, 2 fisheye.
+    /// Lens distortion model: 0 none, 1 OpenCV, 2 fisheye, 3 the lens table
+    /// (every other model, and masked cameras: [`super::table`]).
     pub dist_model: u32,
     /// Padding (to align `dist`).
     pub pad0: u32,
@@ -114,6 +116,8 @@ pub struct Grid {
     pub width: u32,
     /// Rows.
     pub height: u32,
+    /// The kernel reads a lens table ([`Grid::uses_table`]).
+    table: bool,
 }
 
 impl Grid {
@@ -121,26 +125,6 @@ impl Grid {
     /// Rejects a half-zero size and grids of 2^32 samples or more.
     pub fn new(camera: &Camera, width: u32, height: u32) -> Result<Self> {
         camera.validate()?;
-        if camera.distortion.coefficients().is_none() {
-            return Err(Error::invalid(
-                "distortion",
-                format!(
-                    "the {} model is not in the GPU kernel (it has opencv with k1, k2, p1, \
-                     p2, k3 and opencv_fisheye): use a CPU method (riemann, gauss, exact)",
-                    camera.distortion.name()
-                ),
-            ));
-        }
-        if camera.masked_fraction() > 0.0 {
-            return Err(Error::invalid(
-                "distortion",
-                format!(
-                    "{:.3} % of the sensor lies beyond the lens's radial distortion limit; the \
-                     GPU kernel does not mask: use a CPU method (riemann, gauss, exact)",
-                    100.0 * camera.masked_fraction()
-                ),
-            ));
-        }
         let (w, h) = match (width, height) {
             (0, 0) => (camera.width, camera.height),
             (0, _) | (_, 0) => {
@@ -162,7 +146,16 @@ impl Grid {
             camera: *camera,
             width: w,
             height: h,
+            table: camera.distortion.coefficients().is_none() || camera.masked_fraction() > 0.0,
         })
+    }
+
+    /// True when the kernel reads a lens table (`dist_model` 3,
+    /// [`super::table::LensTable`]): for the models without an analytic
+    /// path in the kernel, and for every camera with a radial distortion
+    /// limit that masks part of the sensor.
+    pub fn uses_table(&self) -> bool {
+        self.table
     }
 
     /// Number of samples.
@@ -193,7 +186,10 @@ impl Grid {
         let c = &self.camera;
         let (sx, sy) = self.step();
         let tiles = self.tiles();
-        let (model, k) = c.distortion.coefficients().unwrap_or((0, [0.0; 5]));
+        let (model, k) = match c.distortion.coefficients() {
+            Some(m) if !self.table => m,
+            _ => (3, [0.0; 5]),
+        };
         FlowParams {
             f_mm: c.focal_mm as f32,
             pitch_x: c.pitch_x_mm as f32,

@@ -10,15 +10,23 @@
 //! The field is computed in f32; per-thread and per-workgroup sums are f32
 //! (at most 32 and 64 terms), and the partial sums are added in f64 on the
 //! host.
+//!
+//! Lens distortion: the kernel has OpenCV's five-coefficient model and the
+//! fisheye analytically; every other model (and any camera with a radial
+//! distortion limit that masks part of the sensor) runs in table mode, where
+//! the host gives the kernel each sample's undistorted point and Jacobian
+//! ([`LensTable`]). Masked samples are out of the mean and NaN in the field.
 
 pub mod cpu;
 pub(crate) mod gpu;
 pub(crate) mod kernel;
+pub(crate) mod table;
 
 pub use crate::gpu::Backend;
 pub use cpu::FieldMean;
 pub use gpu::FlowRunner;
 pub use kernel::{FlowParams, Grid, TwistGpu};
+pub use table::{LensSample, LensTable};
 
 use crate::error::{Error, Result};
 use crate::gpu::Resolved;
@@ -37,6 +45,9 @@ pub struct FlowField {
     pub u: Vec<f32>,
     /// Vertical flow, px/s (+ down).
     pub v: Vec<f32>,
+    /// The share of the samples beyond the lens's radial distortion limit:
+    /// NaN in `u` and `v`, out of the mean (0 without a limit).
+    pub masked: f64,
     /// Mean speed of the field's samples: `mm_s` on the sensor, `px_s` the
     /// mean of [`FlowField::speed`] (the true pixel speed; `mm_s / pitch`
     /// with square, unskewed pixels).
@@ -56,11 +67,22 @@ impl FlowField {
 
 /// The MMBM of a field's samples: `mean_mm_s`, and in px/s `mean_mm_s / pitch`
 /// with square pixels, else the mean of the samples' px/s speeds `field`
-/// (which [`needs_field`] says must then be computed).
-fn to_mmbm(scene: &Scene, mean_mm_s: f64, grid: &Grid, field: &[[f32; 2]]) -> Result<Mmbm> {
+/// (which [`needs_field`] says must then be computed) over the valid ones
+/// (`lens`: masked samples are out of the mean).
+fn to_mmbm(
+    scene: &Scene,
+    mean_mm_s: f64,
+    grid: &Grid,
+    field: &[[f32; 2]],
+    lens: Option<&LensTable>,
+) -> Result<Mmbm> {
     let px_s = if needs_field(scene) {
-        let sum: f64 = field.iter().map(|x| x[0].hypot(x[1]) as f64).sum();
-        let px = sum / field.len() as f64;
+        let ok = |k: usize| lens.is_none_or(|t| t.valid[k]);
+        let sum: f64 = (0..field.len())
+            .filter(|&k| ok(k))
+            .map(|k| field[k][0].hypot(field[k][1]) as f64)
+            .sum();
+        let px = sum / table::valid_len(grid, lens) as f64;
         if !px.is_finite() {
             return Err(Error::invalid(
                 "MMBM",
@@ -114,10 +136,12 @@ pub fn flow_field(
         ));
     }
     let g = TwistGpu::new(scene.camera.focal_mm, tw, scene.plane.as_ref());
-    let (mean, field) = match backend.resolve("flow field", "twin", &ANNOUNCED)? {
+    let lens = LensTable::cached(&grid)?;
+    let lens = lens.as_deref();
+    let (mean, mut field) = match backend.resolve("flow field", "twin", &ANNOUNCED)? {
         Resolved::Gpu(_) => {
             let (sums, field) = FlowRunner::new()?.tiles(&grid, &[g], true)?;
-            (sums[0] / grid.len() as f64, field)
+            (sums[0] / table::valid_len(&grid, lens) as f64, field)
         }
         Resolved::Cpu(threads) => {
             let run = || cpu::flow_tiles(&grid, &g, true);
@@ -128,7 +152,7 @@ pub fn flow_field(
                     .build()
                     .map_err(|e| Error::invalid("threads", e.to_string()))?
                     .install(run),
-            };
+            }?;
             (f.mean_mm_s, f.field)
         }
     };
@@ -144,12 +168,21 @@ pub fn flow_field(
             "the flow field overflows f32 (velocities too large for the sensor); nothing written",
         ));
     }
+    let mmbm = to_mmbm(scene, mean, &grid, &field, lens)?;
+    if let Some(t) = lens {
+        for (x, ok) in field.iter_mut().zip(&t.valid) {
+            if !ok {
+                *x = [f32::NAN; 2];
+            }
+        }
+    }
     Ok(FlowField {
         width: grid.width,
         height: grid.height,
         u: field.iter().map(|x| x[0]).collect(),
         v: field.iter().map(|x| x[1]).collect(),
-        mmbm: to_mmbm(scene, mean, &grid, &field)?,
+        masked: lens.map_or(0.0, LensTable::masked_share),
+        mmbm,
     })
 }
 
@@ -159,20 +192,22 @@ pub fn flow_field_gpu(scene: &Scene, tw: &Twist, w: u32, h: u32) -> Result<FlowF
 }
 
 /// MMBM on the GPU: the mean flow speed over a `w x h` grid of cell centres
-/// (`0 x 0`: every pixel centre of the sensor), without writing the field.
-/// Validates the scene.
+/// (`0 x 0`: every pixel centre of the sensor; those beyond the lens's
+/// radial distortion limit left out), without writing the field. Validates
+/// the scene.
 pub fn mmbm_gpu(scene: &Scene, tw: &Twist, w: u32, h: u32) -> Result<Mmbm> {
     scene.validate_for(tw)?;
     let grid = Grid::new(&scene.camera, w, h)?;
     let g = TwistGpu::new(scene.camera.focal_mm, tw, scene.plane.as_ref());
     let mut r = FlowRunner::new()?;
+    let lens = r.lens(&grid)?;
     let (sums, field) = r.tiles(&grid, &[g], needs_field(scene))?;
-    let mean = sums[0] / grid.len() as f64;
+    let mean = sums[0] / table::valid_len(&grid, lens.as_deref()) as f64;
     if !mean.is_finite() {
         return Err(Error::invalid(
             "motion",
             format!("MMBM is {mean}: the flow overflows f32 on the GPU"),
         ));
     }
-    to_mmbm(scene, mean, &grid, &field)
+    to_mmbm(scene, mean, &grid, &field, lens.as_deref())
 }

@@ -67,7 +67,8 @@ pub struct Arrow {
 }
 
 /// The arrows of a quiver plot and their magnification: flow (px/s) at the
-/// centres of an `ARROWS_PER_ROW`-wide grid of blocks, times the exposure
+/// centres of an `ARROWS_PER_ROW`-wide grid of blocks (none where the field
+/// is NaN: masked beyond the lens's radial distortion limit), times the exposure
 /// (s), times the largest 1-2-5 factor that keeps the longest arrow within
 /// 0.9 of the arrow spacing (1 when the field is zero).
 pub fn arrows(camera: &Camera, u: &[f32], v: &[f32], exposure_s: f64) -> Result<(Vec<Arrow>, f64)> {
@@ -93,6 +94,10 @@ pub fn arrows(camera: &Camera, u: &[f32], v: &[f32], exposure_s: f64) -> Result<
             let px = (((i as f64 + 0.5) * w as f64 / nx as f64) as usize).min(w - 1);
             let py = (((j as f64 + 0.5) * h as f64 / ny as f64) as usize).min(h - 1);
             let (a, b) = (u[py * w + px] as f64, v[py * w + px] as f64);
+            if a.is_nan() && b.is_nan() {
+                // Masked (beyond the lens's radial distortion limit): no arrow.
+                continue;
+            }
             if !(a.is_finite() && b.is_finite()) {
                 return Err(Error::invalid(
                     "quiver field",
@@ -141,13 +146,15 @@ pub fn quiver_png(
 ) -> Result<()> {
     let (arrows, mag) = arrows(camera, field_u, field_v, exposure_s)?;
     crate::plot::ensure_font()?;
-    let n = field_u.len() as f64;
-    let mean = field_u
-        .iter()
-        .zip(field_v)
-        .map(|(a, b)| (*a as f64).hypot(*b as f64))
-        .sum::<f64>()
-        / n;
+    // The mean over the samples with a flow (masked ones are NaN).
+    let speeds = || {
+        field_u
+            .iter()
+            .zip(field_v)
+            .map(|(a, b)| (*a as f64).hypot(*b as f64))
+            .filter(|s| !s.is_nan())
+    };
+    let mean = speeds().sum::<f64>() / speeds().count().max(1) as f64;
     let vmax = arrows.iter().map(|a| a.speed).fold(0.0, f64::max);
     let (w, h) = (camera.width as f64, camera.height as f64);
     // Arrows start at block centres and are at most 0.9 spacing long.

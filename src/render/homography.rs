@@ -165,6 +165,9 @@ pub fn lens_derivatives(
 /// the Jacobian of the undistortion map (pixel to pinhole pixel) there, in
 /// f64 from [`Camera::pixel_to_ray`] and the distortion's Jacobian. `None`
 /// for a pinhole camera; an error names a pixel that does not undistort.
+/// A pixel beyond the lens's radial distortion limit ([`masked_pixels`])
+/// sees no ray: its entry is the identity at its own centre, a placeholder
+/// whose colour the renderer replaces by 0.
 pub fn pixel_maps(cam: &Camera) -> crate::error::Result<Option<Vec<GpuHomography>>> {
     if cam.distortion.is_none() {
         return Ok(None);
@@ -190,6 +193,15 @@ pub fn pixel_maps(cam: &Camera) -> crate::error::Result<Option<Vec<GpuHomography
     for j in 0..cam.height {
         for i in 0..cam.width {
             let (x, y) = (i as f64 + 0.5, j as f64 + 0.5);
+            let (ud, vd) = cam.pixel_to_mm(x, y);
+            if cam.is_masked_mm(ud, vd) {
+                out.push(GpuHomography {
+                    h0: [x as f32, y as f32, 1.0, 0.0],
+                    h1: [0.0, 1.0, 0.0, 0.0],
+                    h2: [0.0; 4],
+                });
+                continue;
+            }
             let (rx, ry) = cam.pixel_to_ray(x, y).ok_or_else(|| {
                 crate::error::Error::invalid(
                     "distortion",
@@ -212,6 +224,24 @@ pub fn pixel_maps(cam: &Camera) -> crate::error::Result<Option<Vec<GpuHomography
         }
     }
     Ok(Some(out))
+}
+
+/// Per pixel (row-major), true where its centre lies beyond the lens's
+/// radial distortion limit ([`Camera::is_masked_mm`]): no ray, black (0) in
+/// a rendered image before sensor noise, NaN in the blur maps. `None` when
+/// no pixel is masked.
+pub fn masked_pixels(cam: &Camera) -> Option<Vec<bool>> {
+    if cam.distortion.is_none() || cam.masked_fraction() == 0.0 {
+        return None;
+    }
+    let mask: Vec<bool> = (0..cam.height)
+        .flat_map(|j| (0..cam.width).map(move |i| (i, j)))
+        .map(|(i, j)| {
+            let (ud, vd) = cam.pixel_to_mm(i as f64 + 0.5, j as f64 + 0.5);
+            cam.is_masked_mm(ud, vd)
+        })
+        .collect();
+    mask.iter().any(|&m| m).then_some(mask)
 }
 
 /// The pixel box outside which the target is never seen during the exposure

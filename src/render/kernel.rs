@@ -31,7 +31,7 @@ use super::texture::MipTexture;
 use crate::board::{BLOB_RED, BOARD_WHITE};
 use crate::camera::Camera;
 
-pub use super::homography::{homographies, pixel_maps, target_bbox};
+pub use super::homography::{homographies, masked_pixels, pixel_maps, target_bbox};
 pub use super::layout::{RenderParams, KIND_BLOBS, KIND_CHECKER, KIND_IMAGE, LOD_SCALE};
 
 /// The defocus parameters ([`RenderParams::lens`]): the aperture radius is

@@ -3,7 +3,8 @@
 //! its image path length (px), end-to-start displacement (px) and
 //! time-averaged image speed (px/s = path / duration). Their sensor means are
 //! the "exposure MMBM". Pixels whose scene point is missing (ray misses the
-//! target, or the point goes behind the camera) are NaN and left out of the means.
+//! target, or the point goes behind the camera, or the pixel lies beyond the
+//! lens's radial distortion limit) are NaN and left out of the means.
 
 use super::target::Target;
 use super::trajectory::{Pose, Trajectory};
@@ -26,6 +27,9 @@ pub struct BlurMaps {
     pub disp_px: Vec<f32>,
     /// Time-averaged image speed, px/s.
     pub speed_px_s: Vec<f32>,
+    /// Time-averaged image speed on the sensor, mm/s (the same path in mm:
+    /// `speed_px_s` times the pitch with square, unskewed pixels).
+    pub speed_mm_s: Vec<f32>,
 }
 
 /// Sensor means of [`BlurMaps`] (NaN pixels left out).
@@ -37,6 +41,8 @@ pub struct BlurMeans {
     pub disp_px: f64,
     /// Mean speed, px/s (the exposure MMBM in px/s).
     pub speed_px_s: f64,
+    /// Mean speed, mm/s (the exposure MMBM in mm/s).
+    pub speed_mm_s: f64,
     /// Share of pixels with a valid track (0..1).
     pub valid: f64,
 }
@@ -58,13 +64,14 @@ impl BlurMaps {
 
     /// Sensor means, f64 accumulation.
     pub fn means(&self) -> BlurMeans {
-        let mut s = [0.0f64; 3];
+        let mut s = [0.0f64; 4];
         let mut n = 0usize;
         for i in 0..self.path_px.len() {
             if self.path_px[i].is_finite() {
                 s[0] += self.path_px[i] as f64;
                 s[1] += self.disp_px[i] as f64;
                 s[2] += self.speed_px_s[i] as f64;
+                s[3] += self.speed_mm_s[i] as f64;
                 n += 1;
             }
         }
@@ -73,10 +80,14 @@ impl BlurMaps {
             path_px: s[0] / d,
             disp_px: s[1] / d,
             speed_px_s: s[2] / d,
+            speed_mm_s: s[3] / d,
             valid: n as f64 / self.path_px.len().max(1) as f64,
         }
     }
 }
+
+/// A pixel without a track: path, displacement (px) and path (mm) NaN.
+const NO_TRACK: (f32, f32, f64) = (f32::NAN, f32::NAN, f64::NAN);
 
 /// Poses at `steps + 1` uniform times, as (world-to-camera rotation, centre).
 fn inv_poses(traj: &Trajectory, steps: usize) -> Vec<(DMat3, DVec3)> {
@@ -132,18 +143,23 @@ fn track_from(
     x: f64,
     y: f64,
 ) -> Option<Vec<(f64, f64)>> {
+    if masked(cam, x, y) {
+        return None;
+    }
     let id: Pose = (glam::DQuat::IDENTITY, DVec3::ZERO);
     let p0 = target.intersect(cam, &id, x, y)?;
     poses.iter().map(|p| proj(cam, p, p0)).collect()
 }
 
+/// Path length and end-to-start displacement (px) and path length on the
+/// sensor (mm) of the scene point seen at `(x, y)` at exposure start.
 fn path_disp(
     cam: &Camera,
     target: &Target,
     poses: &[(DMat3, DVec3)],
     x: f64,
     y: f64,
-) -> Option<(f64, f64)> {
+) -> Option<(f64, f64, f64)> {
     let id: Pose = (glam::DQuat::IDENTITY, DVec3::ZERO);
     path_disp_from(cam, target, &id, poses, x, y)
 }
@@ -156,20 +172,35 @@ fn path_disp_from(
     poses: &[(DMat3, DVec3)],
     x: f64,
     y: f64,
-) -> Option<(f64, f64)> {
+) -> Option<(f64, f64, f64)> {
+    if masked(cam, x, y) {
+        return None;
+    }
     let p0 = target.intersect(cam, start, x, y)?;
     let first = proj(cam, &poses[0], p0)?;
     let mut prev = first;
-    let mut len = 0.0;
+    let (mut len, mut len_mm) = (0.0, 0.0);
     for p in &poses[1..] {
         let q = proj(cam, p, p0)?;
         len += ((q.0 - prev.0).powi(2) + (q.1 - prev.1).powi(2)).sqrt();
+        let (a, b) = (cam.pixel_to_mm(q.0, q.1), cam.pixel_to_mm(prev.0, prev.1));
+        len_mm += (a.0 - b.0).hypot(a.1 - b.1);
         prev = q;
     }
     Some((
         len,
         ((prev.0 - first.0).powi(2) + (prev.1 - first.1).powi(2)).sqrt(),
+        len_mm,
     ))
+}
+
+/// True for a pixel position beyond the lens's radial distortion limit: no ray.
+fn masked(cam: &Camera, x: f64, y: f64) -> bool {
+    if cam.distortion.is_none() {
+        return false;
+    }
+    let (ud, vd) = cam.pixel_to_mm(x, y);
+    cam.is_masked_mm(ud, vd)
 }
 
 /// Largest image path length (px) over the sensor: points on a 33 x 25 grid
@@ -183,7 +214,7 @@ pub fn max_path_px(cam: &Camera, target: &Target, traj: &Trajectory) -> f64 {
         for i in 0..nx {
             let x = cam.width as f64 * i as f64 / (nx - 1) as f64;
             let y = cam.height as f64 * j as f64 / (ny - 1) as f64;
-            if let Some((l, _)) = path_disp(cam, target, &poses, x, y) {
+            if let Some((l, _, _)) = path_disp(cam, target, &poses, x, y) {
                 m = m.max(l);
             }
         }
@@ -222,16 +253,16 @@ pub fn blur_maps(
     // Once a stop is requested (crate::cancel) the pixels left are NaN; the
     // caller checks the token and drops the maps.
     let stop = crate::cancel::current();
-    let vals: Vec<(f32, f32)> = (0..w * h)
+    let vals: Vec<(f32, f32, f64)> = (0..w * h)
         .into_par_iter()
         .map(|idx| {
             if stop.is_cancelled() {
-                return (f32::NAN, f32::NAN);
+                return NO_TRACK;
             }
             let (i, j) = (idx % w, idx / w);
             match path_disp(cam, target, &poses, i as f64 + 0.5, j as f64 + 0.5) {
-                Some((l, d)) => (l as f32, d as f32),
-                None => (f32::NAN, f32::NAN),
+                Some((l, d, mm)) => (l as f32, d as f32, mm),
+                None => NO_TRACK,
             }
         })
         .collect();
@@ -242,6 +273,7 @@ pub fn blur_maps(
         path_px: vals.iter().map(|v| v.0).collect(),
         disp_px: vals.iter().map(|v| v.1).collect(),
         speed_px_s: vals.iter().map(|v| (v.0 as f64 / dur) as f32).collect(),
+        speed_mm_s: vals.iter().map(|v| (v.2 / dur) as f32).collect(),
     }
 }
 
@@ -259,11 +291,11 @@ fn blur_maps_rolling(
     let (w, h) = (cam.width as usize, cam.height as usize);
     let (lines, len) = if rows { (h, w) } else { (w, h) };
     let stop = crate::cancel::current();
-    let per_line: Vec<Vec<(f32, f32)>> = (0..lines)
+    let per_line: Vec<Vec<(f32, f32, f64)>> = (0..lines)
         .into_par_iter()
         .map(|l| {
             if stop.is_cancelled() {
-                return vec![(f32::NAN, f32::NAN); len];
+                return vec![NO_TRACK; len];
             }
             let c = l as f64 + 0.5;
             let t0 = cam.shutter.delay_s(c, c, cam.width, cam.height);
@@ -285,8 +317,8 @@ fn blur_maps_rolling(
                         i as f64 + 0.5,
                         j as f64 + 0.5,
                     ) {
-                        Some((a, d)) => (a as f32, d as f32),
-                        None => (f32::NAN, f32::NAN),
+                        Some((a, d, mm)) => (a as f32, d as f32, mm),
+                        None => NO_TRACK,
                     }
                 })
                 .collect()
@@ -294,17 +326,20 @@ fn blur_maps_rolling(
         .collect();
     let mut path = vec![0f32; w * h];
     let mut disp = vec![0f32; w * h];
+    let mut speed_mm = vec![0f32; w * h];
     for (l, vals) in per_line.iter().enumerate() {
         for (m, v) in vals.iter().enumerate() {
             let idx = if rows { l * w + m } else { m * w + l };
             path[idx] = v.0;
             disp[idx] = v.1;
+            speed_mm[idx] = (v.2 / te) as f32;
         }
     }
     BlurMaps {
         width: cam.width,
         height: cam.height,
         duration: te,
+        speed_mm_s: speed_mm,
         speed_px_s: path.iter().map(|&p| (p as f64 / te) as f32).collect(),
         path_px: path,
         disp_px: disp,

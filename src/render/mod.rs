@@ -422,6 +422,14 @@ fn render_frame_stream(job: &RenderJob, stream: u64) -> Result<RenderOutput> {
     // A stop requested during the pass (crate::cancel): the image is partial.
     crate::cancel::check()?;
     let mut rgb = rgb;
+    // Pixels beyond the lens's radial distortion limit see no ray: black.
+    if let Some(mask) = kernel::masked_pixels(cam) {
+        for (px, &m) in rgb.chunks_mut(3).zip(&mask) {
+            if m {
+                px.fill(0.0);
+            }
+        }
+    }
     if let Some(noise) = &cam.noise {
         noise.apply(&mut rgb, job.exposure_s, stream)?;
     }

@@ -3,7 +3,8 @@
 //! line `j` of `n` is exposed over `[t0 + t_r j / n, t0 + t_r j / n + t_e]`,
 //! and the frame's exposure MMBM is the sensor mean of each point's flow
 //! speed averaged over its own line's window (mm/s). Blur length in pixels is
-//! that times `t_e` over the pixel pitch.
+//! the same mean of the true pixel speed (px/s, [`crate::Mmbm::px_s`]: mm/s
+//! over the pitch with square, unskewed pixels) times `t_e`.
 //!
 //! Time: the motion is the renderer's (`render::trajectory`), the twist
 //! interpolated linearly between gyro samples, so at a sensor point the flow
@@ -41,15 +42,18 @@ pub struct FrameMmbm {
     pub readout_s: f64,
     /// Exposure MMBM, mm/s (`None` when the frame's window leaves the log).
     pub exposure_mm_s: Option<f64>,
+    /// Exposure MMBM as the true pixel speed, px/s (the same mean of each
+    /// point's speed in px/s; `exposure_mm_s / pitch` with square, unskewed
+    /// pixels).
+    pub exposure_px_s: Option<f64>,
     /// Instantaneous MMBM at `t_start`, mm/s (`None` outside the log).
     pub start_mm_s: Option<f64>,
 }
 
 impl FrameMmbm {
-    /// Blur length over the exposure, px: exposure MMBM x `t_e` / pitch.
-    pub fn blur_px(&self, cam: &Camera) -> Option<f64> {
-        self.exposure_mm_s
-            .map(|m| crate::camera::blur_px(m, self.exposure_s, cam.pitch_x_mm))
+    /// Blur length over the exposure, px: the exposure MMBM in px/s x `t_e`.
+    pub fn blur_px(&self) -> Option<f64> {
+        self.exposure_px_s.map(|p| p * self.exposure_s)
     }
 }
 
@@ -76,8 +80,11 @@ fn point_flows(cam: &Camera, polys: &[FlowPoly], ud: f64, vd: f64, out: &mut Vec
 }
 
 /// The rule's nodes grouped by line: (delay per second of readout, rule of
-/// that line's nodes with their share of the weights).
-fn line_groups(cam: &Camera, method: Method) -> Result<Vec<(f64, GridRule)>> {
+/// that line's nodes, and the factor that gives its weights their share of
+/// the unmasked sensor's: [`GridRule::distorted`] rescales a lens's line to
+/// weights summing to 1, so its factor is the line's unmasked weight over
+/// every line's; 1 without a lens). Lines masked whole are left out.
+fn line_groups(cam: &Camera, method: Method) -> Result<Vec<(f64, GridRule, f64)>> {
     let rect = cam.sensor_rect();
     let (pts, w) = match method {
         Method::Riemann { nu, nv } => riemann_points(&rect, nu, nv),
@@ -98,10 +105,32 @@ fn line_groups(cam: &Camera, method: Method) -> Result<Vec<(f64, GridRule)>> {
         g.1.push((u, v));
         g.2.push(wk);
     }
-    groups
-        .into_values()
-        .map(|(d, p, w)| Ok((d, GridRule::from_points(&p, &w).distorted(cam)?)))
-        .collect()
+    let lens = !cam.distortion.is_none();
+    let mut out = Vec::with_capacity(groups.len());
+    let mut total = 0.0;
+    for (d, p, w) in groups.into_values() {
+        let kept: f64 = p
+            .iter()
+            .zip(&w)
+            .filter(|(&(u, v), _)| !cam.is_masked_mm(u, v))
+            .map(|(_, &x)| x)
+            .sum();
+        if lens && kept == 0.0 {
+            continue;
+        }
+        total += kept;
+        out.push((d, GridRule::from_points(&p, &w).distorted(cam)?, kept));
+    }
+    if lens && total <= 0.0 {
+        return Err(Error::invalid(
+            "distortion",
+            "every node of the rule lies beyond the lens's radial distortion limit",
+        ));
+    }
+    for g in &mut out {
+        g.2 = if lens { g.2 / total } else { 1.0 };
+    }
+    Ok(out)
 }
 
 /// Exposure MMBM (and the instantaneous MMBM at the start) of every frame.
@@ -126,6 +155,11 @@ pub fn frame_mmbm(
     };
     let t: Vec<f64> = samples.iter().map(|s| s.t).collect();
     let (first, last) = (t[0], t[t.len() - 1]);
+    // Non-square or skewed pixels: the px/s speeds are averaged too.
+    let map = crate::metric::pixel_map(&cam);
+    let to_px = |m: [f64; 4], f: &mut (f64, f64)| {
+        *f = (m[0] * f.0 + m[1] * f.1, m[2] * f.0 + m[3] * f.1);
+    };
     // Buffers reused by every frame: the rule's weights and flows at the
     // samples (grid rules), one point's flows (the `exact` integrand).
     let (mut weights, mut flows) = (Vec::new(), Vec::new());
@@ -156,6 +190,7 @@ pub fn frame_mmbm(
             exposure_s: f.exposure_s,
             readout_s: readout,
             exposure_mm_s: None,
+            exposure_px_s: None,
             start_mm_s: None,
         };
         if a < first || b > last {
@@ -171,13 +206,13 @@ pub fn frame_mmbm(
             .iter()
             .map(|s| sample_scene(s, opts).map(|(tw, sc)| sc.flow_poly(&tw)))
             .collect::<Result<Vec<FlowPoly>>>()?;
-        let (exposure, start) = match &groups {
+        let (exposure, exposure_px, start) = match &groups {
             Some(groups) => {
-                let (mut e, mut start) = (0.0, 0.0);
-                for (delay, rule) in groups {
+                let (mut e, mut e_px, mut start) = (0.0, 0.0, 0.0);
+                for (delay, rule, share) in groups {
                     // Each node's flow at each sample (sample-major), once.
                     weights.clear();
-                    weights.extend(rule.node_flows(&polys[0]).map(|(w, _)| w));
+                    weights.extend(rule.node_flows(&polys[0]).map(|(w, _)| w * share));
                     flows.clear();
                     for p in &polys {
                         flows.extend(rule.node_flows(p).map(|(_, f)| f));
@@ -185,8 +220,12 @@ pub fn frame_mmbm(
                     let w0 = a + readout * delay;
                     e += window_speed(ts, &flows, &weights, w0, w0 + f.exposure_s);
                     start += instant_speed(ts, &flows, &weights, a);
+                    if let Some(m) = map {
+                        flows.iter_mut().for_each(|x| to_px(m, x));
+                        e_px += window_speed(ts, &flows, &weights, w0, w0 + f.exposure_s);
+                    }
                 }
-                (e, start)
+                (e, e_px, start)
             }
             None => {
                 let Method::Exact { tol } = opts.method else {
@@ -196,18 +235,32 @@ pub fn frame_mmbm(
                     readout_s: readout,
                     direction: cam.shutter.direction,
                 };
-                let e = exact_with(
-                    |u, v| {
-                        let (px, py) = cam.mm_to_pixel(u, v);
-                        let w0 = a + shutter.delay_s(px, py, cam.width, cam.height);
-                        let mut buf = point_buf.borrow_mut();
-                        point_flows(&cam, &polys, u, v, &mut buf);
-                        window_speed(ts, &buf, &[1.0], w0, w0 + f.exposure_s)
-                    },
-                    &cam.sensor_rect(),
-                    tol,
-                )
-                .value;
+                // Beyond the lens's radial distortion limit no ray: 0 there,
+                // and the mean over the unmasked share (as `exact` does).
+                let valid = cam.valid_fraction();
+                let window = |m: Option<[f64; 4]>| {
+                    exact_with(
+                        |u, v| {
+                            if cam.is_masked_mm(u, v) {
+                                return 0.0;
+                            }
+                            let (px, py) = cam.mm_to_pixel(u, v);
+                            let w0 = a + shutter.delay_s(px, py, cam.width, cam.height);
+                            let mut buf = point_buf.borrow_mut();
+                            point_flows(&cam, &polys, u, v, &mut buf);
+                            if let Some(m) = m {
+                                buf.iter_mut().for_each(|x| to_px(m, x));
+                            }
+                            window_speed(ts, &buf, &[1.0], w0, w0 + f.exposure_s)
+                        },
+                        &cam.sensor_rect(),
+                        tol,
+                    )
+                    .value
+                        / valid
+                };
+                let e = window(None);
+                let e_px = map.map_or(0.0, |m| window(Some(m)));
                 // The MMBM of the interpolated motion at the start: the
                 // twist (so the flow poly) interpolated to `a`.
                 let k = ts.partition_point(|&s| s <= a).clamp(1, ts.len() - 1) - 1;
@@ -219,7 +272,7 @@ pub fn frame_mmbm(
                     dv: lerp(&polys[k].dv, &polys[k + 1].dv),
                 };
                 let m = crate::metric::mmbm_poly(&cam, &p, opts.method)?.mm_s;
-                (e, m)
+                (e, e_px, m)
             }
         };
         if !(exposure.is_finite() && start.is_finite()) {
@@ -229,13 +282,19 @@ pub fn frame_mmbm(
             ));
         }
         // The blur in px must be a number too (what `blur_px` then gives).
-        crate::camera::checked_blur_px(exposure, f.exposure_s, cam.pitch_x_mm).map_err(|e| {
+        let exposure_px = match map {
+            None => crate::camera::checked_px_s(exposure, cam.pitch_x_mm),
+            Some(_) => Ok(exposure_px),
+        }
+        .and_then(|px| crate::camera::checked_blur_of_px_s(px, f.exposure_s).map(|_| px))
+        .map_err(|e| {
             Error::invalid(
                 format!("frame {k} (t_start = {} s)", f.t_start),
                 e.to_string(),
             )
         })?;
         r.exposure_mm_s = Some(exposure);
+        r.exposure_px_s = Some(exposure_px);
         r.start_mm_s = Some(start);
         out.push(r);
     }
@@ -245,10 +304,10 @@ pub fn frame_mmbm(
 /// The `n` frames with the least blur whose starts are at least `gap_s`
 /// apart (greedy, sharpest first; frames without a value are never chosen),
 /// in frame order.
-pub fn select_sharpest(frames: &[FrameMmbm], cam: &Camera, n: usize, gap_s: f64) -> Vec<usize> {
+pub fn select_sharpest(frames: &[FrameMmbm], n: usize, gap_s: f64) -> Vec<usize> {
     let mut order: Vec<(f64, usize)> = frames
         .iter()
-        .filter_map(|f| f.blur_px(cam).map(|b| (b, f.frame)))
+        .filter_map(|f| f.blur_px().map(|b| (b, f.frame)))
         .collect();
     order.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
     let mut picked: Vec<usize> = Vec::new();

@@ -87,6 +87,23 @@ pub fn sample_mmbm(s: &GyroSample, opts: &SeriesOptions, ev: &Evaluator) -> Resu
     Ok(ev.mean_speed(&scene.flow_poly(&tw)))
 }
 
+/// The MMBM in px/s (the true pixel speed, [`Evaluator::mean_px_speed`])
+/// of one sample whose MMBM in mm/s is `mm_s`, on a camera whose pixels are
+/// not square or are skewed; `None` with square, unskewed pixels (where it
+/// is `mm_s / pitch`).
+pub fn sample_px(
+    s: &GyroSample,
+    opts: &SeriesOptions,
+    ev: &Evaluator,
+    mm_s: f64,
+) -> Result<Option<f64>> {
+    if crate::metric::pixel_map(&opts.scene.camera).is_none() {
+        return Ok(None);
+    }
+    let (tw, scene) = sample_scene(s, opts)?;
+    ev.mean_px_speed(&scene.flow_poly(&tw), mm_s).map(Some)
+}
+
 /// Checks that every value of a batch is a finite MMBM (an overflow of huge
 /// rates gives inf or NaN), naming the first bad sample.
 pub fn check_values(batch: &[GyroSample], values: &[f64]) -> Result<()> {

@@ -12,7 +12,6 @@
 //! k-th image ffmpeg writes is the k-th name of the list.
 
 use super::frames::FrameMmbm;
-use crate::camera::Camera;
 use crate::error::{Error, Result};
 
 /// What [`choose`] keeps: at most `count` frames (all when `None`), each at
@@ -51,11 +50,11 @@ impl Choice {
 
 /// The frames with a value and their blur, px, sharpest first (ties: the
 /// earlier frame first).
-fn by_blur(frames: &[FrameMmbm], cam: &Camera) -> Vec<(f64, usize)> {
+fn by_blur(frames: &[FrameMmbm]) -> Vec<(f64, usize)> {
     let mut order: Vec<(f64, usize)> = frames
         .iter()
         .enumerate()
-        .filter_map(|(k, f)| f.blur_px(cam).map(|b| (b, k)))
+        .filter_map(|(k, f)| f.blur_px().map(|b| (b, k)))
         .collect();
     order.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
     order
@@ -64,12 +63,12 @@ fn by_blur(frames: &[FrameMmbm], cam: &Camera) -> Vec<(f64, usize)> {
 /// The frames `choice` keeps (indices into `frames`, in frame order):
 /// greedy, sharpest first, a frame kept when it is within the blur budget
 /// and at least `gap_s` from every frame already kept, until `count`.
-pub fn choose(frames: &[FrameMmbm], cam: &Camera, choice: &Choice) -> Result<Vec<usize>> {
+pub fn choose(frames: &[FrameMmbm], choice: &Choice) -> Result<Vec<usize>> {
     choice.check()?;
     let mut kept: Vec<usize> = Vec::new();
     // Kept starts, sorted, for the gap test in log time.
     let mut starts: Vec<f64> = Vec::new();
-    for (blur, k) in by_blur(frames, cam) {
+    for (blur, k) in by_blur(frames) {
         if choice.count.is_some_and(|n| kept.len() >= n) {
             break;
         }
@@ -98,8 +97,8 @@ pub fn default_worst(with_value: usize) -> usize {
 
 /// The `n` blurriest frames with a value (indices into `frames`, in frame
 /// order); `None`: [`default_worst`] of the frames with a value.
-pub fn blurriest(frames: &[FrameMmbm], cam: &Camera, n: Option<usize>) -> Vec<usize> {
-    let order = by_blur(frames, cam);
+pub fn blurriest(frames: &[FrameMmbm], n: Option<usize>) -> Vec<usize> {
+    let order = by_blur(frames);
     let n = n.unwrap_or(default_worst(order.len())).min(order.len());
     let mut out: Vec<usize> = order[order.len() - n..].iter().map(|&(_, k)| k).collect();
     out.sort_unstable();
@@ -240,6 +239,7 @@ pub fn ffmpeg_select(frames: &[usize]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::camera::Camera;
 
     fn frames(blur: &[Option<f64>]) -> Vec<FrameMmbm> {
         blur.iter()
@@ -249,8 +249,9 @@ mod tests {
                 t_start: k as f64 * 0.1,
                 exposure_s: 0.01,
                 readout_s: 0.0,
-                // blur_px = mm/s x exposure / pitch
+                // blur_px = px/s x exposure
                 exposure_mm_s: b.map(|b| b * Camera::thesis().pitch_x_mm / 0.01),
+                exposure_px_s: b.map(|b| b / 0.01),
                 start_mm_s: b.map(|_| 0.0),
             })
             .collect()
@@ -258,12 +259,10 @@ mod tests {
 
     #[test]
     fn choose_keeps_the_sharpest_within_gap_and_budget() {
-        let cam = Camera::thesis();
         let f = frames(&[Some(3.0), Some(1.0), Some(2.0), None, Some(0.5), Some(4.0)]);
         let all = |count, gap_s, max_blur_px| {
             choose(
                 &f,
-                &cam,
                 &Choice {
                     count,
                     gap_s,
@@ -282,7 +281,6 @@ mod tests {
         assert_eq!(all(None, 0.0, None), [0, 1, 2, 4, 5]);
         assert!(choose(
             &f,
-            &cam,
             &Choice {
                 count: None,
                 gap_s: -1.0,
@@ -290,9 +288,9 @@ mod tests {
             }
         )
         .is_err());
-        assert_eq!(blurriest(&f, &cam, Some(2)), [0, 5]);
-        assert_eq!(blurriest(&f, &cam, None), [5]);
-        assert_eq!(blurriest(&f, &cam, Some(99)).len(), 5);
+        assert_eq!(blurriest(&f, Some(2)), [0, 5]);
+        assert_eq!(blurriest(&f, None), [5]);
+        assert_eq!(blurriest(&f, Some(99)).len(), 5);
         assert_eq!(
             (default_worst(0), default_worst(10), default_worst(11)),
             (0, 1, 2)

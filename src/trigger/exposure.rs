@@ -12,7 +12,9 @@ use crate::error::Result;
 /// `t_e = clamp(B p / M, TMIN, T)`
 ///
 /// with `M` the MMBM at the decision sample (mm/s, the blur speed the gyro
-/// predicts for the next instants), `p` the pixel pitch (mm), `B` the blur
+/// predicts for the next instants), `p` the pixel pitch (mm; with pixels not
+/// square, the decision sample's mm per px of its true pixel speed,
+/// [`Observation::pitch_mm`], so `M / p` is its px/s), `B` the blur
 /// budget (px), `T` the camera's exposure and `TMIN` the shortest exposure
 /// (s, default 1 ms). The gain is raised by `T / t_e`, so the image is as
 /// bright as at `T`, and as noisy as `t_e`'s photons make it (the sensor noise
@@ -21,7 +23,8 @@ use crate::error::Result;
 /// A policy with a forecast of its own ([`Policy::forecast_exposure_mmbm`]:
 /// `phase`) predicts the MMBM over the coming exposure instead: the exposure
 /// is the longest of [`Exposure::STEPS`] log-spaced ones from `T` down to
-/// `TMIN` whose forecast blur `Ê(t_e) t_e / p` stays within `B` (`TMIN`
+/// `TMIN` whose forecast blur `Ê(t_e) t_e / p` stays within `B` (`p` the
+/// decision sample's, as above; `TMIN`
 /// when none does; the decision sample's rule while the forecast is not
 /// ready).
 ///
@@ -51,11 +54,12 @@ impl Exposure {
         }
     }
 
-    /// The exposure (s) for a blur speed `m` (mm/s) under `timing`.
-    pub fn exposure_for(&self, m: f64, timing: &CameraTiming) -> f64 {
+    /// The exposure (s) for a blur speed `m` (mm/s) on pixels of `pitch_mm`
+    /// (mm per px of the motion) under `timing`.
+    pub fn exposure_for(&self, m: f64, pitch_mm: f64, timing: &CameraTiming) -> f64 {
         let t_max = timing.exposure;
         if m > 0.0 {
-            crate::camera::exposure_for_blur(self.budget_px, m, timing.pitch_mm)
+            crate::camera::exposure_for_blur(self.budget_px, m, pitch_mm)
                 .clamp(self.min_exposure.min(t_max), t_max)
         } else {
             t_max
@@ -68,7 +72,7 @@ impl Exposure {
     /// `None` when it has none now.
     fn forecast_exposure_s(&self, obs: &Observation, t_max: f64) -> Option<f64> {
         let t_min = self.min_exposure.min(t_max);
-        let pitch = obs.timing.pitch_mm;
+        let pitch = obs.pitch_mm;
         let mut ready = false;
         for k in 0..Self::STEPS {
             let te = t_max * (t_min / t_max).powf(k as f64 / (Self::STEPS - 1) as f64);
@@ -110,7 +114,9 @@ impl Policy for Exposure {
         let (t_inner, gain_inner) = self.inner.exposure(obs);
         let te = match self.forecast_exposure_s(obs, t_inner) {
             Some(te) => te,
-            None => self.exposure_for(obs.current(), obs.timing).min(t_inner),
+            None => self
+                .exposure_for(obs.current(), obs.pitch_mm, obs.timing)
+                .min(t_inner),
         };
         (te, gain_inner * t_inner / te)
     }

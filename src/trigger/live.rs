@@ -109,6 +109,13 @@ impl Live {
     /// `mmbm_mm_s` and returns what it produced: a trigger at it, and frames
     /// whose exposure it completed.
     pub fn push(&mut self, t: f64, mmbm_mm_s: f64) -> Result<Vec<Event>> {
+        self.push_px(t, mmbm_mm_s, None)
+    }
+
+    /// [`Live::push`] with the sample's MMBM in px/s too (the true pixel
+    /// speed): pixel budgets convert with its mm per px
+    /// ([`super::policy::Observation::pitch_mm`]), else the timing's pitch.
+    pub fn push_px(&mut self, t: f64, mmbm_mm_s: f64, px_s: Option<f64>) -> Result<Vec<Event>> {
         crate::check::finite("sample time", t)?;
         crate::model::log::check_resolution(t, self.timing.exposure, "the exposure")?;
         if let Some(prev) = self.last_time() {
@@ -161,6 +168,9 @@ impl Live {
             last_trigger: self.last_trigger,
             frames: self.frames,
             timing: &self.timing,
+            pitch_mm: px_s.map_or(self.timing.pitch_mm, |px| {
+                super::run::pixel_pitch(mmbm_mm_s, px, self.timing.pitch_mm)
+            }),
         };
         if self.policy.decide(&obs) && camera_free {
             let (te, gain) = self.policy.exposure(&obs);

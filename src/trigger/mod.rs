@@ -92,7 +92,7 @@ pub use phase::Phase;
 pub use policy::{Level, LogView, Observation, Policy};
 pub use predict::{Forecast, Oracle};
 pub use rules::{Adaptive, Deadline, Fixed, Gate, Threshold};
-pub use run::run;
+pub use run::{run, run_px};
 pub use session::{Policies, Session, SessionConfig, SessionRun};
 pub use stats::{
     prediction_error, summary, summary_over, write_frames, ErrorStats, Summary, Table51,

@@ -36,6 +36,11 @@ pub struct Observation<'a> {
     pub frames: usize,
     /// The camera timing.
     pub timing: &'a CameraTiming,
+    /// Millimetres on the sensor per pixel of the decision sample's motion:
+    /// its MMBM in mm/s over its MMBM in px/s (the true pixel speed,
+    /// `Mmbm::px_s`), what pixel budgets convert with; the timing's pitch
+    /// with square, unskewed pixels (or a still sample).
+    pub pitch_mm: f64,
 }
 
 impl Observation<'_> {

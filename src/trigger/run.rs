@@ -9,14 +9,38 @@ use crate::model::log::{check_resolution, check_times, max_abs_time, Timed};
 /// `samples[i]` (gyro samples, or bare times in s: only the times are used).
 /// The policy sees, at each sample, only the samples up to it (the oracle
 /// also gets the whole log in [`Policy::prepare`]). Returns the frames in
-/// time order.
+/// time order. Pixel budgets use the timing's pitch ([`run_px`] with the
+/// samples' px/s for cameras whose pixels are not square).
 pub fn run<S: Timed>(
     samples: &[S],
     mmbm_mm_s: &[f64],
     policy: &mut dyn Policy,
     timing: &CameraTiming,
 ) -> Result<Vec<Frame>> {
+    run_px(samples, mmbm_mm_s, None, policy, timing)
+}
+
+/// [`run`] with the samples' MMBM in px/s too (the true pixel speed,
+/// `Mmbm::px_s`): pixel budgets then convert each decision sample's mm/s
+/// with its own mm per px ([`Observation::pitch_mm`]).
+pub fn run_px<S: Timed>(
+    samples: &[S],
+    mmbm_mm_s: &[f64],
+    px_s: Option<&[f64]>,
+    policy: &mut dyn Policy,
+    timing: &CameraTiming,
+) -> Result<Vec<Frame>> {
     timing.validate()?;
+    if let Some(px) = px_s.filter(|p| p.len() != mmbm_mm_s.len()) {
+        return Err(Error::invalid(
+            "mmbm series",
+            format!(
+                "{} px/s values for {} mm/s values",
+                px.len(),
+                mmbm_mm_s.len()
+            ),
+        ));
+    }
     if samples.len() != mmbm_mm_s.len() {
         return Err(Error::invalid(
             "mmbm series",
@@ -79,6 +103,9 @@ pub fn run<S: Timed>(
             last_trigger,
             frames: frames.len(),
             timing,
+            pitch_mm: px_s.map_or(timing.pitch_mm, |px| {
+                pixel_pitch(mmbm_mm_s[i], px[i], timing.pitch_mm)
+            }),
         };
         if policy.decide(&obs) && camera_free {
             let (te, gain) = policy.exposure(&obs);
@@ -101,4 +128,15 @@ pub fn run<S: Timed>(
         }
     }
     Ok(frames)
+}
+
+/// Millimetres per pixel of a sample's motion: `mm_s / px_s`, or `pitch`
+/// where that is not a positive finite number (a still sample).
+pub fn pixel_pitch(mm_s: f64, px_s: f64, pitch: f64) -> f64 {
+    let p = mm_s / px_s;
+    if p.is_finite() && p > 0.0 {
+        p
+    } else {
+        pitch
+    }
 }

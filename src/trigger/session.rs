@@ -11,7 +11,7 @@
 
 use super::live::Live;
 use super::parse::PolicySpec;
-use super::run::run;
+use super::run::run_px;
 use super::stream::{Stream, StreamControl, StreamOptions};
 use super::timing::{CameraTiming, Frame};
 use crate::camera::Camera;
@@ -45,13 +45,24 @@ impl Policies {
         &self.timing
     }
 
-    /// Runs every policy over a log ([`run()`]): `mmbm_mm_s[i]`
+    /// Runs every policy over a log ([`super::run()`]): `mmbm_mm_s[i]`
     /// is the MMBM at the time of `samples[i]` (samples, or bare times in
     /// s). One list of frames per policy, in the order of [`Self::specs`].
     pub fn run<S: Timed>(&self, samples: &[S], mmbm_mm_s: &[f64]) -> Result<Vec<Vec<Frame>>> {
+        self.run_px(samples, mmbm_mm_s, None)
+    }
+
+    /// [`Policies::run`] with the samples' MMBM in px/s too
+    /// ([`super::run_px`]: pixel budgets on pixels that are not square).
+    pub fn run_px<S: Timed>(
+        &self,
+        samples: &[S],
+        mmbm_mm_s: &[f64],
+        px_s: Option<&[f64]>,
+    ) -> Result<Vec<Vec<Frame>>> {
         self.specs
             .iter()
-            .map(|p| run(samples, mmbm_mm_s, p.build().as_mut(), &self.timing))
+            .map(|p| run_px(samples, mmbm_mm_s, px_s, p.build().as_mut(), &self.timing))
             .collect()
     }
 
@@ -163,7 +174,18 @@ impl Session {
             _ => return Err(Error::invalid("gyro log", "no samples")),
         };
         let mmbm_mm_s = self.evaluate(log)?;
-        let frames = self.policies.run(log, &mmbm_mm_s)?;
+        // Pixels not square: each sample's px/s for the pixel budgets.
+        let px_s = match crate::metric::pixel_map(self.camera()) {
+            None => None,
+            Some(_) => {
+                let ev = crate::metric::Evaluator::new(self.camera(), self.series.method)?;
+                let px = log.samples().iter().zip(&mmbm_mm_s).map(|(s, &m)| {
+                    crate::series::sample_px(s, &self.series, &ev, m).map(|p| p.unwrap_or(0.0))
+                });
+                Some(px.collect::<Result<Vec<f64>>>()?)
+            }
+        };
+        let frames = self.policies.run_px(log, &mmbm_mm_s, px_s.as_deref())?;
         Ok(SessionRun {
             mmbm_mm_s,
             duration_s: last - first,
@@ -182,6 +204,7 @@ impl Session {
 mod tests {
     use super::*;
     use crate::sim::{simulate, Gait, GaitConfig};
+    use crate::trigger::Exposure;
 
     fn walk() -> ImuLog {
         let g = GaitConfig::preset(Gait::Moderate);
@@ -202,6 +225,49 @@ mod tests {
         }
     }
 
+    /// The px/s (true pixel speed) of every sample of `log`.
+    fn px_series(s: &Session, log: &ImuLog, m: &[f64]) -> Vec<f64> {
+        let ev = crate::metric::Evaluator::new(s.camera(), s.series().method).unwrap();
+        log.iter()
+            .zip(m)
+            .map(|(x, &mm)| {
+                crate::series::sample_px(x, s.series(), &ev, mm)
+                    .unwrap()
+                    .unwrap()
+            })
+            .collect()
+    }
+
+    #[test]
+    fn pixel_budgets_use_the_true_pixel_speed() {
+        // Anamorphic pixels (fx = 1.5 fy): exposure control keeps the
+        // decision sample's px/s x t_e at the budget, not its mm/s over
+        // pitch_x x t_e.
+        let log = walk();
+        let mut camera = Camera::thesis();
+        camera.pitch_y_mm = 1.5 * camera.pitch_x_mm;
+        let s = Session::new(config(camera, &["fixed:5+exp:0.5"]), None).unwrap();
+        let got = s.run(&log).unwrap();
+        let m = &got.mmbm_mm_s;
+        let px = px_series(&s, &log, m);
+        let (mut inside, mut off) = (0, 0);
+        for f in &got.frames[0] {
+            let te = f.exposure_s();
+            if te >= s.timing().exposure * (1.0 - 1e-12) || te <= Exposure::MIN_EXPOSURE {
+                continue; // clamped
+            }
+            inside += 1;
+            let blur = px[f.index] * te;
+            assert!((blur - 0.5).abs() < 1e-9, "{blur}");
+            let old = m[f.index] / camera.pitch_x_mm * te;
+            off += usize::from((old - 0.5).abs() > 0.02);
+        }
+        assert!(
+            inside >= 5 && off * 2 >= inside,
+            "{inside} frames, {off} off by the old rule"
+        );
+    }
+
     #[test]
     fn a_session_runs_what_the_parts_run() {
         let log = walk();
@@ -218,8 +284,10 @@ mod tests {
         assert_eq!(got.mmbm_mm_s, m);
         assert_eq!(got.duration_s, log[log.len() - 1].t - log[0].t);
         assert_eq!(got.frames.len(), 2);
+        // pitch_x != pitch_y: the pixel budget takes each sample's px/s.
+        let px = px_series(&s, &log, &m);
         for (frames, p) in got.frames.iter().zip(s.policies().specs()) {
-            let want = run(&log, &m, p.build().as_mut(), s.timing()).unwrap();
+            let want = run_px(&log, &m, Some(&px), p.build().as_mut(), s.timing()).unwrap();
             assert!(!want.is_empty(), "{}", p.as_str());
             assert_eq!(frames, &want);
         }

@@ -410,10 +410,13 @@ impl Stream {
             );
             return Ok(None);
         }
-        let m = match sample_mmbm(s, &self.series, &self.eval)
+        // The MMBM and, on pixels that are not square, its px/s (for the
+        // pixel budgets).
+        let values = sample_mmbm(s, &self.series, &self.eval)
             .and_then(|m| check_values(std::slice::from_ref(s), &[m]).map(|_| m))
-        {
-            Ok(m) => m,
+            .and_then(|m| crate::series::sample_px(s, &self.series, &self.eval, m).map(|p| (m, p)));
+        let (m, px) = match values {
+            Ok(v) => v,
             Err(e) => {
                 let e = at.error(e);
                 if self.opts.strict {
@@ -424,7 +427,7 @@ impl Stream {
             }
         };
         self.last_t = s.t;
-        self.decide(s, m, out)?;
+        self.decide(s, m, px, out)?;
         self.samples += 1;
         if self.opts.stats {
             self.control.add_latency(read_at.elapsed());
@@ -434,10 +437,16 @@ impl Stream {
 
     /// Gives sample `s` with MMBM `m` to every policy and writes the lines
     /// it produces.
-    fn decide(&mut self, s: &GyroSample, m: f64, out: &mut dyn Write) -> Result<()> {
+    fn decide(
+        &mut self,
+        s: &GyroSample,
+        m: f64,
+        px: Option<f64>,
+        out: &mut dyn Write,
+    ) -> Result<()> {
         let mut text = String::new();
         for live in self.runs.iter_mut() {
-            let events = live.push(s.t, m)?;
+            let events = live.push_px(s.t, m, px)?;
             let triggered = events.iter().any(|e| matches!(e, Event::Trigger(..)));
             for e in events {
                 let v = match e {

@@ -156,7 +156,7 @@ impl Policy for Task {
         let start = t0 + slot as f64 * period;
         let score = self
             .model
-            .best(obs.current(), obs.timing.exposure, obs.timing.pitch_mm)
+            .best(obs.current(), obs.timing.exposure, obs.pitch_mm)
             .1;
         let observing = now < start + period / std::f64::consts::E;
         if observing {
@@ -175,7 +175,7 @@ impl Policy for Task {
     }
     fn exposure(&self, obs: &Observation) -> (f64, f64) {
         let t_ref = obs.timing.exposure;
-        let te = self.model.best(obs.current(), t_ref, obs.timing.pitch_mm).0;
+        let te = self.model.best(obs.current(), t_ref, obs.pitch_mm).0;
         (te, t_ref / te)
     }
 }

@@ -239,3 +239,38 @@ pub fn tree(dir: &Path) -> std::collections::BTreeMap<String, Vec<u8>> {
     }
     out
 }
+
+/// A gyro log of `n + 1` samples `dt` apart of one constant rotation `w`
+/// (rad/s): the flow does not change in time.
+pub fn steady_rotation(w: glam::DVec3, n: usize, dt: f64) -> Vec<mmbm::io::gyro::GyroSample> {
+    (0..=n)
+        .map(|k| mmbm::io::gyro::GyroSample {
+            t: k as f64 * dt,
+            omega: w,
+            velocity: None,
+            depth: None,
+        })
+        .collect()
+}
+
+/// A fisheye whose polynomial turns back at 1.2 (`theta + theta^3 - 0.8
+/// theta^5`), f = 26 px on 64 x 48: the corners (about 10 % of the sensor)
+/// lie beyond its radial distortion limit.
+pub fn turning_fisheye() -> mmbm::Camera {
+    mmbm::Camera {
+        distortion: mmbm::camera::Distortion::Fisheye {
+            k1: 1.0,
+            k2: -0.8,
+            k3: 0.0,
+            k4: 0.0,
+        },
+        ..mmbm::Camera::new(0.26, 0.01, 64, 48)
+    }
+}
+
+/// The largest and the mean `|a - b|` of two images (GPU against its twin).
+pub fn abs_diff_max_mean(a: &[f32], b: &[f32]) -> (f32, f32) {
+    let diffs: Vec<f32> = a.iter().zip(b).map(|(x, y)| (x - y).abs()).collect();
+    let max = diffs.iter().cloned().fold(0.0, f32::max);
+    (max, diffs.iter().sum::<f32>() / diffs.len() as f32)
+}
