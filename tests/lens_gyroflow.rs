@@ -256,6 +256,33 @@ fn stored_radial_limit_is_recomputed_as_gyroflow_does() {
     assert!(e.contains("radial_distortion_limit"), "{e}");
 }
 
+/// A telephoto fisheye calibration whose polynomial turns down before
+/// pi/2 and up again (Sony a6700 at 50 mm in the database): Gyroflow
+/// computes no radial limit, and every in-sensor pixel's ray is the root on
+/// the first branch (Gyroflow's Newton from theta_d), not a later one.
+#[test]
+fn a_fisheye_that_turns_back_up_keeps_the_first_branch() {
+    let mut p = profile(
+        "opencv_fisheye",
+        &[
+            -0.22452861677115005,
+            217.17550024300397,
+            -10296.464062136569,
+            48050.180651557894,
+        ],
+        json!({}),
+    );
+    p["calib_dimension"] = json!({"w": 3840, "h": 2160});
+    p["fisheye_params"]["camera_matrix"] = json!([
+        [19347.33097906391, 0.0, 2048.20702350777],
+        [0.0, 19733.029810849617, 1059.8731880951857],
+        [0.0, 0.0, 1.0]
+    ]);
+    let c = resolve(&write_tmp("tele.json", &p.to_string()), None, None).unwrap();
+    assert_eq!(c.masked_fraction(), 0.0);
+    assert!(agreement(&c, &p, 64, 36) < 1e-6);
+}
+
 #[test]
 fn a_superview_calibration_at_4_3_is_widened() {
     let mut p = profile(

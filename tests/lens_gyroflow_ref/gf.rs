@@ -13,6 +13,13 @@ pub struct Gf {
     k: [f64; 12],
     digital: Option<String>,
     dp: [f64; 16],
+    /// `opencv_fisheye`: the first theta in (0, pi/2] where the slope of
+    /// theta_d(theta) is no longer positive (pi/2 - 1e-9 if none), by a scan
+    /// of 100,000 steps. Gyroflow's Newton starts at theta_d and stays on the
+    /// first branch; a profile whose slope turns negative and back to
+    /// positive before pi/2 has no radial limit, but a bracket to pi/2 would
+    /// hold the roots of later branches.
+    first_turn: f64,
 }
 
 impl Gf {
@@ -71,6 +78,7 @@ impl Gf {
             k,
             digital,
             dp,
+            first_turn: first_turn(&k),
         }
     }
 
@@ -160,9 +168,12 @@ impl Gf {
                 let t2 = th * th;
                 th * (1.0 + k[0] * t2 + k[1] * t2 * t2 + k[2] * t2.powi(3) + k[3] * t2.powi(4))
             };
+            // Bracket: up to Gyroflow's radial limit, and never past the
+            // polynomial's first turning point (see `first_turn`).
             let top = self
                 .r_limit()
-                .map_or(std::f64::consts::FRAC_PI_2 - 1e-9, f64::atan);
+                .map_or(std::f64::consts::FRAC_PI_2 - 1e-9, f64::atan)
+                .min(self.first_turn);
             if g(top) < thd {
                 return None;
             }
@@ -331,4 +342,20 @@ impl Gf {
         }
         (sum / n as f64, masked as f64 / (nu * nv) as f64)
     }
+}
+
+/// [`Gf::first_turn`] of the fisheye coefficients `k`.
+fn first_turn(k: &[f64; 12]) -> f64 {
+    let slope = |th: f64| {
+        let t2 = th * th;
+        1.0 + 3.0 * k[0] * t2
+            + 5.0 * k[1] * t2 * t2
+            + 7.0 * k[2] * t2.powi(3)
+            + 9.0 * k[3] * t2.powi(4)
+    };
+    let n = 100_000;
+    (1..=n)
+        .map(|i| i as f64 * std::f64::consts::FRAC_PI_2 / n as f64)
+        .find(|&th| slope(th) <= 0.0)
+        .unwrap_or(std::f64::consts::FRAC_PI_2 - 1e-9)
 }
