@@ -1,4 +1,4 @@
-//! The gyro CSV's fast path (a regular file read in parallel blocks while
+//! The gyro CSV's fast path (a regular file read in blocks by a one-pass parser while
 //! its rows are plain numbers) against the exact `csv`-crate reader
 //! (`GyroReader::open_exact`): the same samples to the bit, the same
 //! warnings (they name lines), and on spoiled files the same error text.

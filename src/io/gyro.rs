@@ -244,7 +244,7 @@ pub struct GyroReader {
 
 impl GyroReader {
     /// Opens `path` (`-`: standard input, named `<stdin>` in errors) and
-    /// checks the header. A plain CSV in a regular file is read in parallel
+    /// checks the header. A plain CSV in a regular file is read by a fast parser
     /// while its rows are plain numbers, with the same samples, errors and
     /// line numbers as [`GyroReader::open_exact`].
     pub fn open(path: &Path, opts: GyroOptions) -> Result<Self> {

@@ -1,14 +1,19 @@
 //! The fast path of a plain gyro CSV in a regular file
 //! ([`super::plain::CsvSource`]): the file is read in blocks of whole lines
-//! and each block is parsed in parallel pieces (rayon) by a tight loop over
-//! plain numeric rows. Only the common, clean form is taken: one record per
+//! and each block is parsed in pieces by a tight one-pass loop over plain
+//! numeric rows. Only the common, clean form is taken: one record per
 //! line, `\n` or `\r\n` line ends, no quote, no comment or blank line, the
 //! header's column count, every column read a finite number that
-//! [`crate::io::decimal::parse_f64`] reads (the exact reader's own first
-//! try, so the values are the same bits). Anything else in a block is
-//! [`Unusual`]: the caller then reads on with the exact `csv` reader from
-//! where the fast path stopped (its records skipped), so every error and
-//! line number is the exact reader's.
+//! [`crate::io::decimal`] reads as [`crate::io::decimal::parse_f64`] does
+//! (the exact reader's own first try, so the values are the same bits).
+//! Anything else in a block is [`Unusual`]: the caller then reads on with
+//! the exact `csv` reader from where the fast path stopped (its records
+//! skipped), so every error and line number is the exact reader's.
+//!
+//! The pieces are parsed in turn on the reader's thread: on rayon's pool
+//! (the pieces of a block in parallel) it took less CPU time than the `csv`
+//! reader but more wall time on a loaded 2-core machine, where the pool is
+//! busy with the metric and the reader waits for it.
 //!
 //! Line numbers are the exact reader's: the `csv` crate counts a record's
 //! line before it reads the `\n` of a `\r\n` ending the line before, so a
@@ -18,7 +23,6 @@ use super::plain::Raw;
 use crate::io::decimal::{parse_f64, parse_prefix};
 use crate::io::input::MAX_LINE_BYTES;
 use glam::DVec3;
-use rayon::prelude::*;
 use std::fs::File;
 use std::os::unix::fs::FileExt;
 
@@ -28,7 +32,7 @@ use std::os::unix::fs::FileExt;
 const BLOCK: usize = 1 << 19;
 const _: () = assert!(2 * BLOCK <= MAX_LINE_BYTES);
 
-/// Bytes per parallel piece of a block (about 2,700 rows of a 4-column log).
+/// Bytes per piece of a block (about 700 rows of a 4-column log).
 const PIECE: usize = 32 << 10;
 
 /// Where a column's value goes: `t`, `wx, wy, wz`, `vx, vy, vz`, `depth`.
@@ -242,7 +246,7 @@ impl FastRows {
         }
         let layout = &self.layout;
         self.pieces = bounds
-            .par_iter()
+            .iter()
             .map(|&(s, e, crlf)| parse_piece(&data[s..e], layout, crlf))
             .collect::<Result<_, _>>()?;
         // Local line numbers to the file's.
