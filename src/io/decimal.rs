@@ -23,28 +23,43 @@ pub fn parse_f64(s: &[u8]) -> Option<f64> {
 /// fast path's bounds, else `None`.
 #[inline]
 fn fast(s: &[u8]) -> Option<f64> {
-    let (neg, body) = match s.first()? {
-        b'-' => (true, &s[1..]),
-        b'+' => (false, &s[1..]),
-        _ => (false, s),
+    parse_prefix(s)
+        .filter(|&(_, n)| n == s.len())
+        .map(|(x, _)| x)
+}
+
+/// The plain number at the start of `s` (`[+-]digits[.digits]`, up to the
+/// first byte that cannot go on: not a digit, a second point or a 20th
+/// digit) and its length in bytes, where the fast path reads it (so that
+/// when it is all of a text, the value is [`parse_f64`]'s); else `None`.
+/// For parsers that split fields as they go.
+#[inline]
+pub fn parse_prefix(s: &[u8]) -> Option<(f64, usize)> {
+    let (neg, start) = match s.first()? {
+        b'-' => (true, 1),
+        b'+' => (false, 1),
+        _ => (false, 0),
     };
     let (mut m, mut digits, mut point) = (0u64, 0u32, None);
-    for (i, &b) in body.iter().enumerate() {
-        match b {
-            b'0'..=b'9' if digits < 19 => {
-                m = m * 10 + u64::from(b - b'0');
-                digits += 1;
-            }
-            b'.' if point.is_none() => point = Some(i),
-            _ => return None,
+    let mut i = start;
+    while let Some(&b) = s.get(i) {
+        let d = b.wrapping_sub(b'0');
+        if d < 10 && digits < 19 {
+            m = m * 10 + u64::from(d);
+            digits += 1;
+        } else if b == b'.' && point.is_none() {
+            point = Some(i);
+        } else {
+            break;
         }
+        i += 1;
     }
-    let e = point.map_or(0, |i| body.len() - i - 1);
+    let e = point.map_or(0, |p| i - p - 1);
     if digits == 0 || m > 1 << 53 || e >= POW10.len() {
         return None;
     }
     let x = m as f64 / POW10[e];
-    Some(if neg { -x } else { x })
+    Some((if neg { -x } else { x }, i))
 }
 
 #[cfg(test)]
@@ -60,6 +75,18 @@ mod tests {
             want.map(f64::to_bits),
             "'{s}': {got:?} vs {want:?}"
         );
+        // A prefix before a comma is all of the text exactly when the fast
+        // path reads the text, with its value.
+        let field = format!("{s},9");
+        let prefix = parse_prefix(field.as_bytes()).filter(|&(_, n)| n == s.len());
+        assert_eq!(
+            prefix.map(|(x, _)| x.to_bits()),
+            fast(s.as_bytes()).map(f64::to_bits),
+            "'{s}'"
+        );
+        if let Some((x, _)) = prefix {
+            assert_eq!(Some(x.to_bits()), want.map(f64::to_bits), "'{s}'");
+        }
     }
 
     #[test]

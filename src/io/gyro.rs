@@ -10,6 +10,7 @@
 //! field, the same way for every format; errors name the file, line and
 //! column.
 
+mod fast;
 mod plain;
 
 use super::gcsv::GcsvReader;
@@ -243,8 +244,21 @@ pub struct GyroReader {
 
 impl GyroReader {
     /// Opens `path` (`-`: standard input, named `<stdin>` in errors) and
-    /// checks the header.
+    /// checks the header. A plain CSV in a regular file is read by a fast parser
+    /// while its rows are plain numbers, with the same samples, errors and
+    /// line numbers as [`GyroReader::open_exact`].
     pub fn open(path: &Path, opts: GyroOptions) -> Result<Self> {
+        Self::open_with(path, opts, true)
+    }
+
+    /// [`GyroReader::open`] with the plain CSV read by the exact (`csv`
+    /// crate) reader alone, record by record: the reference the fast path is
+    /// checked against.
+    pub fn open_exact(path: &Path, opts: GyroOptions) -> Result<Self> {
+        Self::open_with(path, opts, false)
+    }
+
+    fn open_with(path: &Path, opts: GyroOptions, fast: bool) -> Result<Self> {
         let mut readout = None;
         let own_units = |what: &str| -> Result<()> {
             if opts.time_unit != TimeUnit::S || opts.angle_unit != AngleUnit::Rad {
@@ -293,7 +307,7 @@ impl GyroReader {
             (Source::Phone(ImuRows::open(path)?), path)
         } else {
             let file = super::input::open_stream(path)?;
-            (Source::Csv(CsvSource::open(Box::new(file), path)?), path)
+            (Source::Csv(CsvSource::open_file(file, path, fast)?), path)
         };
         Ok(GyroReader {
             path: path.into(),

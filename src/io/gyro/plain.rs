@@ -4,9 +4,11 @@
 //! own units and axes. Lines are capped ([`LineCap`]); errors name the file,
 //! line and column.
 
+use super::fast::{FastRows, Layout};
 use crate::error::{quote, Error, Result};
 use crate::io::input::{LineCap, MAX_LINE_BYTES};
 use glam::DVec3;
+use std::fs::File;
 use std::io::Read;
 use std::path::{Path, PathBuf};
 
@@ -38,6 +40,8 @@ pub(super) struct CsvSource {
     idx_depth: Option<usize>,
     names: Vec<String>,
     record: csv::ByteRecord,
+    /// The fast path ([`super::fast`]), while it lasts.
+    fast: Option<FastRows>,
 }
 
 impl CsvSource {
@@ -67,7 +71,54 @@ impl CsvSource {
             idx_depth: columns.depth,
             names,
             record: csv::ByteRecord::new(),
+            fast: None,
         })
+    }
+
+    /// Opens a file: a regular file is read by the fast path
+    /// ([`super::fast`]) while its lines are plain numeric rows, by the exact
+    /// reader from the first line that is not (`fast` false: the exact
+    /// reader only).
+    pub fn open_file(file: File, path: &Path, fast: bool) -> Result<Self> {
+        let twin = match fast && file.metadata().is_ok_and(|m| m.is_file()) {
+            true => file.try_clone().ok(),
+            false => None,
+        };
+        let mut src = Self::open(Box::new(file), path)?;
+        src.fast = twin.map(|f| FastRows::new(f, src.layout()));
+        Ok(src)
+    }
+
+    /// The fast path's view of the header.
+    pub(super) fn layout(&self) -> Layout {
+        Layout::new(
+            self.names.len(),
+            self.idx_t,
+            self.idx_w,
+            self.idx_v,
+            self.idx_depth,
+        )
+    }
+
+    /// The next record of the fast path while it lasts; when it meets a line
+    /// that is not plain, the exact reader skips the records it gave.
+    fn next_fast(&mut self) -> Result<Option<Option<Raw>>> {
+        let Some(fast) = &mut self.fast else {
+            return Ok(None);
+        };
+        match fast.next_raw() {
+            Ok(r) => Ok(Some(r)),
+            Err(_) => {
+                let skip = fast.delivered();
+                self.fast = None;
+                for _ in 0..skip {
+                    if let Err(e) = self.reader.read_byte_record(&mut self.record) {
+                        return Err(csv_error(&mut self.reader, &self.path, e, "record"));
+                    }
+                }
+                Ok(None)
+            }
+        }
     }
 
     /// True when the log has `vx, vy, vz`.
@@ -92,6 +143,9 @@ impl CsvSource {
 
     /// The next record (None at the end of the file).
     pub fn next_raw(&mut self) -> Result<Option<Raw>> {
+        if let Some(r) = self.next_fast()? {
+            return Ok(r);
+        }
         let more = match self.reader.read_byte_record(&mut self.record) {
             Ok(more) => more,
             Err(e) => return Err(csv_error(&mut self.reader, &self.path, e, "record")),

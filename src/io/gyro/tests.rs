@@ -141,3 +141,75 @@ fn a_reflection_names_its_determinant_and_the_proper_rotation() {
     }
     assert_eq!(reflections, 24);
 }
+
+/// The records of `text` by the fast path with `block` and `piece` bytes,
+/// as (line, values) — `Err` where it hands over to the exact reader.
+fn fast_records(
+    text: &[u8],
+    block: usize,
+    piece: usize,
+) -> std::result::Result<Vec<String>, fast::Unusual> {
+    let f = log(std::str::from_utf8(text).unwrap());
+    let exact =
+        CsvSource::open_file(std::fs::File::open(f.path()).unwrap(), f.path(), false).unwrap();
+    let file = std::fs::File::open(f.path()).unwrap();
+    let mut rows = fast::FastRows::with_sizes(file, exact.layout(), block, piece);
+    let mut out = Vec::new();
+    while let Some(r) = rows.next_raw()? {
+        out.push(format!("{r:?}"));
+    }
+    Ok(out)
+}
+
+/// The same by the exact reader.
+fn exact_records(text: &[u8]) -> Vec<String> {
+    let f = log(std::str::from_utf8(text).unwrap());
+    let mut exact =
+        CsvSource::open_file(std::fs::File::open(f.path()).unwrap(), f.path(), false).unwrap();
+    let mut out = Vec::new();
+    while let Some(r) = exact.next_raw().unwrap() {
+        out.push(format!("{r:?}"));
+    }
+    out
+}
+
+#[test]
+fn fast_path_at_every_block_and_piece_boundary() {
+    // Mixed line ends (the exact reader numbers a record after a `\r\n`
+    // line one lower), spaces, an unread column, every number form.
+    let texts = [
+        "t,wx,wy,wz,note\r\n0,0.1,-2,3e-3,a\n0.5, 1 ,.5,-0,\r\n1,2,3,4,x y\r\n1.5,1,2,3,z\n2,-1.25,0.000001,7,w",
+        "wz,t,depth,wy,vx,vy,wx,vz\n1,0,2,3,4,5,6,7\n1,1,2,3,4,5,6,7\r\n1,2,2,3,4,5,6,7\n",
+    ];
+    for text in texts {
+        let text = text.as_bytes();
+        let want = exact_records(text);
+        assert!(want.len() >= 3, "{want:?}");
+        for block in 1..=text.len() + 1 {
+            for piece in [1, 2, 3, 5, 8, 13, 21, 34, 1000] {
+                let got = fast_records(text, block, piece);
+                assert_eq!(got.as_ref(), Ok(&want), "block {block}, piece {piece}");
+            }
+        }
+    }
+    // What the fast path leaves to the exact reader.
+    for text in [
+        "t,wx,wy,wz\n0,1,2,3\n\n1,1,2,3\n",
+        "t,wx,wy,wz\n0,1,2,3\n#c\n1,1,2,3\n",
+        "t,wx,wy,wz\n0,1,2,\"3\"\n",
+        "t,wx,wy,wz\n0,1,2,3\r1,1,2,3\n",
+        "t,wx,wy,wz\n0,1,2\n",
+        "t,wx,wy,wz\n0,1,2,x\n",
+        "t,wx,wy,wz\n0,1,2,inf\n",
+        "# c\nt,wx,wy,wz\n0,1,2,3\n",
+        "t,wx,wy,wz\n",
+    ] {
+        for block in [1, 4, 1000] {
+            assert_eq!(
+                fast_records(text.as_bytes(), block, 3),
+                Err(fast::Unusual),
+                "{text:?}"
+            );
+        }
+    }
+}
