@@ -8,7 +8,7 @@ use mmbm::metric::{Method, Scene};
 use mmbm::series::mmbm_series;
 use mmbm::trigger::{self, CameraTiming, Event, Frame, Live};
 use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Output, Stdio};
 
 /// Every causal policy form, with thresholds that make each trigger often.
@@ -29,26 +29,6 @@ const CAUSAL: &[&str] = &[
     "deadline:5",
     "deadline:5:0.4",
 ];
-
-fn simulated_walk(dir: &Path) -> PathBuf {
-    let p = dir.join("walk.csv");
-    let o = common::mmbm_cmd()
-        .args([
-            "simulate",
-            "--gait",
-            "moderate",
-            "--duration",
-            "20",
-            "--seed",
-            "7",
-        ])
-        .arg("--out")
-        .arg(&p)
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    p
-}
 
 fn timing(exposure: f64) -> CameraTiming {
     CameraTiming {
@@ -104,7 +84,7 @@ fn assert_same_as_offline(log: &[GyroSample], exposure: f64, what: &str) {
 #[test]
 fn live_equals_offline_on_a_simulated_walk() {
     let dir = tempfile::tempdir().unwrap();
-    let log = read_log(&simulated_walk(dir.path()), GyroOptions::default()).unwrap();
+    let log = read_log(&common::simulated_walk(dir.path()), GyroOptions::default()).unwrap();
     assert_same_as_offline(&log, 0.07, "simulated walk");
 }
 
@@ -203,7 +183,7 @@ fn triggers_of(lines: &[serde_json::Value]) -> Vec<f64> {
 #[test]
 fn cli_stdin_gives_the_offline_triggers() {
     let dir = tempfile::tempdir().unwrap();
-    let mut logs = vec![(simulated_walk(dir.path()), "0.07")];
+    let mut logs = vec![(common::simulated_walk(dir.path()), "0.07")];
     if let Some(p) = common::shared_log("running_phone") {
         logs.push((p, "0.02"));
     }
@@ -231,7 +211,7 @@ fn cli_stdin_gives_the_offline_triggers() {
 #[test]
 fn json_lines_and_replay_match_csv_stdin() {
     let dir = tempfile::tempdir().unwrap();
-    let walk = simulated_walk(dir.path());
+    let walk = common::simulated_walk(dir.path());
     let log = read_log(&walk, GyroOptions::default()).unwrap();
     let mut js = String::new();
     for s in &log {

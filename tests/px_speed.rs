@@ -232,20 +232,8 @@ fn frames_blur_px_is_the_true_pixel_speed_times_the_exposure() {
 #[test]
 fn anamorphic_exposure_control_live_equals_offline() {
     let d = tempfile::tempdir().unwrap();
-    let log = d.path().join("walk.csv");
+    let log = common::simulated_walk(d.path());
     let log_s = log.to_str().unwrap();
-    let sim = [
-        "simulate",
-        "--gait",
-        "moderate",
-        "--duration",
-        "20",
-        "--seed",
-        "7",
-        "--out",
-        log_s,
-    ];
-    assert!(common::mmbm(&sim).status.success());
     let cam = d.path().join("ana.toml");
     std::fs::write(
         &cam,

@@ -274,3 +274,24 @@ pub fn abs_diff_max_mean(a: &[f32], b: &[f32]) -> (f32, f32) {
     let max = diffs.iter().cloned().fold(0.0, f32::max);
     (max, diffs.iter().sum::<f32>() / diffs.len() as f32)
 }
+
+/// `mmbm simulate` of a 20 s moderate walk (seed 7) into `dir/walk.csv`.
+pub fn simulated_walk(dir: &Path) -> PathBuf {
+    let p = dir.join("walk.csv");
+    let o = mmbm_cmd()
+        .args([
+            "simulate",
+            "--gait",
+            "moderate",
+            "--duration",
+            "20",
+            "--seed",
+            "7",
+        ])
+        .arg("--out")
+        .arg(&p)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    p
+}
