@@ -370,3 +370,23 @@ fn cli_frames_maps_backend() {
     assert!(err.contains("poly3") && err.contains("on the CPU"), "{err}");
     assert!(auto.join("frame_000000.exr").exists());
 }
+
+/// A `--backend` that is none of the four is refused by name, before any file is read.
+#[test]
+fn unknown_backend_is_refused() {
+    let o = common::mmbm(&[
+        "frames",
+        "--backend",
+        "tpu",
+        "--gyro",
+        "no.csv",
+        "--frames",
+        "no.csv",
+    ]);
+    assert!(!o.status.success());
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        e.contains("'tpu'") && e.contains("auto, gpu, cpu or bulk"),
+        "{e}"
+    );
+}
