@@ -16,7 +16,7 @@
 //!
 //! | layer | modules | holds |
 //! |---|---|---|
-//! | 0 | [`error`], [`check`], [`bounded`], [`stats`], [`diagnostics`], [`cancel`] | the error enum; value checks (finite, positive) that name the value; bounded whole-file reading (file kinds, the text cap); mean and percentile; where the library's warnings go (the `log` facade); stopping long calls from outside |
+//! | 0 | [`error`], [`check`], [`limits`], [`bounded`], [`stats`], [`diagnostics`], [`cancel`] | the error enum; value checks (finite, positive) that name the value; every cap on inputs; bounded whole-file reading (file kinds, the text cap); mean and percentile; where the library's warnings go (the `log` facade); stopping long calls from outside |
 //! | 1 | [`camera`], [`model`], [`io`], [`gpu`] | the camera (intrinsics, distortion, shutter, noise, lens); motion, flow; files; the wgpu device and compute plumbing |
 //! | 2 | [`metric`], [`board`], [`plot`], [`sim`], [`assess`] | MMBM rules; the thesis board, blobs, pose; figures; gait simulation; image blur metrics |
 //! | 3 | [`field`], [`tables`] | the flow-field kernel (GPU + CPU twin); thesis tables |
@@ -43,6 +43,7 @@ pub mod experiment;
 pub mod field;
 pub mod gpu;
 pub mod io;
+pub mod limits;
 pub mod metric;
 pub mod model;
 pub mod plot;

@@ -14,6 +14,7 @@ use std::path::{Path, PathBuf};
 const LAYERS: &[(&str, u32)] = &[
     ("error", 0),
     ("check", 0),
+    ("limits", 0),
     ("bounded", 0),
     ("stats", 0),
     ("diagnostics", 0),
