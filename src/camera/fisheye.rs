@@ -65,39 +65,22 @@ pub fn limit(k: [f64; 4]) -> f64 {
 }
 
 /// The angle `theta` (rad) with `theta_d(theta) = rd` on `[0, turning
-/// point]`: Newton's method safeguarded by bisection on that bracket, to
+/// point]`: [`super::newton::solve_rising`] (Newton safeguarded by bisection), to
 /// `tol` in `theta_d`. `None` when `rd` lies beyond the [`limit`] (no ray).
 pub fn solve(k: [f64; 4], rd: f64, tol: f64) -> Option<f64> {
     let top = turning_point(k);
     if rd.is_nan() || rd < 0.0 || theta_d(k, top) < rd - tol {
         return None;
     }
-    let (mut lo, mut hi) = (0.0, top);
-    let mut th = rd.clamp(lo, hi);
-    // The last step's size: a Newton step must at least halve it, else bisect
-    // (Newton alone can ping-pong across a bracket that barely shrinks).
-    let mut last = hi - lo;
-    for _ in 0..200 {
-        let f = theta_d(k, th) - rd;
-        if f.abs() <= tol {
-            return Some(th);
-        }
-        if f < 0.0 {
-            lo = th;
-        } else {
-            hi = th;
-        }
-        let df = slope(k, th);
-        let next = th - f / df;
-        let newton = df > 0.0 && next > lo && next < hi && 2.0 * (f / df).abs() <= last;
-        let prev = th;
-        th = if newton { next } else { 0.5 * (lo + hi) };
-        last = (th - prev).abs();
-        if hi - lo <= f64::EPSILON * hi {
-            return Some(th);
-        }
-    }
-    Some(th)
+    Some(super::newton::solve_rising(
+        |th| theta_d(k, th),
+        |th| slope(k, th),
+        rd,
+        top,
+        rd,
+        tol,
+        200,
+    ))
 }
 
 #[cfg(test)]

@@ -17,6 +17,7 @@ pub(crate) mod insta360;
 pub(crate) mod intrinsics;
 pub(crate) mod lens;
 pub(crate) mod models;
+pub(crate) mod newton;
 pub(crate) mod noise;
 pub(crate) mod opencv;
 pub(crate) mod parts;

@@ -8,8 +8,8 @@
 //! angle `theta = atan r` (rad) where `d(r s(r))/dr <= 0`, and below 90
 //! degrees; [`limit`] is the distorted radius there, the radial distortion
 //! limit (infinite when the distorted radius grows without bound). The
-//! inverse [`solve`] is Newton's method in `theta`, safeguarded by bisection
-//! on `[0, turning point]`, as `super::fisheye::solve`.
+//! inverse [`solve`] is `super::newton::solve_rising` in `theta` (Newton safeguarded by bisection)
+//! on `[0, turning point]`, as for the fisheye.
 
 use super::fisheye::THETA_MAX;
 
@@ -79,30 +79,16 @@ pub fn solve(p: &dyn Profile, target: f64, tol: f64) -> Option<f64> {
     if target.is_nan() || target < 0.0 || rd(p, top) < target - tol {
         return None;
     }
-    let (mut lo, mut hi) = (0.0, top);
     // Start at the pinhole angle of the target (the model is near identity there).
-    let mut th = target.atan().clamp(lo, hi);
-    let mut last = hi - lo;
-    for _ in 0..300 {
-        let f = rd(p, th) - target;
-        if f.abs() <= tol {
-            return Some(th.tan());
-        }
-        if f < 0.0 {
-            lo = th;
-        } else {
-            hi = th;
-        }
-        let df = slope(p, th);
-        let next = th - f / df;
-        let newton = df > 0.0 && next > lo && next < hi && 2.0 * (f / df).abs() <= last;
-        let prev = th;
-        th = if newton { next } else { 0.5 * (lo + hi) };
-        last = (th - prev).abs();
-        if hi - lo <= f64::EPSILON * hi {
-            break;
-        }
-    }
+    let th = super::newton::solve_rising(
+        |th| rd(p, th),
+        |th| slope(p, th),
+        target,
+        top,
+        target.atan(),
+        tol,
+        300,
+    );
     Some(th.tan())
 }
 

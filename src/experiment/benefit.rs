@@ -58,6 +58,16 @@ pub const RESAMPLES: usize = 2000;
 /// Seed of the bootstrap's random numbers.
 pub const BOOTSTRAP_SEED: u64 = 20_261_123;
 
+/// The [`RESAMPLES`] bootstrap resamplings of `n` blocks: each a list of `n`
+/// block indices drawn with replacement, from [`BOOTSTRAP_SEED`] (the same
+/// draws for every table that resamples `n` blocks).
+pub fn bootstrap_indices(n: usize) -> Vec<Vec<usize>> {
+    let mut rng = rand::rngs::StdRng::seed_from_u64(BOOTSTRAP_SEED);
+    (0..RESAMPLES)
+        .map(|_| (0..n).map(|_| rng.gen_range(0..n)).collect())
+        .collect()
+}
+
 /// A point estimate with its 95 % bootstrap interval.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Estimate {
@@ -178,14 +188,7 @@ pub fn headlines(
             (ok / secs, blur / n)
         };
         let all: Vec<usize> = (0..blocks.len()).collect();
-        let mut rng = rand::rngs::StdRng::seed_from_u64(BOOTSTRAP_SEED);
-        let samples: Vec<Vec<usize>> = (0..RESAMPLES)
-            .map(|_| {
-                (0..blocks.len())
-                    .map(|_| rng.gen_range(0..blocks.len()))
-                    .collect()
-            })
-            .collect();
+        let samples = bootstrap_indices(blocks.len());
         let mut seeds: Vec<u64> = ws.iter().map(|w| w.seed).collect();
         seeds.sort_unstable();
         for (pi, p) in policies.iter().enumerate() {

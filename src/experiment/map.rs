@@ -5,8 +5,8 @@
 //! the best fixed exposure in hindsight (`oracle`, over the grid), against
 //! auto-exposure and against the thesis's fixed rate, each ratio paired over
 //! the 2-s blocks of the walks with a 95 % percentile bootstrap over the
-//! blocks of all seeds (the headline's [`BLOCK_S`](super::benefit::BLOCK_S), [`RESAMPLES`] and
-//! [`BOOTSTRAP_SEED`]).
+//! blocks of all seeds (the headline's [`BLOCK_S`](super::benefit::BLOCK_S), [`RESAMPLES`](super::benefit::RESAMPLES) and
+//! [`BOOTSTRAP_SEED`](super::benefit::BOOTSTRAP_SEED): [`bootstrap_indices`](super::benefit::bootstrap_indices)).
 //!
 //! The trigger times and exposures do not depend on the light (the
 //! auto-exposure predicts its level from the scene, see
@@ -15,7 +15,7 @@
 //! ([`super::map_render`]). The best policies of a cell are chosen on all
 //! its blocks (point estimates) and then held fixed in the resamples.
 
-use super::benefit::{Estimate, WalkBlocks, BOOTSTRAP_SEED, RESAMPLES};
+use super::benefit::{bootstrap_indices, Estimate, WalkBlocks};
 use super::config::ExperimentConfig;
 use super::map_render::{judge_at_lights, Judged, Light};
 use super::walk::{make_walk, Walk};
@@ -25,7 +25,6 @@ use crate::metric::Scene;
 use crate::render::Quality;
 use crate::stats::percentile;
 use crate::trigger::{Frame, PolicyFamily, PolicySpec};
-use rand::{Rng, SeedableRng};
 use rayon::prelude::*;
 
 /// One policy in one cell.
@@ -384,14 +383,7 @@ fn cell(
     let ae = best(&ps, fam(PolicyFamily::AutoExposure));
     let fixed = ps.iter().position(|p| p.policy.is_baseline());
     let winner = best(&ps, |_| true).unwrap_or(0);
-    let mut rng = rand::rngs::StdRng::seed_from_u64(BOOTSTRAP_SEED);
-    let samples: Vec<Vec<usize>> = (0..RESAMPLES)
-        .map(|_| {
-            (0..blocks.len())
-                .map(|_| rng.gen_range(0..blocks.len()))
-                .collect()
-        })
-        .collect();
+    let samples = bootstrap_indices(blocks.len());
     let ratio = |a: Option<usize>, b: Option<usize>| -> Option<Estimate> {
         let (a, b) = (a?, b?);
         let value = ps[a].sharp_fps / ps[b].sharp_fps;

@@ -166,3 +166,16 @@ pub fn thesis_rule(m: &[f64], x: f64) -> bool {
         && m[n - 3] > m[n - 2]
         && m[n - 2] > m[n - 1]
 }
+
+/// The slot of a fixed rate `fps` (frames/s) that `now` (s) falls in: its
+/// index `k` and its start `t0 + k / fps` (s), the latest start at or
+/// before `now` (guarded against rounding at slot boundaries). Shared by the
+/// one-frame-per-slot policies (`deadline`, `task`).
+pub(super) fn rate_slot(t0: f64, fps: f64, now: f64) -> (i64, f64) {
+    let period = 1.0 / fps;
+    let mut slot = ((now - t0) * fps).floor() as i64;
+    if t0 + slot as f64 * period > now {
+        slot -= 1;
+    }
+    (slot, t0 + slot as f64 * period)
+}

@@ -1,7 +1,7 @@
 //! The causal policies: fixed rate, the thesis threshold rule, its adaptive
 //! version, the fixed-rate quality gate and the deadline schedule.
 
-use super::policy::{thesis_rule, Level, LogView, Observation, Policy};
+use super::policy::{rate_slot, thesis_rule, Level, LogView, Observation, Policy};
 use super::timing::{CameraTiming, Frame};
 use crate::error::Result;
 use std::collections::VecDeque;
@@ -331,17 +331,12 @@ impl Policy for Deadline {
         let t0 = obs.t0;
         let now = obs.now();
         let period = 1.0 / self.fps;
-        let mut slot = ((now - t0) * self.fps).floor() as i64;
-        // Guard against rounding at slot boundaries.
-        if t0 + slot as f64 * period > now {
-            slot -= 1;
-        }
+        let (slot, start) = rate_slot(t0, self.fps, now);
         if slot != self.slot {
             self.slot = slot;
             self.taken = false;
             self.obs_min = f64::INFINITY;
         }
-        let start = t0 + slot as f64 * period;
         let end = start + period;
         let m = obs.current();
         let observing = self.level.is_none() && now < start + period / std::f64::consts::E;

@@ -5,7 +5,7 @@
 //! `camera::noise`).
 
 use super::numbers::parse_pos;
-use super::policy::{LogView, Observation, Policy};
+use super::policy::{rate_slot, LogView, Observation, Policy};
 use super::timing::CameraTiming;
 use crate::error::{Error, Result};
 
@@ -144,16 +144,12 @@ impl Policy for Task {
     fn decide(&mut self, obs: &Observation) -> bool {
         let (t0, now) = (obs.t0, obs.now());
         let period = 1.0 / self.fps;
-        let mut slot = ((now - t0) * self.fps).floor() as i64;
-        if t0 + slot as f64 * period > now {
-            slot -= 1;
-        }
+        let (slot, start) = rate_slot(t0, self.fps, now);
         if slot != self.slot {
             self.slot = slot;
             self.taken = false;
             self.obs_max = f64::NEG_INFINITY;
         }
-        let start = t0 + slot as f64 * period;
         let score = self
             .model
             .best(obs.current(), obs.timing.exposure, obs.pitch_mm)
