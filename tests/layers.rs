@@ -1,10 +1,11 @@
 //! The module graph of the library: every top-level module imports only from
 //! its own layer or the ones below it (the table in `src/lib.rs`), and no two
 //! modules import each other, directly or through others: neither between
-//! top-level modules nor between the files of one folder.
+//! top-level modules nor between the files of any folder at any depth.
 //!
-//! Imports are read from the source text: `crate::NAME` paths (top level)
-//! and `super::NAME` / `crate::FOLDER::NAME` paths (siblings in a folder).
+//! Imports are read from the source text: `crate::` paths, `super::` and
+//! `self::` paths and `use CHILD::` lines, resolved to module paths; circles
+//! are looked for among the children of every folder, at every depth.
 //! Test code (`#[cfg(test)]` onwards, files named `tests.rs`) is skipped.
 
 use std::collections::{BTreeMap, BTreeSet};
@@ -213,64 +214,201 @@ fn no_module_imports_a_higher_layer() {
     assert!(bad.is_empty(), "upward imports:\n{}", bad.join("\n"));
 }
 
+/// The paths a source's code imports, as module paths from the crate root
+/// (each cut to the longest prefix that is a module in `known`): `crate::`
+/// paths, `super::` and `self::` paths resolved against the source's own
+/// module, and `use NAME::` where `NAME` is a child module of the source.
+/// A braced list (`use super::{a, b::C}`) gives each of its members.
+fn imports(s: &Source, known: &BTreeSet<Vec<String>>) -> BTreeSet<Vec<String>> {
+    let ident = |t: &str| -> String {
+        t.chars()
+            .take_while(|c| c.is_alphanumeric() || *c == '_')
+            .collect()
+    };
+    // The path segments after a prefix, expanding one level of braces.
+    fn tails(rest: &str, ident: &dyn Fn(&str) -> String) -> Vec<Vec<String>> {
+        let mut path = Vec::new();
+        let mut r = rest;
+        loop {
+            if let Some(inner) = r.strip_prefix('{') {
+                let close = inner.find('}').unwrap_or(inner.len());
+                let mut out = Vec::new();
+                for member in inner[..close].split(',') {
+                    let m = member.trim();
+                    if m.is_empty() || m == "self" {
+                        out.push(path.clone());
+                        continue;
+                    }
+                    for t in tails(m, ident) {
+                        let mut p = path.clone();
+                        p.extend(t);
+                        out.push(p);
+                    }
+                }
+                return out;
+            }
+            let id = ident(r);
+            if id.is_empty() {
+                break;
+            }
+            path.push(id.clone());
+            match r[id.len()..].strip_prefix("::") {
+                Some(next) => r = next,
+                None => break,
+            }
+        }
+        vec![path]
+    }
+    let resolve = |mut p: Vec<String>| -> Option<Vec<String>> {
+        while !p.is_empty() && !known.contains(&p) {
+            p.pop();
+        }
+        (!p.is_empty()).then_some(p)
+    };
+    let mut out = BTreeSet::new();
+    // A re-export (`pub use ...;`) is the folder's public face, not a use:
+    // it counts only where the module's own code names what it re-exports.
+    let is_reexport = |l: &str| l.trim_start().starts_with("pub use ");
+    let scanned: String = s
+        .code
+        .lines()
+        .filter(|l| !is_reexport(l))
+        .collect::<Vec<_>>()
+        .join("\n");
+    let code = &scanned;
+    let bounded = |i: usize| {
+        !code[..i]
+            .chars()
+            .last()
+            .is_some_and(|c| c.is_alphanumeric() || c == '_' || c == ':')
+    };
+    for (i, _) in code.match_indices("crate::") {
+        if bounded(i) {
+            for t in tails(&code[i + 7..], &ident) {
+                out.extend(resolve(t));
+            }
+        }
+    }
+    for prefix in ["super::", "self::"] {
+        for (i, _) in code.match_indices(prefix) {
+            if !bounded(i) {
+                continue;
+            }
+            let mut base = s.module.clone();
+            let mut rest = &code[i..];
+            while let Some(r) = rest.strip_prefix("super::") {
+                base.pop();
+                rest = r;
+            }
+            if let Some(r) = rest.strip_prefix("self::") {
+                rest = r;
+            }
+            for t in tails(rest, &ident) {
+                let mut p = base.clone();
+                p.extend(t);
+                out.extend(resolve(p));
+            }
+        }
+    }
+    let body: String = code
+        .lines()
+        .filter(|l| !l.trim_start().starts_with("use "))
+        .collect::<Vec<_>>()
+        .join("\n");
+    let names_word = |name: &str| {
+        body.match_indices(name).any(|(i, _)| {
+            let before = body[..i].chars().last();
+            let after = body[i + name.len()..].chars().next();
+            !before.is_some_and(|c| c.is_alphanumeric() || c == '_')
+                && !after.is_some_and(|c| c.is_alphanumeric() || c == '_')
+        })
+    };
+    for line in s.code.lines() {
+        let l = line.trim_start();
+        let reexport = is_reexport(l);
+        let l = l.strip_prefix("pub ").unwrap_or(l);
+        let Some(rest) = l.strip_prefix("use ") else {
+            continue;
+        };
+        let bare = !["crate::", "super::", "self::"]
+            .iter()
+            .any(|p| rest.starts_with(p));
+        if !reexport && !bare {
+            continue; // read by the scans above
+        }
+        let mut base = s.module.clone();
+        let mut rest = rest;
+        if let Some(r) = rest.strip_prefix("crate::") {
+            base.clear();
+            rest = r;
+        }
+        while let Some(r) = rest.strip_prefix("super::") {
+            base.pop();
+            rest = r;
+        }
+        if let Some(r) = rest.strip_prefix("self::") {
+            rest = r;
+        }
+        let mut first = base.clone();
+        first.push(ident(rest));
+        if base == s.module && !known.contains(&first) {
+            continue; // an outside crate
+        }
+        for t in tails(rest, &ident) {
+            let name = t.last().cloned().unwrap_or_default();
+            let mut p = base.clone();
+            p.extend(t);
+            let Some(m) = resolve(p) else { continue };
+            if !reexport || names_word(&name) {
+                out.insert(m);
+            }
+        }
+    }
+    out.remove(&s.module);
+    out
+}
+
+/// The import graphs of every folder at every depth: for folder `P`, the
+/// nodes are its children (files and subfolders) and `(self)`, the folder's
+/// own code (its `mod.rs` or `NAME.rs`); an import from a source under child
+/// `A` of `P` of a module under child `B` of `P` is the edge `A -> B`.
+fn folder_graphs(sources: &[Source]) -> BTreeMap<Vec<String>, BTreeMap<String, BTreeSet<String>>> {
+    let known: BTreeSet<Vec<String>> = sources.iter().map(|s| s.module.clone()).collect();
+    let mut graphs: BTreeMap<Vec<String>, BTreeMap<String, BTreeSet<String>>> = BTreeMap::new();
+    for s in sources {
+        let m = &s.module;
+        for t in imports(s, &known) {
+            let lp = m.iter().zip(&t).take_while(|(a, b)| a == b).count();
+            let from = m.get(lp).cloned().unwrap_or_else(|| "(self)".into());
+            let to = t.get(lp).cloned().unwrap_or_else(|| "(self)".into());
+            if from != to {
+                graphs
+                    .entry(m[..lp].to_vec())
+                    .or_default()
+                    .entry(from)
+                    .or_default()
+                    .insert(to);
+            }
+        }
+    }
+    graphs
+}
+
 #[test]
 fn no_import_circles() {
     let sources = library_sources();
-    // Top level.
-    let mut g: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
-    for s in &sources {
-        let me = s.module[0].clone();
-        let e = g.entry(me.clone()).or_default();
-        for (dep, _) in after(&s.code, "crate::") {
-            if dep != me && layer(&dep).is_some() {
-                e.insert(dep);
-            }
-        }
-    }
-    assert_eq!(
-        find_cycle(&g),
-        None,
-        "import circle between top-level modules"
+    let graphs = folder_graphs(&sources);
+    assert!(
+        graphs.contains_key(&vec!["io".to_string(), "gyro".to_string()]),
+        "the checker no longer sees the files of src/io/gyro/"
     );
-    // Inside each folder: files import siblings through `super::` or the
-    // folder's full path. A folder's `mod.rs` only declares and re-exports
-    // (its own code counts as the node named after the folder).
-    let mut folders: BTreeMap<String, BTreeMap<String, BTreeSet<String>>> = BTreeMap::new();
-    for s in &sources {
-        if s.module.len() != 2 {
-            continue;
+    let mut bad = Vec::new();
+    for (folder, g) in &graphs {
+        if let Some(c) = find_cycle(g) {
+            bad.push(format!("src/{}/: {}", folder.join("/"), c.join(" -> ")));
         }
-        let (folder, me) = (&s.module[0], &s.module[1]);
-        let mut deps = BTreeSet::new();
-        for (dep, _) in after(&s.code, "super::") {
-            deps.insert(dep);
-        }
-        for (top, dep) in after(&s.code, "crate::") {
-            if &top == folder && !dep.is_empty() {
-                deps.insert(dep);
-            }
-        }
-        deps.remove(me);
-        folders
-            .entry(folder.clone())
-            .or_default()
-            .entry(me.clone())
-            .or_default()
-            .extend(deps);
     }
-    for (folder, g) in &folders {
-        // Keep edges to files of this folder only.
-        let names: BTreeSet<String> = g.keys().cloned().collect();
-        let g: BTreeMap<String, BTreeSet<String>> = g
-            .iter()
-            .map(|(k, v)| (k.clone(), v.intersection(&names).cloned().collect()))
-            .collect();
-        assert_eq!(
-            find_cycle(&g),
-            None,
-            "import circle between the files of src/{folder}/"
-        );
-    }
+    assert!(bad.is_empty(), "import circles:\n{}", bad.join("\n"));
 }
 
 #[test]
@@ -293,4 +431,24 @@ fn the_checker_sees_circles_and_upward_imports() {
         after(code, "super::"),
         vec![("walk".to_string(), "Walk".to_string())]
     );
+    // A circle three levels down (as src/io/gyro/fast.rs <-> plain.rs once was),
+    // through a braced `super::` list and a `use CHILD::` line.
+    let src = |m: &str, code: &str| Source {
+        module: m.split('/').map(String::from).collect(),
+        code: code.to_string(),
+        path: PathBuf::from(m),
+    };
+    let mut files = vec![
+        src("a", "use crate::a::b::c::T;"),
+        src("a/b", "use c::T;"),
+        src("a/b/c", "use super::{d::U, e};"),
+        src("a/b/d", "use super::c::T;"),
+        src("a/b/e", ""),
+    ];
+    let g = folder_graphs(&files);
+    let ab = vec!["a".to_string(), "b".to_string()];
+    assert!(find_cycle(&g[&ab]).is_some(), "{g:?}");
+    assert!(g[&ab]["(self)"].contains("c"), "{g:?}");
+    files[3] = src("a/b/d", "use super::e;");
+    assert_eq!(find_cycle(&folder_graphs(&files)[&ab]), None);
 }

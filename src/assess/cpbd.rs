@@ -41,10 +41,10 @@
 //! (horizontal edges walked down the columns), both sets of widths pooled in
 //! the same histogram. The original cannot see blur along the columns.
 
-use super::check_blocks;
+use super::blocks::check_blocks;
+use super::blocks::BLOCK;
 use super::edges::{edge_widths, is_edge_block, transpose, AngleRule, Axes};
 use super::matlab_edge::{canny, sobel_vertical};
-use super::BLOCK;
 use crate::error::Result;
 use image::GrayImage;
 
@@ -83,7 +83,7 @@ pub(crate) struct CpbdData {
 impl CpbdData {
     pub(crate) fn new(img: &GrayImage, axes: Axes) -> Self {
         let (w, h) = (img.width() as usize, img.height() as usize);
-        let a = super::to_f64(img);
+        let a = super::blocks::to_f64(img);
         let canny = canny(&a, w, h);
         let e = sobel_vertical(&a, w, h, Some(SOBEL_THRESHOLD));
         let rows = edge_widths(&a, w, h, &e, AngleRule::Cpbd);

@@ -58,10 +58,10 @@
 //! `jnbm_2d <= jnbm` on every image. Compare `jnbm_2d` values with each
 //! other, not with `jnbm`.
 
-use super::check_blocks;
+use super::blocks::check_blocks;
+use super::blocks::BLOCK;
 use super::edges::{edge_widths, is_edge_block, transpose, AngleRule, Axes};
 use super::matlab_edge::{canny, sobel_vertical};
-use super::BLOCK;
 use crate::error::{Error, Result};
 use image::GrayImage;
 use rayon::prelude::*;
@@ -141,7 +141,7 @@ fn block(a: &[f64], axes: Axes) -> Block {
 
 /// All whole blocks of `img`, row-major by block, with their edge data.
 pub(crate) fn blocks(img: &GrayImage, nbx: u32, nby: u32, axes: Axes) -> Vec<Block> {
-    let a = super::to_f64(img);
+    let a = super::blocks::to_f64(img);
     let w = img.width() as usize;
     let n = BLOCK as usize;
     (0..nbx * nby)

@@ -23,6 +23,7 @@
 //! [`assess`] computes all six; JNBM is `None` when it is undefined (no edge
 //! block with a measured width, see [`jnbm()`]).
 
+pub(crate) mod blocks;
 pub(crate) mod blur_effect;
 pub(crate) mod cpbd;
 pub mod edges;
@@ -31,19 +32,18 @@ pub(crate) mod laplacian;
 pub mod matlab_edge;
 pub(crate) mod whole_image;
 
+use blocks::check_blocks;
+pub use blocks::BLOCK;
 pub use blur_effect::{blur_effect, blur_effect_axes};
 pub use cpbd::{cpbd, cpbd_2d};
 pub use jnbm::{jnbm, jnbm_2d, jnbm_2d_report, jnbm_report, JnbmReport};
 pub use laplacian::laplacian_var;
 pub use whole_image::{cpbd_whole_image, jnbm_whole_image, jnbm_whole_image_report};
 
-use crate::error::{Error, Result};
+use crate::error::Result;
 use image::{DynamicImage, GrayImage, RgbImage};
 use serde::Serialize;
 use std::path::Path;
-
-/// Side of the square blocks used by JNBM and CPBD, pixels.
-pub const BLOCK: u32 = 64;
 
 /// Integer Rec. 601 luma of an 8-bit sRGB image:
 /// `Y = (299 R + 587 G + 114 B + 500) div 1000` (rounded half up, exact).
@@ -109,27 +109,6 @@ pub fn assess(img: &GrayImage) -> Result<Assessment> {
         blur_effect: blur_effect(img)?,
         laplacian_var: laplacian_var(img)?,
     })
-}
-
-/// Checks that an image holds at least one whole `BLOCK x BLOCK` block.
-pub(crate) fn check_blocks(what: &str, img: &GrayImage) -> Result<(u32, u32)> {
-    let (bx, by) = (img.width() / BLOCK, img.height() / BLOCK);
-    if bx == 0 || by == 0 {
-        return Err(Error::invalid(
-            what,
-            format!(
-                "image is {}x{} px; at least one whole {BLOCK}x{BLOCK} block is needed",
-                img.width(),
-                img.height()
-            ),
-        ));
-    }
-    Ok((bx, by))
-}
-
-/// Grey values as `f64` (0..255), row-major.
-pub(crate) fn to_f64(img: &GrayImage) -> Vec<f64> {
-    img.as_raw().iter().map(|&v| v as f64).collect()
 }
 
 #[cfg(test)]

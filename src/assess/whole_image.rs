@@ -21,7 +21,7 @@
 //! Formulas (`w_JNB`, `beta`, pooling) are those of
 //! [`super::jnbm`](mod@super::jnbm) and [`super::cpbd`](mod@super::cpbd).
 
-use super::check_blocks;
+use super::blocks::check_blocks;
 use super::cpbd::{p_blur, w_jnb_cpbd};
 use super::edges::{edge_widths, is_edge_block, AngleRule};
 use super::jnbm::{w_jnb, JnbmReport, BETA};
@@ -121,7 +121,7 @@ struct EdgeData {
 impl EdgeData {
     fn new(img: &GrayImage) -> Self {
         let (w, h) = (img.width() as usize, img.height() as usize);
-        let a = super::to_f64(img);
+        let a = super::blocks::to_f64(img);
         let sobel = sobel_vertical_edges(&a, w, h);
         let widths = edge_widths(&a, w, h, &sobel, AngleRule::Symmetric);
         EdgeData {
@@ -133,14 +133,14 @@ impl EdgeData {
     }
 
     fn block(&self, bx: u32, by: u32) -> impl Iterator<Item = usize> + '_ {
-        let b = super::BLOCK as usize;
+        let b = super::blocks::BLOCK as usize;
         let (x0, y0) = (bx as usize * b, by as usize * b);
         (y0..y0 + b).flat_map(move |y| (x0..x0 + b).map(move |x| y * self.w + x))
     }
 
     fn is_edge_block(&self, bx: u32, by: u32) -> bool {
         let n = self.block(bx, by).filter(|&i| self.canny[i]).count();
-        is_edge_block(n, (super::BLOCK * super::BLOCK) as usize)
+        is_edge_block(n, (super::blocks::BLOCK * super::blocks::BLOCK) as usize)
     }
 
     fn contrast(&self, bx: u32, by: u32) -> f64 {

@@ -54,13 +54,13 @@
 mod head;
 mod rows;
 
-use super::input::{check_increasing, line_too_long, open_stream, read_line, Line, MAX_LINE_BYTES};
+use super::input::{line_too_long, read_line, Line, MAX_LINE_BYTES};
 use crate::error::{quote, Error, Result};
 use glam::{DMat3, DVec3};
-use head::read_head;
-pub use rows::{GcsvReader, GcsvRow};
+pub use head::read_header;
+pub use rows::{to_csv, GcsvReader, GcsvRow};
 use std::fs::File;
-use std::io::{BufRead, BufReader, Read};
+use std::io::{BufRead, Read};
 use std::path::Path;
 
 /// The first line of a `.gcsv` file (either form).
@@ -283,35 +283,5 @@ fn utf8<'a>(bytes: &'a [u8], path: &Path, line: u64) -> Result<&'a str> {
         .map_err(|_| parse_err(path, line, "-", "the line is not UTF-8 text".into()))
 }
 
-/// Reads the header of the `.gcsv` file at `path` (up to its column line).
-pub fn read_header(path: &Path) -> Result<GcsvHeader> {
-    let mut src = BufReader::new(open_stream(path)?);
-    read_head(&mut src, path).map(|(h, _, _)| h)
-}
-
-/// The whole file as gyro CSV text, one line per line of the file: `#` for
-/// each line before the column line, `t,wx,wy,wz`, then one row per sample
-/// (s, rad/s, camera frame, `{:?}` decimals: shortest round trip), with `#`
-/// for blank and `#` lines among the samples. Times must strictly increase.
-/// (The readers take the samples from [`GcsvReader`]; this text is for
-/// other tools.)
-pub fn to_csv(path: &Path) -> Result<String> {
-    let mut r = GcsvReader::open(path)?;
-    let comments = |n: u64| "#\n".repeat(n as usize);
-    let mut s = comments(r.lines_read().saturating_sub(1));
-    s += "t,wx,wy,wz\n";
-    let mut written = r.lines_read();
-    let mut prev = None;
-    while let Some(row) = r.next_row()? {
-        check_increasing(path, row.line, r.time_column(), row.t, prev)?;
-        prev = Some((row.t, row.line));
-        s += &comments(row.line - written - 1);
-        let w = row.omega;
-        s += &format!("{:?},{:?},{:?},{:?}\n", row.t, w.x, w.y, w.z);
-        written = row.line;
-    }
-    s += &comments(r.lines_read() - written);
-    Ok(s)
-}
 #[cfg(test)]
 mod tests;

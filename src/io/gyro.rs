@@ -12,6 +12,7 @@
 
 mod fast;
 mod plain;
+mod raw;
 
 use super::gcsv::GcsvReader;
 use super::input::check_increasing;
@@ -21,7 +22,8 @@ use crate::error::{Error, Result};
 pub use crate::model::log::GyroSample;
 use crate::model::log::{is_gap, ImuLog, LogReadout};
 use glam::{DMat3, DVec3};
-use plain::{CsvSource, Raw};
+use plain::CsvSource;
+use raw::Raw;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 use std::str::FromStr;

@@ -6,7 +6,8 @@
 //! ffprobe's frames in [`ffprobe`]); [`input`]: the kind and size checks every reader
 //! shares (regular files and pipes only, capped lines, headers and image
 //! sizes); [`decimal`]: the numbers of text logs, read fast and to the bit as
-//! `str::parse` reads them. This layer imports nothing above `error`.
+//! `str::parse` reads them. Besides layer 0 it imports only its own layer's
+//! `model` (the validated log a reader yields) and `camera` (a log's readout).
 
 pub mod atomic;
 pub mod decimal;

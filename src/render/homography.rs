@@ -6,8 +6,8 @@
 
 use super::layout::GpuHomography;
 use super::target::Target;
-use super::trajectory::Trajectory;
 use crate::camera::Camera;
+use crate::model::trajectory::Trajectory;
 use glam::{DMat3, DVec3};
 
 /// The pixel-to-ray matrix: `K^-1 (x, y, 1)` is the camera-frame direction
@@ -23,7 +23,7 @@ fn pixel_to_ray(cam: &Camera) -> DMat3 {
 }
 
 /// The homography of pose `pose` (f64).
-pub fn homography(cam: &Camera, target: &Target, pose: &super::trajectory::Pose) -> DMat3 {
+pub fn homography(cam: &Camera, target: &Target, pose: &crate::model::trajectory::Pose) -> DMat3 {
     let f = target.frame();
     let (q, c) = pose;
     let dist = f.normal.dot(f.origin) - f.normal.dot(*c);
@@ -135,7 +135,7 @@ pub fn homographies(
 pub fn lens_derivatives(
     cam: &Camera,
     target: &Target,
-    pose: &super::trajectory::Pose,
+    pose: &crate::model::trajectory::Pose,
 ) -> (DMat3, DMat3) {
     let f = target.frame();
     let (q, c) = pose;

@@ -7,8 +7,8 @@
 //! lens's radial distortion limit) are NaN and left out of the means.
 
 use super::target::Target;
-use super::trajectory::{Pose, Trajectory};
 use crate::camera::Camera;
+use crate::model::trajectory::{Pose, Trajectory};
 use glam::{DMat3, DVec3};
 use rayon::prelude::*;
 

@@ -30,14 +30,13 @@ pub(crate) mod psf;
 mod sampling;
 pub(crate) mod target;
 pub mod texture;
-pub(crate) mod trajectory;
 
 pub use crate::gpu::Backend;
+pub use crate::model::trajectory::{Pose, Trajectory};
 pub use maps::{blur_maps, BlurMaps, BlurMeans};
 pub use poster::Background;
 pub use psf::{psf, Psf};
 pub use target::{project, Target, TargetKind, DEFAULT_BACKGROUND};
-pub use trajectory::{Pose, Trajectory};
 
 use crate::camera::Camera;
 use crate::error::{Error, Result};

@@ -8,9 +8,9 @@
 
 use super::maps::{max_path_px, track};
 use super::target::Target;
-use super::trajectory::Trajectory;
 use crate::camera::Camera;
 use crate::error::{Error, Result};
+use crate::model::trajectory::Trajectory;
 
 /// A PSF image.
 #[derive(Debug, Clone, PartialEq)]

@@ -11,11 +11,11 @@
 
 use super::poster::Background;
 use super::texture::MipTexture;
-use super::trajectory::Pose;
 use crate::board::Board;
 use crate::camera::Camera;
 use crate::check::{finite, positive};
 use crate::error::{Error, Result};
+use crate::model::trajectory::Pose;
 use glam::{DMat3, DVec3};
 use std::path::PathBuf;
 use std::sync::Arc;

@@ -6,7 +6,7 @@
 //! the same mean of the true pixel speed (px/s, [`crate::Mmbm::px_s`]: mm/s
 //! over the pitch with square, unskewed pixels) times `t_e`.
 //!
-//! Time: the motion is the renderer's (`render::trajectory`), the twist
+//! Time: the motion is the renderer's (`model::trajectory`), the twist
 //! interpolated linearly between gyro samples, so at a sensor point the flow
 //! is linear in time between samples and the speed is the length of that
 //! interpolated flow, integrated in closed form ([`super::lerp`]); it is at

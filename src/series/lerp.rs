@@ -1,5 +1,5 @@
 //! Flow speeds of the motion interpolated linearly between gyro samples
-//! (the renderer's motion, `render::trajectory`): between samples `k` and
+//! (the renderer's motion, `model::trajectory`): between samples `k` and
 //! `k + 1` the twist, and so the flow at a fixed sensor point, is
 //! `F(s) = F_k + s (F_{k+1} - F_k)` for `s` in `[0, 1]`, and its speed is
 //! `|F(s)|`, not the interpolation of the two speeds (they differ where the

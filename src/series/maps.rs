@@ -28,7 +28,7 @@ use crate::error::{Error, Result};
 use crate::io::frames::VideoFrame;
 use crate::model::log::ImuLog;
 use crate::model::motion::Plane;
-use crate::render::trajectory::Trajectory;
+use crate::model::trajectory::Trajectory;
 use rayon::prelude::*;
 
 /// Channels of a frame's maps, in the EXR's order of [`FrameMaps::channels`].

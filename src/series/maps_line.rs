@@ -7,7 +7,7 @@ use crate::camera::Camera;
 use crate::model::flow::FlowPoly;
 use crate::model::log::ImuLog;
 use crate::model::motion::{Plane, Twist};
-use crate::render::trajectory::Trajectory;
+use crate::model::trajectory::Trajectory;
 use glam::{DMat3, DQuat, DVec3};
 
 /// One line's motion over its exposure, as rotations (the GPU path uploads

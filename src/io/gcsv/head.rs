@@ -7,8 +7,8 @@ use super::{
     DEFAULT_GSCALE, DEFAULT_ORIENTATION, DEFAULT_TSCALE, MAGIC,
 };
 use crate::error::{quote, Result};
-use crate::io::input::MAX_HEADER_BYTES;
-use std::io::BufRead;
+use crate::io::input::{open_stream, MAX_HEADER_BYTES};
+use std::io::{BufRead, BufReader};
 use std::path::Path;
 
 /// A `key,value` header line: key, value (both trimmed) and line number.
@@ -253,4 +253,10 @@ fn check_columns(columns: &[String], path: &Path, line: u64) -> Result<()> {
         ));
     }
     Ok(())
+}
+
+/// Reads the header of the `.gcsv` file at `path` (up to its column line).
+pub fn read_header(path: &Path) -> Result<GcsvHeader> {
+    let mut src = BufReader::new(open_stream(path)?);
+    read_head(&mut src, path).map(|(h, _, _)| h)
 }

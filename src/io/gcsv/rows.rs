@@ -1,11 +1,11 @@
 //! The samples of a `.gcsv` file, one row at a time (constant memory).
 
+use super::head::read_head;
 use super::{
-    camera_axes, next_line, parse_err, parse_orientation, read_head, utf8, Axes, Columns,
-    GcsvHeader,
+    camera_axes, next_line, parse_err, parse_orientation, utf8, Axes, Columns, GcsvHeader,
 };
 use crate::error::{quote, Error, Result};
-use crate::io::input::open_stream;
+use crate::io::input::{check_increasing, open_stream};
 use glam::{DMat3, DVec3};
 use std::fs::File;
 use std::io::BufReader;
@@ -191,4 +191,29 @@ fn scaled(s: &str, scale: f64, path: &Path, line: u64, column: &str) -> Result<f
         ));
     }
     Ok(y)
+}
+
+/// The whole file as gyro CSV text, one line per line of the file: `#` for
+/// each line before the column line, `t,wx,wy,wz`, then one row per sample
+/// (s, rad/s, camera frame, `{:?}` decimals: shortest round trip), with `#`
+/// for blank and `#` lines among the samples. Times must strictly increase.
+/// (The readers take the samples from [`GcsvReader`]; this text is for
+/// other tools.)
+pub fn to_csv(path: &Path) -> Result<String> {
+    let mut r = GcsvReader::open(path)?;
+    let comments = |n: u64| "#\n".repeat(n as usize);
+    let mut s = comments(r.lines_read().saturating_sub(1));
+    s += "t,wx,wy,wz\n";
+    let mut written = r.lines_read();
+    let mut prev = None;
+    while let Some(row) = r.next_row()? {
+        check_increasing(path, row.line, r.time_column(), row.t, prev)?;
+        prev = Some((row.t, row.line));
+        s += &comments(row.line - written - 1);
+        let w = row.omega;
+        s += &format!("{:?},{:?},{:?},{:?}\n", row.t, w.x, w.y, w.z);
+        written = row.line;
+    }
+    s += &comments(r.lines_read() - written);
+    Ok(s)
 }

@@ -19,7 +19,7 @@
 //! line before it reads the `\n` of a `\r\n` ending the line before, so a
 //! record after a `\r\n` line is numbered one lower than its line.
 
-use super::plain::Raw;
+use super::raw::Raw;
 use crate::io::decimal::{parse_f64, parse_prefix};
 use crate::io::input::MAX_LINE_BYTES;
 use glam::DVec3;

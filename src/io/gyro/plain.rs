@@ -5,28 +5,13 @@
 //! line and column.
 
 use super::fast::{FastRows, Layout};
+use super::raw::Raw;
 use crate::error::{quote, Error, Result};
 use crate::io::input::{LineCap, MAX_LINE_BYTES};
 use glam::DVec3;
 use std::fs::File;
 use std::io::Read;
 use std::path::{Path, PathBuf};
-
-/// One sample as a source reads it: the file's units and axes, before the
-/// reader's options (units, rotation, offset).
-#[derive(Debug, Clone, Copy)]
-pub(super) struct Raw {
-    /// The sample's line in the file (1-based).
-    pub line: u64,
-    /// Time, in the file's unit.
-    pub t: f64,
-    /// Angular velocity, in the file's unit and IMU axes.
-    pub w: DVec3,
-    /// Linear velocity, m/s, IMU axes, when the log has `vx, vy, vz`.
-    pub v: Option<DVec3>,
-    /// Scene depth, m, when the log has `depth`.
-    pub depth: Option<f64>,
-}
 
 type Records = csv::Reader<LineCap<Box<dyn Read + Send>>>;
 

@@ -8,7 +8,7 @@
 
 use crate::check::positive;
 use crate::error::{Error, Result};
-use crate::io::gyro::GyroSample;
+use crate::model::log::GyroSample;
 use crate::model::log::{check_times, is_gap, median_interval, min_interval, ImuLog};
 use crate::model::motion::Twist;
 use glam::{DMat3, DQuat, DVec3};
