@@ -546,8 +546,8 @@ fn map_fps_above_the_cap_is_refused_up_front() {
     let _ = std::fs::remove_dir_all(&d);
 }
 
-/// `experiment --out DIR` over its config or its gyro log under a name it
-/// writes there is refused; a config elsewhere in DIR is fine.
+/// `experiment --out DIR` (and `dataset --out DIR`) over its config under a
+/// name it writes there is refused, leaving the folder as it was.
 #[test]
 fn experiment_output_folder_spares_its_inputs() {
     let d = folder("exp");
@@ -572,5 +572,27 @@ fn experiment_output_folder_spares_its_inputs() {
         std::fs::read_to_string(d.join("rep/report.md")).unwrap(),
         "exposure_s = 0.07\n"
     );
+    // The same for a dataset folder: its config named like its manifest.
+    std::fs::create_dir_all(d.join("ds")).unwrap();
+    std::fs::write(d.join("ds/manifest.jsonl"), "count = 1\n").unwrap();
+    let o = common::mmbm_in(
+        &d,
+        &[
+            "dataset",
+            "--config",
+            "ds/manifest.jsonl",
+            "--out",
+            "ds",
+            "--quiet",
+        ],
+    );
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("the input --config"), "{err}");
+    assert_eq!(
+        std::fs::read_to_string(d.join("ds/manifest.jsonl")).unwrap(),
+        "count = 1\n"
+    );
+    assert_eq!(std::fs::read_dir(d.join("ds")).unwrap().count(), 1);
     let _ = std::fs::remove_dir_all(&d);
 }
