@@ -82,10 +82,13 @@ fn read_expected(path: &Path) -> Result<(Vec<(f64, f64)>, f64)> {
 }
 
 pub fn run(a: BlobsArgs) -> Result<()> {
-    // The output's place, checked before any work.
-    if let Some(p) = &a.mask {
-        mmbm::io::atomic::check_output(p)?;
-    }
+    // The output's place, against every input, before any work.
+    mmbm::io::guard::OutputGuard::new()
+        .output("--mask", a.mask.as_deref())
+        .input("IMAGE", Some(&a.image))
+        .input("--expected", a.expected.as_deref())
+        .input("--camera", a.camera.camera.as_deref())
+        .check()?;
     let img = mmbm::io::images::read_rgb8(&a.image)?;
     let params = BlobParams {
         threshold: a.threshold,

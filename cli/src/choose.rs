@@ -5,6 +5,7 @@
 
 use clap::Args;
 use mmbm::error::{Error, Result};
+use mmbm::io::guard::OutputGuard;
 use mmbm::series::frames::FrameMmbm;
 use mmbm::series::select::{blurriest, choose, ffmpeg_select, image_list, Choice, FrameName};
 use std::path::{Path, PathBuf};
@@ -52,9 +53,8 @@ pub struct ChoiceArgs {
 }
 
 impl ChoiceArgs {
-    /// Checks the flags together and every output path (with `out`, the
-    /// table's), before any work.
-    pub fn check(&self, out: Option<&Path>) -> Result<()> {
+    /// Checks the flags together, before any work (the paths: [`Self::guard`]).
+    pub fn check(&self) -> Result<()> {
         let chosen = self.select.is_some() || self.max_blur.is_some();
         if !chosen && (self.gap != 0.0 || self.image_list.is_some() || self.ffmpeg_select.is_some())
         {
@@ -70,22 +70,18 @@ impl ChoiceArgs {
                 "nothing to write the blurriest frames to: give --worst-list FILE and/or --worst-ffmpeg-select FILE",
             ));
         }
-        self.choice().check()?;
-        let mut outputs: Vec<(&str, &Path)> = Vec::new();
-        if let Some(p) = out {
-            outputs.push(("--out", p));
-        }
-        for (flag, p) in [
-            ("--image-list", &self.image_list),
-            ("--ffmpeg-select", &self.ffmpeg_select),
-            ("--worst-list", &self.worst_list),
-            ("--worst-ffmpeg-select", &self.worst_ffmpeg_select),
-        ] {
-            if let Some(p) = p {
-                outputs.push((flag, p));
-            }
-        }
-        mmbm::io::atomic::check_outputs(&outputs)
+        self.choice().check()
+    }
+
+    /// A guard over every output: the table's (`out`, `None` for stdout) and
+    /// the lists'; the command adds its inputs and folders.
+    pub fn guard(&self, out: Option<&Path>) -> OutputGuard {
+        OutputGuard::new()
+            .output("--out", out)
+            .output("--image-list", self.image_list.as_deref())
+            .output("--ffmpeg-select", self.ffmpeg_select.as_deref())
+            .output("--worst-list", self.worst_list.as_deref())
+            .output("--worst-ffmpeg-select", self.worst_ffmpeg_select.as_deref())
     }
 
     fn choice(&self) -> Choice {

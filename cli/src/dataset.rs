@@ -183,6 +183,12 @@ pub fn run(a: DatasetArgs) -> Result<()> {
         Some(p) => DatasetConfig::load(p)?,
         None => DatasetConfig::default(),
     };
+    // The dataset folder writable and none of its inputs under a name
+    // written there, before any work.
+    mmbm::io::guard::OutputGuard::new()
+        .output_dir("--out", Some(&out), dataset::writes)
+        .input("--config", a.config.as_deref())
+        .check()?;
     let (sh, from) = shard(&a)?;
     let s = dataset::run(&cfg, &out, sh, !a.quiet)?;
     eprintln!(

@@ -39,6 +39,11 @@ pub fn run(a: ExperimentArgs) -> Result<()> {
         ));
     };
     let cfg = ExperimentConfig::load(&config)?;
+    // The config may lie in the output folder, but not under a name written there.
+    mmbm::io::guard::OutputGuard::new()
+        .output_dir("--out", Some(&out), experiment::writes)
+        .input("--config", Some(&config))
+        .check()?;
     run_and_print(&cfg, &out, !a.quiet)
 }
 

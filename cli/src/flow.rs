@@ -56,7 +56,13 @@ pub fn run(a: FlowArgs) -> Result<()> {
         super::args::check_ext(q, &["png"], "--quiver")?;
         outputs.push(("--quiver", q.as_path()));
     }
-    mmbm::io::atomic::check_outputs(&outputs)?;
+    let mut guard = mmbm::io::guard::OutputGuard::new();
+    for (flag, p) in outputs {
+        guard = guard.output(flag, Some(p));
+    }
+    guard
+        .input("--camera", a.camera.camera.as_deref())
+        .check()?;
     let scene = Scene {
         camera: a.camera.camera()?,
         plane: a.scene.plane()?,

@@ -7,6 +7,7 @@ use mmbm::error::{Error, Result};
 use mmbm::io::frames::read_frame_table;
 use mmbm::io::gyro::read_log;
 use mmbm::series::frames::frame_mmbm;
+use mmbm::series::maps_write::{is_map_name, stage_maps};
 use mmbm::series::SeriesOptions;
 use mmbm::{AnyMethod, Scene};
 use std::io::Write;
@@ -52,7 +53,9 @@ pub struct FramesArgs {
     pub choice: super::choose::ChoiceArgs,
     /// Also write each frame's per-pixel blur fields to DIR/frame_NNNNNN.exr (float EXR: disp.u,
     /// disp.v px, path_px, flow.u, flow.v px/s; NaN beyond the lens's radial limit), for the frames
-    /// written (all, or the --select ones) inside the log.
+    /// written (all, or the --select ones) inside the log. The maps appear together with the table and
+    /// the lists, or not at all (staged in a hidden folder, removed on failure or interrupt); no other
+    /// output may lie in DIR.
     #[arg(long, value_name = "DIR")]
     pub maps: Option<PathBuf>,
     /// Where --maps computes: cpu (f64, all cores), gpu (the maps kernel, or an error), auto
@@ -72,11 +75,15 @@ pub struct FramesArgs {
 }
 
 pub fn run(a: FramesArgs) -> Result<()> {
-    // The output's place, checked before any work.
-    a.choice.check(a.out.as_deref())?;
-    if let Some(d) = &a.maps {
-        mmbm::io::atomic::check_output_dir(d)?;
-    }
+    // Every output's place, against the others and every input, before any work.
+    a.choice.check()?;
+    a.choice
+        .guard(a.out.as_deref())
+        .output_dir("--maps", a.maps.as_deref(), is_map_name)
+        .input("--gyro", Some(&a.gyro))
+        .input("--frames", Some(&a.frames))
+        .input("--camera", a.camera.camera.as_deref())
+        .check()?;
     let method = match a.method {
         AnyMethod::Cpu(m) => m,
         AnyMethod::Gpu { .. } => {
@@ -135,9 +142,21 @@ pub fn run(a: FramesArgs) -> Result<()> {
         }
         Ok(())
     };
-    if let Some(dir) = &a.maps {
-        let done =
-            mmbm::series::maps_write::write_maps(&samples, &opts, &frames, &keep, dir, a.backend)?;
+    // The maps go to a staging folder; they, the table and the lists appear
+    // together once all were written, or none does.
+    let staged = match &a.maps {
+        Some(dir) => Some(stage_maps(&samples, &opts, &frames, &keep, dir, a.backend)?),
+        None => None,
+    };
+    let done = mmbm::io::atomic::all_or_nothing(|| {
+        match &a.out {
+            Some(p) => mmbm::io::atomic::write_atomic(p, |w| write(w))?,
+            None => write(&mut std::io::stdout().lock())?,
+        }
+        a.choice.write(&rows, &keep)?;
+        staged.map(|s| s.publish()).transpose()
+    })?;
+    if let (Some(dir), Some(done)) = (&a.maps, done) {
         let n = done.written.len();
         let mean = done.written.iter().map(|d| d.1).sum::<f64>() / n.max(1) as f64;
         eprintln!(
@@ -155,13 +174,6 @@ pub fn run(a: FramesArgs) -> Result<()> {
             );
         }
     }
-    mmbm::io::atomic::all_or_nothing(|| {
-        match &a.out {
-            Some(p) => mmbm::io::atomic::write_atomic(p, |w| write(w))?,
-            None => write(&mut std::io::stdout().lock())?,
-        }
-        a.choice.write(&rows, &keep)
-    })?;
     eprintln!(
         "{} frames ({} written), method {method}, camera readout {} s",
         rows.len(),

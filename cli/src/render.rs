@@ -5,7 +5,8 @@ use super::series::GyroArgs;
 use clap::Args;
 use glam::DVec3;
 use mmbm::error::{Error, Result};
-use mmbm::io::atomic::{all_or_nothing, check_outputs};
+use mmbm::io::atomic::all_or_nothing;
+use mmbm::io::guard::OutputGuard;
 use mmbm::io::images::{write_exr, write_png_linear_rgb};
 use mmbm::render::{
     self, Backend, Integrator, Quality, RenderJob, RenderOutput, Target, Trajectory,
@@ -133,6 +134,12 @@ fn pair(s: &str, what: &str) -> Result<[f64; 2]> {
     Ok([v[0], v[1]])
 }
 
+/// The texture file of an `image:PATH:WIDTH_M` target.
+fn texture_path(spec: &str) -> Option<PathBuf> {
+    let rest = spec.strip_prefix("image:")?;
+    rest.rsplit_once(':').map(|(p, _)| PathBuf::from(p))
+}
+
 fn write_image(p: &Path, o: &RenderOutput) -> Result<()> {
     check_ext(p, &["exr", "png"], "output")?;
     o.write_image(p)
@@ -168,7 +175,16 @@ pub fn run(args: RenderArgs) -> Result<()> {
     if let Some((_, _, file)) = &psf {
         outputs.push(("--psf", file));
     }
-    check_outputs(&outputs)?;
+    // Every output writable, none on another nor on an input, before any work.
+    let mut guard = OutputGuard::new();
+    for (flag, p) in outputs {
+        guard = guard.output(flag, Some(p));
+    }
+    guard
+        .input("--gyro", a.gyro.as_deref())
+        .input("--camera", a.camera.camera.as_deref())
+        .input("--target image:", texture_path(&a.target).as_deref())
+        .check()?;
     let mut camera = a.camera.camera()?;
     let log = match &a.gyro {
         Some(g) => {

@@ -110,6 +110,12 @@ pub struct SeriesArgs {
 }
 
 pub fn run(a: SeriesArgs) -> Result<()> {
+    // The output's place, against every input, before any work.
+    mmbm::io::guard::OutputGuard::new()
+        .output("--out", a.out.as_deref())
+        .input("--gyro", Some(&a.gyro))
+        .input("--camera", a.camera.camera.as_deref())
+        .check()?;
     let method = a.method;
     let opts = SeriesOptions {
         scene: Scene {

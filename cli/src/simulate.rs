@@ -37,10 +37,11 @@ pub struct SimulateArgs {
 }
 
 pub fn run(a: SimulateArgs) -> Result<()> {
-    // The output's place, checked before any work.
-    if let Some(p) = &a.out {
-        mmbm::io::atomic::check_output(p)?;
-    }
+    // The output's place, against the config, before any work.
+    mmbm::io::guard::OutputGuard::new()
+        .output("--out", a.out.as_deref())
+        .input("--config", a.config.as_deref())
+        .check()?;
     let gait = a.gait;
     let cfg = match &a.config {
         Some(p) => GaitConfig::load(p, gait)?,

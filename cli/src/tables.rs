@@ -21,10 +21,10 @@ pub struct TablesArgs {
 }
 
 pub fn run(a: TablesArgs) -> Result<()> {
-    // The output's place, checked before any work.
-    if let Some(p) = &a.plot {
-        mmbm::io::atomic::check_output(p)?;
-    }
+    // The output's place (writable), before any work.
+    mmbm::io::guard::OutputGuard::new()
+        .output("--plot", a.plot.as_deref())
+        .check()?;
     let ts = tables::all_tables()?;
     let grid = tables::grid_error()?;
     if a.json {

@@ -107,10 +107,12 @@ fn summary_text(frames: &[Frame], spec: &str, duration: f64, pitch_mm: Option<f6
 }
 
 pub fn run(a: TriggerArgs) -> Result<()> {
-    // The output's place, checked before any work.
-    if let Some(p) = &a.out {
-        mmbm::io::atomic::check_output(p)?;
-    }
+    // The output's place, against every input, before any work.
+    mmbm::io::guard::OutputGuard::new()
+        .output("--out", a.out.as_deref())
+        .input("--gyro", Some(&a.gyro))
+        .input("--camera", a.camera.camera.as_deref())
+        .check()?;
     let camera = a.camera.camera()?;
     let samples = read_log(&a.gyro, a.gyro_opts.options()?)?;
     let session = Session::new(

@@ -30,7 +30,7 @@ pub use config::DatasetConfig;
 pub use guard::{Record, RunLock};
 pub use item::{ItemParams, Sources};
 pub use manifest::{merge, verify, ManifestLine};
-pub use run::{make_item, run, RunSummary};
+pub use run::{make_item, run, writes, RunSummary};
 pub use sensor::SensorPipeline;
 pub use shard::{Shard, MAX_SHARDS};
 pub use webdataset::{

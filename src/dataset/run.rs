@@ -102,6 +102,24 @@ pub fn make_item(
     Ok(line)
 }
 
+/// True for a path (relative to the dataset folder) a run, `--merge` or
+/// `--format webdataset` writes: `dataset.json`, the manifests, the lock
+/// files and everything under `items/` and `webdataset/`.
+pub fn writes(rel: &Path) -> bool {
+    let mut parts = rel.components();
+    let Some(first) = parts.next() else {
+        return false;
+    };
+    let first = first.as_os_str().to_string_lossy();
+    if first == "items" || first == "webdataset" {
+        return true;
+    }
+    parts.next().is_none()
+        && (first == super::guard::RECORD
+            || first.starts_with(".lock-")
+            || (first.starts_with("manifest") && first.ends_with(".jsonl")))
+}
+
 /// What a run did.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RunSummary {
@@ -121,6 +139,23 @@ pub struct RunSummary {
 pub fn run(cfg: &DatasetConfig, out: &Path, shard: Shard, progress: bool) -> Result<RunSummary> {
     cfg.validate()?;
     shard.check_count(cfg.count)?;
+    // The folder writable and no input (textures, logs) under a name
+    // written there, before any work.
+    let mut guard = crate::io::guard::OutputGuard::new()
+        .output_dir("--out", Some(out), writes)
+        .input("textures", Some(&cfg.textures));
+    let logs: Vec<_> = cfg
+        .motion
+        .iter()
+        .filter_map(|m| match super::config::MotionSource::parse(m) {
+            Ok(super::config::MotionSource::Log(p)) => Some(p),
+            _ => None,
+        })
+        .collect();
+    for p in &logs {
+        guard = guard.input("motion log:", Some(p));
+    }
+    guard.check()?;
     let src = Sources::open(cfg)?;
     let rec = Record::of(cfg, &src)?;
     std::fs::create_dir_all(out).map_err(|e| Error::io(out, e))?;

@@ -191,7 +191,17 @@ impl MapSection {
         for &l in &self.lights_e_per_s {
             positive("map.lights_e_per_s", l)?;
         }
-        positive("map.fps", self.fps)?;
+        positive("[map] fps", self.fps)?;
+        if self.fps > crate::trigger::MAX_FPS {
+            return Err(Error::invalid(
+                "[map] fps",
+                format!(
+                    "{} frames/s is above the limit of {} frames/s (the trigger policies' cap)",
+                    self.fps,
+                    crate::trigger::MAX_FPS
+                ),
+            ));
+        }
         positive("map.max_gain_x", self.max_gain_x)?;
         if self.grid_ms.is_empty() {
             return Err(Error::invalid(

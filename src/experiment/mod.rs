@@ -33,4 +33,4 @@ pub use config::{ExperimentConfig, MapSection, WalkTimes, DEMO_POLICIES};
 pub use map::{BenefitMap, Cell, CellPolicy};
 pub use map_report::answer as map_answer;
 pub use report::{table_6, Outcome};
-pub use run::run;
+pub use run::{run, writes};

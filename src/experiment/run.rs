@@ -28,11 +28,30 @@ pub fn frames_to_render(frames: &[Frame], max: usize) -> Vec<usize> {
     (0..max).map(|k| kept[k * kept.len() / max]).collect()
 }
 
+/// True for a path (relative to the output folder) the experiment writes:
+/// `frames.csv`, `report.md` and the PNG figures, all at its top level.
+pub fn writes(rel: &Path) -> bool {
+    let mut parts = rel.components();
+    let (Some(one), None) = (parts.next(), parts.next()) else {
+        return false;
+    };
+    let name = Path::new(one.as_os_str());
+    name == Path::new("frames.csv")
+        || name == Path::new("report.md")
+        || name
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("png"))
+}
+
 /// Runs the experiment and writes `frames.csv`, `report.md` and the figures into `out`.
 pub fn run(cfg: &ExperimentConfig, out: &Path, progress: bool) -> Result<Outcome> {
     cfg.validate()?;
-    // The outputs' place is checked before minutes of rendering.
-    crate::io::atomic::check_output_dir(out)?;
+    // The outputs' place is checked before minutes of rendering: writable,
+    // and not over the gyro log it reads.
+    crate::io::guard::OutputGuard::new()
+        .output_dir("--out", Some(out), writes)
+        .input("gyro (config)", cfg.gyro.as_deref())
+        .check()?;
     let t_start = Instant::now();
     let quality = Quality::from_str(&cfg.quality)?;
     let scene = Scene {

@@ -197,7 +197,11 @@ pub fn check_output_dir(path: &Path) -> Result<()> {
                 path,
                 std::io::Error::new(
                     e.kind(),
-                    format!("cannot write in '{}': {e}", show_path(dir)),
+                    format!(
+                        "cannot write in '{}': {}",
+                        show_path(dir),
+                        super::guard::plain(&e)
+                    ),
                 ),
             )
         })
@@ -240,9 +244,11 @@ pub fn remove_pending() -> usize {
         .iter()
         .filter(|p| std::fs::remove_file(p).is_ok())
         .count();
+    // A writer may still be adding a file to a folder being removed: try
+    // again a few times.
     let dirs = taken(&PENDING_DIRS)
         .iter()
-        .filter(|p| std::fs::remove_dir_all(p).is_ok())
+        .filter(|p| (0..4).any(|_| std::fs::remove_dir_all(p).is_ok() || !p.exists()))
         .count();
     files + dirs
 }

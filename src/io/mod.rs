@@ -1,4 +1,6 @@
-//! Files in and out: atomic output ([`atomic`]: temp file + rename), image
+//! Files in and out: atomic output ([`atomic`]: temp file + rename), one
+//! check of a command's outputs against each other and its inputs before
+//! any work ([`guard`]), image
 //! files ([`images`]: EXR, sRGB PNG, textures) and gyro log readers
 //! (`gyro`: CSV, ROS 2 MCAP through `mcap` and Gyroflow `.gcsv` through
 //! [`gcsv`]; [`lines`]: one line at a time, for live streams); video frame
@@ -14,6 +16,7 @@ pub mod decimal;
 pub mod ffprobe;
 pub mod frames;
 pub mod gcsv;
+pub mod guard;
 pub mod gyro;
 pub mod images;
 pub mod input;

@@ -86,7 +86,7 @@ pub use live::{Event, Live};
 pub use pace::check_speed;
 pub use parse::{
     parse_policy, ExposureControl, Family, PolicyFamily, PolicySpec, Rate, DEFAULT_HORIZON_S,
-    THESIS_POLICY,
+    MAX_FPS, THESIS_POLICY,
 };
 pub use phase::Phase;
 pub use policy::{Level, LogView, Observation, Policy};
