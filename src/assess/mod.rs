@@ -42,6 +42,8 @@ use image::{DynamicImage, GrayImage, RgbImage};
 use serde::Serialize;
 use std::path::Path;
 
+pub use crate::limits::MAX_ASSESS_PIXELS;
+
 /// Side of the square blocks used by JNBM and CPBD, pixels.
 pub const BLOCK: u32 = 64;
 
@@ -70,8 +72,20 @@ pub fn to_grey(img: &DynamicImage) -> GrayImage {
 }
 
 /// Reads a PNG/JPEG (format guessed from the content) as a grey image,
-/// naming the file in errors.
+/// naming the file in errors. An image that declares more than
+/// [`MAX_ASSESS_PIXELS`] in its header is refused before it is decoded (the
+/// metrics' working memory, about 64 bytes per pixel, stays bounded).
 pub fn load_grey(path: &Path) -> Result<GrayImage> {
+    let (w, h) = crate::io::input::image_dimensions(path)?;
+    if w as u64 * h as u64 > MAX_ASSESS_PIXELS {
+        return Err(Error::Image {
+            path: path.into(),
+            message: format!(
+                "the header declares {w} x {h} pixels; assess takes at most {MAX_ASSESS_PIXELS} \
+                 (its working memory is about 64 bytes per pixel)"
+            ),
+        });
+    }
     Ok(to_grey(&crate::io::images::decode(path)?))
 }
 

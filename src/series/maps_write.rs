@@ -25,7 +25,8 @@ pub struct MapsWritten {
 }
 
 /// Writes the maps of the frames `which` (rows of `frames`) to `dir`
-/// (created if missing), one EXR each ([`file_name`]), each file
+/// (created if missing; a camera over [`super::maps::MAX_MAP_PIXELS`] is
+/// refused first), one EXR each ([`file_name`]), each file
 /// atomically; a frame whose span leaves the log or crosses a gap in it
 /// gets none (listed in [`MapsWritten::skipped`]). `backend`: where the
 /// maps are computed ([`super::maps_gpu::resolve`]: the GPU kernel or the
@@ -38,6 +39,7 @@ pub fn write_maps(
     dir: &std::path::Path,
     backend: crate::gpu::Backend,
 ) -> Result<MapsWritten> {
+    super::maps::check_size(&opts.scene.camera)?;
     std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
     let rays = MapRays::new(&opts.scene.camera)?;
     let mut gpu = super::maps_gpu::resolve(backend, &opts.scene.camera)?;
