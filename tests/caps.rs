@@ -232,6 +232,109 @@ fn experiment_lists_are_capped_naming_the_key() {
     assert!(cfg.validate().is_err());
 }
 
+/// A real, decodable `side` x `side` all-black 8-bit grey PNG, made cheaply:
+/// its zlib stream is written by hand (fixed Huffman codes: one literal 0,
+/// then matches of 258 bytes at distance 1, 13 bits each), about 1 MB for
+/// 13000 x 13000 (169 MB of pixels).
+fn black_png(side: u32) -> Vec<u8> {
+    struct Bits {
+        out: Vec<u8>,
+        acc: u64,
+        n: u32,
+    }
+    impl Bits {
+        /// `len` bits of `v`, least significant first (deflate's order).
+        fn put(&mut self, v: u64, len: u32) {
+            self.acc |= v << self.n;
+            self.n += len;
+            while self.n >= 8 {
+                self.out.push(self.acc as u8);
+                self.acc >>= 8;
+                self.n -= 8;
+            }
+        }
+        /// A Huffman code of `len` bits, most significant first.
+        fn code(&mut self, c: u64, len: u32) {
+            let rev = (0..len).fold(0, |r, i| r | ((c >> i) & 1) << (len - 1 - i));
+            self.put(rev, len);
+        }
+    }
+    let n = side as u64 * (side as u64 + 1); // a filter byte (0) per row
+    let mut b = Bits { out: vec![0x78, 0x01], acc: 0, n: 0 };
+    b.put(1, 1); // the last block
+    b.put(1, 2); // fixed Huffman codes
+    b.code(0b0011_0000, 8); // literal 0
+    let (matches, rest) = ((n - 1) / 258, (n - 1) % 258);
+    for _ in 0..matches {
+        b.code(0b1100_0101, 8); // length 258 (code 285)
+        b.code(0, 5); // distance 1
+    }
+    for _ in 0..rest {
+        b.code(0b0011_0000, 8);
+    }
+    b.code(0, 7); // end of block
+    if b.n > 0 {
+        b.out.push(b.acc as u8); // the last bits, to a byte boundary
+    }
+    let mut z = b.out;
+    let adler = ((n % 65521) << 16 | 1) as u32; // a = 1, b = n: all zeros
+    z.extend_from_slice(&adler.to_be_bytes());
+    let chunk = |kind: &[u8], data: &[u8]| {
+        let mut c = (data.len() as u32).to_be_bytes().to_vec();
+        let body = [kind, data].concat();
+        c.extend_from_slice(&body);
+        c.extend_from_slice(&crc32(&body).to_be_bytes());
+        c
+    };
+    let mut ihdr = side.to_be_bytes().to_vec();
+    ihdr.extend_from_slice(&side.to_be_bytes());
+    ihdr.extend_from_slice(&[8, 0, 0, 0, 0]); // 8-bit grey
+    [
+        b"\x89PNG\r\n\x1a\n".to_vec(),
+        chunk(b"IHDR", &ihdr),
+        chunk(b"IDAT", &z),
+        chunk(b"IEND", &[]),
+    ]
+    .concat()
+}
+
+fn crc32(bytes: &[u8]) -> u32 {
+    let mut c = !0u32;
+    for &b in bytes {
+        c ^= b as u32;
+        for _ in 0..8 {
+            c = if c & 1 == 1 { 0xEDB8_8320 ^ (c >> 1) } else { c >> 1 };
+        }
+    }
+    !c
+}
+
+#[test]
+fn black_png_is_a_real_image() {
+    // The generator, checked by the image crate's decoder on a small one.
+    let img = image::load_from_memory(&black_png(300)).unwrap().to_luma8();
+    assert_eq!(img.dimensions(), (300, 300));
+    assert!(img.pixels().all(|p| p.0[0] == 0));
+}
+
+#[test]
+fn assess_refuses_a_huge_image_under_a_3_gb_limit() {
+    // A real 13000 x 13000 PNG (its pixels decode): refused from its header
+    // under a 3 GB address-space limit, where decoding it would abort.
+    let d = tempfile::tempdir().unwrap();
+    std::fs::write(d.path().join("big.png"), black_png(13_000)).unwrap();
+    let bin = common::bin();
+    let t = Instant::now();
+    let o = std::process::Command::new("sh")
+        .arg("-c")
+        .arg(format!("ulimit -v 3000000 && exec '{}' assess big.png", bin.display()))
+        .current_dir(d.path())
+        .output()
+        .unwrap();
+    refused(&o, &["big.png", "13000 x 13000", "assess takes at most"]);
+    assert!(t.elapsed() < Duration::from_secs(10));
+}
+
 #[test]
 fn assess_refuses_a_huge_image_from_its_header() {
     let d = tempfile::tempdir().unwrap();
