@@ -49,7 +49,7 @@ fn maps_refuse_a_huge_camera_on_every_backend_before_any_work() {
     for (w, h) in [
         (100_000u64, 100_000u64),
         (8193, 8192),
-        (1 << 13, 1 << 12 | 1),
+        (1 << 13, (1 << 12) + 1),
     ] {
         assert!(w * h > cap);
         frames_inputs(d.path(), w, h);
@@ -255,12 +255,16 @@ fn black_png(side: u32) -> Vec<u8> {
         }
         /// A Huffman code of `len` bits, most significant first.
         fn code(&mut self, c: u64, len: u32) {
-            let rev = (0..len).fold(0, |r, i| r | ((c >> i) & 1) << (len - 1 - i));
+            let rev = (0..len).fold(0, |r, i| r | (((c >> i) & 1) << (len - 1 - i)));
             self.put(rev, len);
         }
     }
     let n = side as u64 * (side as u64 + 1); // a filter byte (0) per row
-    let mut b = Bits { out: vec![0x78, 0x01], acc: 0, n: 0 };
+    let mut b = Bits {
+        out: vec![0x78, 0x01],
+        acc: 0,
+        n: 0,
+    };
     b.put(1, 1); // the last block
     b.put(1, 2); // fixed Huffman codes
     b.code(0b0011_0000, 8); // literal 0
@@ -277,7 +281,7 @@ fn black_png(side: u32) -> Vec<u8> {
         b.out.push(b.acc as u8); // the last bits, to a byte boundary
     }
     let mut z = b.out;
-    let adler = ((n % 65521) << 16 | 1) as u32; // a = 1, b = n: all zeros
+    let adler = (((n % 65521) << 16) | 1) as u32; // a = 1, b = n: all zeros
     z.extend_from_slice(&adler.to_be_bytes());
     let chunk = |kind: &[u8], data: &[u8]| {
         let mut c = (data.len() as u32).to_be_bytes().to_vec();
@@ -303,7 +307,11 @@ fn crc32(bytes: &[u8]) -> u32 {
     for &b in bytes {
         c ^= b as u32;
         for _ in 0..8 {
-            c = if c & 1 == 1 { 0xEDB8_8320 ^ (c >> 1) } else { c >> 1 };
+            c = if c & 1 == 1 {
+                0xEDB8_8320 ^ (c >> 1)
+            } else {
+                c >> 1
+            };
         }
     }
     !c
@@ -327,7 +335,10 @@ fn assess_refuses_a_huge_image_under_a_3_gb_limit() {
     let t = Instant::now();
     let o = std::process::Command::new("sh")
         .arg("-c")
-        .arg(format!("ulimit -v 3000000 && exec '{}' assess big.png", bin.display()))
+        .arg(format!(
+            "ulimit -v 3000000 && exec '{}' assess big.png",
+            bin.display()
+        ))
         .current_dir(d.path())
         .output()
         .unwrap();
