@@ -225,8 +225,10 @@ fn experiment_lists_are_capped_naming_the_key() {
         assert!(!p.join("xo").exists());
     }
     // At the cap a list is accepted (validation only).
-    let mut cfg = mmbm::experiment::ExperimentConfig::default();
-    cfg.sweep_exposures_s = vec![0.01; mmbm::limits::MAX_LIST_ENTRIES];
+    let mut cfg = mmbm::experiment::ExperimentConfig {
+        sweep_exposures_s: vec![0.01; mmbm::limits::MAX_LIST_ENTRIES],
+        ..Default::default()
+    };
     assert!(cfg.validate().is_ok());
     cfg.sweep_exposures_s.push(0.01);
     assert!(cfg.validate().is_err());
