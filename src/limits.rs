@@ -6,11 +6,111 @@
 //! cap and where it came from. `docs/limits.md` lists every cap here, and
 //! `tests/limits_doc.rs` keeps that list true.
 
+use crate::error::{Error, Result};
+
 // == pixels and images ==
+
+/// Most pixels of a rendered frame (`render`, datasets, the experiment),
+/// px. Memory: about 24 bytes each with maps.
+pub const MAX_PIXELS: u64 = 1 << 26;
+
+/// Most pixel-samples of one rendered frame (pixels x samples per pixel): work.
+pub const MAX_PIXEL_SAMPLES: u64 = 1 << 40;
+
+/// Most cells of a flow field (`flow`, `field::flow_field`, Python), cells.
+pub const MAX_FIELD_PIXELS: u64 = 1 << 26;
+
+/// Most pixels an input PNG/JPEG may declare in its header (checked before
+/// decoding), px: 2^28, 1 GiB as 8-bit RGBA.
+pub const MAX_IMAGE_PIXELS: u64 = 1 << 28;
+
+/// Most pixels of one frame's blur maps (`frames --maps`, Python's
+/// `frames(maps=True)`), px: the camera's width x height, checked before
+/// anything is allocated, on every backend. The f64 path holds about 58
+/// bytes per pixel at its peak (measured: 349 MB for 3000 x 2000; a cached
+/// ray of 16 bytes, the five f32 channels twice, the EXR being written), so
+/// 2^25 pixels (a 5.8k x 5.8k sensor; 8K UHD's 33.2 million fit) take
+/// about 2 GB.
+pub const MAX_MAP_PIXELS: u64 = 1 << 25;
+
+/// Most pixels an image given to `mmbm assess` (and `assess::load_grey`)
+/// may declare, px, checked from its header before it is decoded. The
+/// metrics hold about 64 bytes per pixel at their peak (measured: 1.0 GB
+/// for a 4000 x 4000 grey PNG: the decoded image, its grey copy, edge maps,
+/// f64 gradients), so 2^25 pixels (8K UHD fits) take about 2.1 GB.
+pub const MAX_ASSESS_PIXELS: u64 = 1 << 25;
+
+/// Refuses `width` x `height` over `max` pixels, naming `what` (a flag, key
+/// or file) and `doing` (what would have been sized by it).
+pub fn check_pixels(what: &str, doing: &str, width: u64, height: u64, max: u64) -> Result<()> {
+    let pixels = width as u128 * height as u128;
+    if pixels > max as u128 {
+        return Err(Error::invalid(
+            what,
+            format!("{width}x{height} = {pixels} pixels: {doing} takes at most {max} pixels"),
+        ));
+    }
+    Ok(())
+}
 
 // == light and sensor noise ==
 
+/// Most light a sensor may be given, e-/s for a white pixel (`--light`,
+/// `[camera.noise] phi_e_per_s` of camera files, dataset and experiment
+/// configs, `map.lights_e_per_s`, `task:...:light=`, Python). No real pixel
+/// holds more than about 1e6 to 1e7 electrons (its full well), so 1e12 e-/s
+/// fills even that in 10 us: generous for any exposure, and finite.
+pub const MAX_LIGHT_E_PER_S: f64 = 1e12;
+
+/// Largest mean (electrons) whose shot noise is drawn from the exact
+/// Poisson sampler; above it, from the normal approximation `N(mu, mu)`
+/// rounded and clamped at 0, which is bounded in time for every mean (the
+/// exact sampler of `rand_distr` 0.4 loses its precision beyond about
+/// 1e15 and spins near 1e305). The difference between the two
+/// distributions is of the order of the skewness `1/sqrt(mu)`, at most
+/// 3.2e-5 here, and a mean this large is clipped at any real full well.
+pub const MAX_EXACT_POISSON_MEAN_E: f64 = 1e9;
+
+/// Refuses a light level that is not finite, not positive or above
+/// [`MAX_LIGHT_E_PER_S`], naming where it came from (`what`).
+pub fn check_light(what: &str, phi_e_per_s: f64) -> Result<f64> {
+    if !(phi_e_per_s.is_finite() && phi_e_per_s > 0.0) {
+        return Err(Error::invalid(
+            what,
+            format!("must be > 0 e-/s, got {phi_e_per_s}"),
+        ));
+    }
+    if phi_e_per_s > MAX_LIGHT_E_PER_S {
+        return Err(Error::invalid(
+            what,
+            format!(
+                "{phi_e_per_s:e} e-/s is above the cap of {MAX_LIGHT_E_PER_S:e} e-/s \
+                 (a white pixel would pass any real full well in under 10 us)"
+            ),
+        ));
+    }
+    Ok(phi_e_per_s)
+}
+
 // == lists and entries ==
+
+/// Most entries of each list of an experiment config (`policies`, `walks`,
+/// `sweep_exposures_s`, `map.lights_e_per_s`, `map.gaits`, `map.boards`,
+/// `map.policies`, `map.grid_ms`; `seeds` and `map.seeds` had this cap
+/// already): each entry multiplies the frames rendered, and 100 of them
+/// already run for hours.
+pub const MAX_LIST_ENTRIES: usize = 100;
+
+/// Refuses a list of `len` entries over `max`, naming its key.
+pub fn check_len(key: &str, len: usize, max: usize) -> Result<()> {
+    if len > max {
+        return Err(Error::invalid(
+            key,
+            format!("{len} entries: at most {max} are accepted"),
+        ));
+    }
+    Ok(())
+}
 
 // == lens profiles ==
 

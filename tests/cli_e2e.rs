@@ -65,6 +65,8 @@ fn simulate_then_trigger() {
             "--exposure",
             "0.05",
             "--summary",
+            "--out",
+            "summary-frames.csv",
         ],
     );
     assert!(String::from_utf8_lossy(&o.stdout).contains("fixed:5:"));

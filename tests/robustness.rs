@@ -116,6 +116,8 @@ fn edge_inputs_that_have_an_answer() {
             "--exposure",
             "0.05",
             "--summary",
+            "--out",
+            "calm-frames.csv",
         ],
     );
     let out = String::from_utf8_lossy(&o.stdout);

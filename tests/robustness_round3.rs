@@ -61,6 +61,8 @@ fn time_bases_too_coarse_for_the_exposure_are_refused() {
             "--policy",
             "fixed:5",
             "--summary",
+            "--out",
+            "f.csv",
         ],
     );
     let out = String::from_utf8_lossy(&o.stdout);

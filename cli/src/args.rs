@@ -96,8 +96,8 @@ pub struct CameraArgs {
     /// Readout direction: top-to-bottom, bottom-to-top, left-to-right, right-to-left.
     #[arg(long, value_name = "DIR")]
     pub readout_direction: Option<mmbm::camera::Readout>,
-    /// Sensor noise at this light level (electrons per second of a white pixel),
-    /// with the camera file's other noise keys or their defaults.
+    /// Sensor noise at this light level (electrons per second of a white pixel,
+    /// at most 1e12), with the camera file's other noise keys or their defaults.
     #[arg(long, value_name = "E_PER_S")]
     pub light: Option<f64>,
 }
@@ -106,6 +106,11 @@ impl CameraArgs {
     /// The camera these options describe, validated: the file (or the
     /// thesis camera) with the flags over it, by the library.
     pub fn camera(&self) -> Result<Camera> {
+        // Over the cap: named by the flag (a non-positive light is named by
+        // its key, noise.phi_e_per_s, as it always was).
+        if let Some(phi) = self.light.filter(|&p| p > mmbm::limits::MAX_LIGHT_E_PER_S) {
+            mmbm::limits::check_light("--light", phi)?;
+        }
         let over = mmbm::camera::CameraOverrides {
             keys: mmbm::camera::CameraFile {
                 focal_mm: self.focal,

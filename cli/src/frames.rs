@@ -94,6 +94,10 @@ pub fn run(a: FramesArgs) -> Result<()> {
         }
     };
     let camera = a.camera.camera()?;
+    if a.maps.is_some() {
+        // The maps' size, before the log is read or anything allocated.
+        mmbm::series::maps::check_size(&camera)?;
+    }
     let frames = read_frame_table(&a.frames, a.exposure)?;
     let samples = read_log(&a.gyro, a.gyro_opts.options()?)?;
     let camera = super::args::with_log_readout(camera, samples.readout(), &a.gyro)?;

@@ -105,8 +105,10 @@ pub struct RenderOpts {
     /// images) or lattice (supersampled area and time; the reference).
     #[arg(long, default_value = "auto")]
     pub integrator: Integrator,
-    /// auto (GPU if any, else CPU), gpu, cpu, or bulk (a hardware GPU, else CPU).
-    #[arg(long, default_value = "auto")]
+    /// bulk (the default: a hardware GPU, else the CPU twin, which is faster
+    /// than a software adapter such as lavapipe), auto (GPU if any, software
+    /// ones included, else CPU), gpu (a GPU or an error) or cpu.
+    #[arg(long, default_value = "bulk")]
     pub backend: Backend,
     /// Seed of the per-pixel sample shifts.
     #[arg(long, default_value_t = 0)]

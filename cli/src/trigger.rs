@@ -17,19 +17,32 @@ use std::path::PathBuf;
 looks at the future, so not causal: `mmbm live` refuses it; FPS at most 1000):
   fixed:FPS[@PHASE]  threshold:X  adaptive[:X[:FPS]]  oracle:X[:H]  forecast:X[:H]  phase:X[:H]
   gate:X[:FPS[@PHASE]]  gate0:X[:FPS[@PHASE]]  deadline:FPS[:X]
+  fixed:FPS[@PHASE]@Tms  ae:FPS[@PHASE][:cap=Tms][:target=F][:damp=F][:scene=F]
+  task:FPS:light=E[:read=E][:tmin=Tms]
   (gate keeps a fixed-rate frame when its exposure-averaged MMBM is <= X; gate0, the thesis's test, when
   the MMBM at the exposure start, i.e. of the decision sample, is; phase learns the gait's cycle from
-  its touchdowns)
+  its touchdowns; fixed:FPS@Tms exposes every frame for T ms, gain raised by --exposure / T; ae is a
+  motion-blind auto-exposure on the fixed schedule: exposure up to cap (default --exposure) first, then
+  gain, toward a mean level target (default 0.18) with damping damp (0.5), the scene's mean radiance
+  scene (0.25); task picks each slot's instant and exposure for the highest predicted chance of a sharp
+  frame at the stated light E e-/s (at most 1e12; read noise read e-, default 2.5; shortest exposure
+  tmin, default 0.2ms))
 Exposure control: any policy followed by +exp:B[:TMIN] exposes each frame for
   clamp(B x pitch / MMBM, TMIN, --exposure) s (predicted blur within B px; TMIN default 0.001) and raises
   the gain by --exposure / that; the CSV's gain column says by how much.
+Output: the CSV goes to --out FILE, else to stdout; the summary goes to stderr, or to stdout with
+  --summary when --out names a file (the CSV is never dropped).
 
 Examples:
   mmbm simulate --gait moderate --duration 16 --out walk.csv
   mmbm trigger --gyro walk.csv --policy fixed:5 --policy threshold:0.4 --exposure 0.07 --out frames.csv
-  mmbm trigger --gyro walk.csv --policy oracle:0.4 --policy phase:0.4 --exposure 0.07 --summary
-  mmbm trigger --gyro walk.csv --policy fixed:5+exp:2:0.02 --policy deadline:5+exp:3 --exposure 0.07 --summary
-  mmbm trigger --gyro ../shared/data/running_phone/gyro.csv --policy threshold:p20 --exposure 0.02 --summary"
+  mmbm trigger --gyro walk.csv --policy oracle:0.4 --policy phase:0.4 --exposure 0.07 --out f.csv --summary
+  mmbm trigger --gyro walk.csv --policy fixed:5+exp:2:0.02 --policy deadline:5+exp:3 --exposure 0.07 \\
+      --out f.csv --summary
+  mmbm trigger --gyro walk.csv --policy fixed:5@10ms --policy ae:5:cap=10ms --policy task:5:light=20000 \\
+      --exposure 0.07 --out frames.csv --summary
+  mmbm trigger --gyro ../shared/data/running_phone/gyro.csv --policy threshold:p20 --exposure 0.02 \\
+      --out f.csv --summary"
 )]
 pub struct TriggerArgs {
     /// Gyro log: CSV t,wx,wy,wz[,vx,vy,vz][,depth]; also a ROS 2 .mcap or a
@@ -41,10 +54,11 @@ pub struct TriggerArgs {
     pub policy: Vec<PolicySpec>,
     #[command(flatten)]
     pub timing: TimingArgs,
-    /// Output CSV of frames (default: stdout, unless --summary).
+    /// Output CSV of frames (default or `-`: stdout).
     #[arg(long, value_name = "FILE")]
     pub out: Option<PathBuf>,
-    /// Print the summary on stdout (else on stderr).
+    /// Print the summary on stdout when the CSV goes to a file (--out FILE);
+    /// the summary is otherwise on stderr, and the CSV is never dropped.
     #[arg(long)]
     pub summary: bool,
     /// MMBM method (CPU): riemann[:NUxNV], gauss[:N], exact[:TOL].
@@ -147,16 +161,21 @@ pub fn run(a: TriggerArgs) -> Result<()> {
         }
         Ok(())
     };
-    match &a.out {
-        Some(p) => mmbm::io::atomic::write_atomic(p, |w| write(w))?,
-        None if !a.summary => {
+    // The CSV always goes somewhere: --out FILE, else stdout. The summary
+    // takes stdout only with --summary and a CSV that does not (else stderr).
+    let csv_on_stdout = match &a.out {
+        Some(p) if p.as_os_str() != "-" => {
+            mmbm::io::atomic::write_atomic(p, |w| write(w))?;
+            false
+        }
+        _ => {
             let mut out = std::io::BufWriter::new(std::io::stdout().lock());
             write(&mut out)?;
             out.flush().map_err(|e| Error::io("<stdout>", e))?;
+            true
         }
-        None => {}
-    }
-    if a.summary {
+    };
+    if a.summary && !csv_on_stdout {
         print!("{text}");
     } else {
         eprint!("{text}");

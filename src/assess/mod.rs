@@ -40,10 +40,12 @@ pub use jnbm::{jnbm, jnbm_2d, jnbm_2d_report, jnbm_report, JnbmReport};
 pub use laplacian::laplacian_var;
 pub use whole_image::{cpbd_whole_image, jnbm_whole_image, jnbm_whole_image_report};
 
-use crate::error::Result;
+use crate::error::{Error, Result};
 use image::{DynamicImage, GrayImage, RgbImage};
 use serde::Serialize;
 use std::path::Path;
+
+pub use crate::limits::MAX_ASSESS_PIXELS;
 
 /// Integer Rec. 601 luma of an 8-bit sRGB image:
 /// `Y = (299 R + 587 G + 114 B + 500) div 1000` (rounded half up, exact).
@@ -70,8 +72,20 @@ pub fn to_grey(img: &DynamicImage) -> GrayImage {
 }
 
 /// Reads a PNG/JPEG (format guessed from the content) as a grey image,
-/// naming the file in errors.
+/// naming the file in errors. An image that declares more than
+/// [`MAX_ASSESS_PIXELS`] in its header is refused before it is decoded (the
+/// metrics' working memory, about 64 bytes per pixel, stays bounded).
 pub fn load_grey(path: &Path) -> Result<GrayImage> {
+    let (w, h) = crate::io::input::image_dimensions(path)?;
+    if w as u64 * h as u64 > MAX_ASSESS_PIXELS {
+        return Err(Error::Image {
+            path: path.into(),
+            message: format!(
+                "the header declares {w} x {h} pixels; assess takes at most {MAX_ASSESS_PIXELS} \
+                 (its working memory is about 64 bytes per pixel)"
+            ),
+        });
+    }
     Ok(to_grey(&crate::io::images::decode(path)?))
 }
 

@@ -12,6 +12,7 @@
 //! `Var[DN] = K^2 (mu_e + sigma_d^2) + 1/12` (quantisation).
 
 use crate::error::{Error, Result};
+use crate::limits::MAX_EXACT_POISSON_MEAN_E;
 use rand::{rngs::StdRng, SeedableRng};
 use rand_distr::{Distribution, Normal, Poisson};
 use serde::{Deserialize, Serialize};
@@ -76,12 +77,7 @@ impl Noise {
     /// Rejects parameters out of range, naming the key.
     pub fn validate(&self) -> Result<()> {
         let bad = |k: &str, m: String| Err(Error::invalid(format!("noise.{k}"), m));
-        if !(self.phi_e_per_s.is_finite() && self.phi_e_per_s > 0.0) {
-            return bad(
-                "phi_e_per_s",
-                format!("must be > 0 e-/s, got {}", self.phi_e_per_s),
-            );
-        }
+        crate::limits::check_light("noise.phi_e_per_s", self.phi_e_per_s)?;
         if !(self.read_noise_e.is_finite() && self.read_noise_e >= 0.0) {
             return bad(
                 "read_noise_e",
@@ -128,13 +124,7 @@ impl Noise {
                 );
                 for p in chunk.iter_mut() {
                     let mu = scale * (*p as f64).clamp(0.0, f64::MAX);
-                    let shot = if mu > 0.0 && mu.is_finite() {
-                        Poisson::new(mu)
-                            .map_err(|e| Error::invalid("noise", format!("mean {mu} e-: {e}")))?
-                            .sample(&mut rng)
-                    } else {
-                        0.0
-                    };
+                    let shot = shot_noise(mu, &mut rng)?;
                     let e = (shot + read.sample(&mut rng)).clamp(0.0, self.full_well_e);
                     *p = ((k * e).round().clamp(0.0, max_dn) / max_dn) as f32;
                 }
@@ -144,6 +134,27 @@ impl Noise {
 
     /// Values per RNG chunk of [`Noise::apply`].
     pub const CHUNK: usize = 16384;
+}
+
+/// The electrons of a pixel whose mean is `mu` e- (shot noise), bounded in
+/// time for every mean: the exact Poisson sampler up to
+/// [`MAX_EXACT_POISSON_MEAN_E`] (its seeded draws unchanged), above it the
+/// normal approximation `N(mu, mu)` rounded and clamped at 0; 0 for a mean
+/// of 0 (or NaN), and `f64::MAX` (clipped at the full well by the caller)
+/// for an infinite one.
+pub fn shot_noise<R: rand::Rng + ?Sized>(mu: f64, rng: &mut R) -> Result<f64> {
+    if mu.is_nan() || mu <= 0.0 {
+        Ok(0.0)
+    } else if mu == f64::INFINITY {
+        Ok(f64::MAX)
+    } else if mu <= MAX_EXACT_POISSON_MEAN_E {
+        Ok(Poisson::new(mu)
+            .map_err(|e| Error::invalid("noise", format!("mean {mu} e-: {e}")))?
+            .sample(rng))
+    } else {
+        let z: f64 = rng.sample(rand_distr::StandardNormal);
+        Ok((mu + mu.sqrt() * z).round().max(0.0))
+    }
 }
 
 #[cfg(test)]
@@ -204,6 +215,60 @@ mod tests {
         let mut dark = vec![0.0f32; 1000];
         noise.apply(&mut dark, 0.05, 0).unwrap();
         assert!(dark.iter().all(|&p| (0.0..0.01).contains(&p)));
+    }
+
+    /// Up to the threshold the draws are the exact sampler's, seed for seed
+    /// (goldens keep their bytes); above it they are bounded in time for
+    /// every mean, with the mean and variance of Poisson(mu).
+    #[test]
+    fn shot_noise_is_exact_below_and_bounded_above() {
+        for mu in [0.5, 11.9, 12.0, 1400.0, 2e4, 1e6, MAX_EXACT_POISSON_MEAN_E] {
+            let (mut a, mut b) = (StdRng::seed_from_u64(3), StdRng::seed_from_u64(3));
+            let p = Poisson::new(mu).unwrap();
+            for _ in 0..200 {
+                assert_eq!(shot_noise(mu, &mut a).unwrap(), p.sample(&mut b), "{mu}");
+            }
+        }
+        let start = std::time::Instant::now();
+        let mut rng = StdRng::seed_from_u64(5);
+        for mu in [1.0000001e9, 1e12, 1e15, 1e200, 1e305, 1.7e308, f64::MAX] {
+            let n = 20_000;
+            // Each draw in standard units: (draw - mu) / sqrt(mu).
+            let z: Vec<f64> = (0..n)
+                .map(|_| {
+                    let d = shot_noise(mu, &mut rng).unwrap();
+                    assert!(d.is_finite() && d >= 0.0, "{mu}: {d}");
+                    (d - mu) / mu.sqrt()
+                })
+                .collect();
+            assert!(z.iter().all(|z| z.abs() < 7.0), "{mu}");
+            if mu > 1e16 {
+                continue; // sqrt(mu) nears the spacing of f64 values at mu
+            }
+            let mean = z.iter().sum::<f64>() / n as f64;
+            let var = z.iter().map(|z| (z - mean).powi(2)).sum::<f64>() / (n - 1) as f64;
+            // Standard errors of the mean and the variance of N(0, 1).
+            let (sm, sv) = ((1.0 / n as f64).sqrt(), (2.0 / n as f64).sqrt());
+            assert!(mean.abs() < 5.0 * sm, "{mu}: mean {mean}");
+            assert!((var - 1.0).abs() < 5.0 * sv, "{mu}: variance {var}");
+        }
+        assert_eq!(shot_noise(f64::INFINITY, &mut rng).unwrap(), f64::MAX);
+        assert_eq!(shot_noise(0.0, &mut rng).unwrap(), 0.0);
+        assert_eq!(shot_noise(f64::NAN, &mut rng).unwrap(), 0.0);
+        assert!(start.elapsed().as_secs_f64() < 5.0, "{:?}", start.elapsed());
+    }
+
+    /// An absurd mean through the whole model: saturated white, quickly.
+    #[test]
+    fn absurd_means_saturate() {
+        let noise = Noise::at_light(crate::limits::MAX_LIGHT_E_PER_S);
+        for t in [1.0, 1e300, f64::MAX] {
+            let mut px = vec![0.7f32; 3 * Noise::CHUNK];
+            noise.apply(&mut px, t, 0).unwrap();
+            assert!(px.iter().all(|&p| p == 1.0), "{t}");
+        }
+        let e = Noise::at_light(1e308).validate().unwrap_err().to_string();
+        assert!(e.contains("noise.phi_e_per_s") && e.contains("1e12"), "{e}");
     }
 
     #[test]

@@ -180,16 +180,29 @@ impl MapSection {
         }
     }
 
-    /// Checks the section (each light, exposure and gain positive, the
-    /// strings parse); `max_exposure_s` is the experiment's exposure.
+    /// Refuses a list over [`crate::limits::MAX_LIST_ENTRIES`], naming its key.
+    fn check_lengths(&self) -> Result<()> {
+        use crate::limits::{check_len, MAX_LIST_ENTRIES as MAX};
+        check_len("map.lights_e_per_s", self.lights_e_per_s.len(), MAX)?;
+        check_len("map.gaits", self.gaits.len(), MAX)?;
+        check_len("map.boards", self.boards.len(), MAX)?;
+        check_len("map.policies", self.policies.len(), MAX)?;
+        check_len("map.grid_ms", self.grid_ms.len(), MAX)
+    }
+
+    /// Checks the section (each light positive and at most
+    /// [`crate::limits::MAX_LIGHT_E_PER_S`], exposure and gain positive, the
+    /// lists at most [`crate::limits::MAX_LIST_ENTRIES`] long, the strings
+    /// parse); `max_exposure_s` is the experiment's exposure.
     pub fn validate(&self, max_exposure_s: f64) -> Result<()> {
         use crate::check::positive;
         let key = |k: &str, e: Error| Error::invalid(format!("map.{k}"), e.to_string());
         if self.lights_e_per_s.is_empty() {
             return Ok(());
         }
+        self.check_lengths()?;
         for &l in &self.lights_e_per_s {
-            positive("map.lights_e_per_s", l)?;
+            crate::limits::check_light("map.lights_e_per_s", l)?;
         }
         positive("[map] fps", self.fps)?;
         if self.fps > crate::trigger::MAX_FPS {
@@ -408,9 +421,15 @@ impl ExperimentConfig {
         Ok(cfg)
     }
 
-    /// Checks ranges (times positive, distances positive and ordered, a policy at least).
+    /// Checks ranges (times positive, distances positive and ordered, a
+    /// policy at least, lists at most [`crate::limits::MAX_LIST_ENTRIES`]).
     pub fn validate(&self) -> Result<()> {
         use crate::check::positive;
+        use crate::limits::{check_len, MAX_LIST_ENTRIES as MAX};
+        // The lists' lengths first: nothing is sized or walked by them before.
+        check_len("policies", self.policies.len(), MAX)?;
+        check_len("walks", self.walks.len(), MAX)?;
+        check_len("sweep_exposures_s", self.sweep_exposures_s.len(), MAX)?;
         if let Some(d) = self.duration_s {
             positive("duration_s", d)?;
         }

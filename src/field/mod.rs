@@ -111,7 +111,7 @@ static ANNOUNCED: AtomicBool = AtomicBool::new(false);
 
 /// Most cells of a flow field [`flow_field`] returns (8192 x 8192; about 12
 /// bytes each: u, v and the speed), for every door (CLI, dataset, Python).
-pub const MAX_FIELD_PIXELS: u64 = 1 << 26;
+pub use crate::limits::MAX_FIELD_PIXELS;
 
 /// The flow field (px/s) of `tw` on a `w x h` grid of cell centres (`0 x 0`:
 /// every pixel centre of the sensor) and its mean speed, on `backend` (the

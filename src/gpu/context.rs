@@ -25,6 +25,8 @@ pub fn describe(info: &wgpu::AdapterInfo) -> String {
 }
 
 fn instance() -> wgpu::Instance {
+    // No "XDG_RUNTIME_DIR is invalid" noise from the loader on stderr.
+    super::runtime_dir::ensure();
     let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
     desc.backends = wgpu::Backends::from_env().unwrap_or(wgpu::Backends::all());
     wgpu::Instance::new(desc)

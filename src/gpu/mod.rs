@@ -6,6 +6,7 @@
 
 pub(crate) mod compute;
 pub mod context;
+mod runtime_dir;
 
 pub use context::{gpu, GpuContext};
 

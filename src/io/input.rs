@@ -32,7 +32,7 @@ pub const MAX_HEADER_BYTES: usize = 16 << 20;
 
 /// Most pixels (width x height) an input image may declare to be decoded
 /// (16384 x 16384).
-pub const MAX_IMAGE_PIXELS: u64 = 1 << 28;
+pub use crate::limits::MAX_IMAGE_PIXELS;
 
 /// The error for line `line` of `path` longer than `cap` bytes.
 pub fn line_too_long(path: &Path, line: u64, cap: usize) -> Error {

@@ -45,10 +45,7 @@ use std::fmt;
 use std::str::FromStr;
 use std::sync::atomic::AtomicBool;
 
-/// Most pixels of a rendered frame (memory: about 24 bytes each with maps).
-pub const MAX_PIXELS: u64 = 1 << 26;
-/// Most pixel-samples of one frame (work).
-pub const MAX_PIXEL_SAMPLES: u64 = 1 << 40;
+pub use crate::limits::{MAX_PIXELS, MAX_PIXEL_SAMPLES};
 
 /// Most entries of a rolling-shutter homography table (lines x instants; 48 bytes each).
 pub const MAX_TABLE: u64 = 1 << 21;

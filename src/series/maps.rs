@@ -26,6 +26,7 @@ use super::SeriesOptions;
 use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::io::frames::VideoFrame;
+pub use crate::limits::MAX_MAP_PIXELS;
 use crate::model::log::ImuLog;
 use crate::model::motion::Plane;
 use crate::model::trajectory::Trajectory;
@@ -109,8 +110,10 @@ pub struct MapRays {
 }
 
 impl MapRays {
-    /// The rays of `cam` (validated).
+    /// The rays of `cam` (validated, at most [`MAX_MAP_PIXELS`]: checked
+    /// before anything is allocated).
     pub fn new(cam: &Camera) -> Result<Self> {
+        check_size(cam)?;
         cam.validate()?;
         let w = cam.width as usize;
         let rays = (0..w * cam.height as usize)
@@ -137,6 +140,18 @@ impl MapRays {
     pub fn rays(&self) -> &[(f64, f64)] {
         &self.rays
     }
+}
+
+/// Refuses a camera of more than [`MAX_MAP_PIXELS`] pixels for blur maps
+/// (before anything is sized by it; every backend and door calls it).
+pub fn check_size(cam: &Camera) -> Result<()> {
+    crate::limits::check_pixels(
+        "camera",
+        "a frame's blur maps (frames --maps)",
+        cam.width as u64,
+        cam.height as u64,
+        MAX_MAP_PIXELS,
+    )
 }
 
 /// The chords per line's exposure for `traj`'s motion: about one per pixel

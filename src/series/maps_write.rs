@@ -36,7 +36,8 @@ pub struct MapsWritten {
 }
 
 /// Writes the maps of the frames `which` (rows of `frames`) to `dir`
-/// (created if missing), one EXR each ([`file_name`]), all or none
+/// (created if missing; a camera over [`super::maps::MAX_MAP_PIXELS`] is
+/// refused first), one EXR each ([`file_name`]), all or none
 /// ([`stage_maps`], then [`StagedMaps::publish`]); a frame whose span leaves
 /// the log or crosses a gap in it gets none (listed in
 /// [`MapsWritten::skipped`]). `backend`: where the maps are computed
@@ -92,6 +93,7 @@ pub fn stage_maps(
     dir: &Path,
     backend: crate::gpu::Backend,
 ) -> Result<StagedMaps> {
+    super::maps::check_size(&opts.scene.camera)?;
     let base = if dir.is_dir() {
         dir.to_path_buf()
     } else {

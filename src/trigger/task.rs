@@ -188,7 +188,19 @@ pub(crate) fn parse_task(keys: &[&str], spec: &str) -> Result<TaskModel> {
             ));
         };
         match k.trim() {
-            "light" => light = Some(parse_pos(v, "light (e-/s)", spec)?),
+            "light" => {
+                let l = parse_pos(v, "light (e-/s)", spec)?;
+                if l > crate::limits::MAX_LIGHT_E_PER_S {
+                    return Err(Error::invalid(
+                        "policy",
+                        format!(
+                            "'{spec}': light {l:e} e-/s is above the cap of {:e} e-/s",
+                            crate::limits::MAX_LIGHT_E_PER_S
+                        ),
+                    ));
+                }
+                light = Some(l);
+            }
             "read" => m.read_noise_e = parse_pos(v, "read noise (e-)", spec)?,
             "tmin" => {
                 let Some(ms) = v.trim().strip_suffix("ms") else {
