@@ -14,7 +14,8 @@ of the work gives the same bytes. Item files: DIR/items/NNNNNNNN/{blurred,sharp}
 (linear EXR, sRGB PNG), flow.exr (flow.u, flow.v at exposure start, px/s), maps.exr (path_px,
 disp_px, speed_px_s), item.json (its manifest line: every parameter, the instantaneous MMBM at
 exposure start and the exposure MMBM, file sizes and SHA-256). A rerun skips complete items; DIR/dataset.json holds the
-configuration's fingerprint, and a run with another configuration is refused (use a new --out).
+configuration's fingerprint, and a run with another configuration is refused (use a new --out);
+a larger count grows the set (the items made are kept), a smaller one is refused.
 
 Sharding: --shard K/N (K from 1) makes the items with i mod N = K-1 and writes
 DIR/manifest.part-K-of-N.jsonl; without --shard, a SLURM job array (SLURM_ARRAY_TASK_ID,
@@ -27,7 +28,8 @@ WebDataset: --format webdataset also packs the verified set into DIR/webdataset/
 8-digit index: KEY.json, KEY.blurred.exr, KEY.blurred.png, KEY.sharp.exr, KEY.sharp.png,
 KEY.flow.exr, KEY.maps.exr) and DIR/webdataset/index.json (each shard's items, size, SHA-256).
 The tar bytes depend only on the items, so a sharded run packed at --merge gives the same tars as
-a single run; a rerun keeps complete shards.
+a single run; a rerun keeps complete shards. One packing at a time (a second is refused), all or
+nothing (DIR/webdataset/ appears complete). --verify also checks the shards against the index.
 
 Examples:
   mmbm dataset --print-config > ds.toml
