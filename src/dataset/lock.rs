@@ -239,3 +239,46 @@ impl DirLock {
         Ok(DirLock(f))
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_lock_on_a_removed_file_is_not_kept() {
+        let d = tempfile::tempdir().unwrap();
+        let p = d.path().join(".lock-x");
+        let a = acquire(&p, false, true).unwrap().unwrap();
+        // Opened by another run just before the holder ends.
+        let stale = File::open(&p).unwrap();
+        drop(a);
+        assert!(!p.exists(), "the holder removes its file");
+        // The stale inode can be locked, but it is no longer the name's.
+        assert!(try_lock(&stale, &p, false).unwrap());
+        assert!(!is_named(&stale, &p));
+        // A taker makes a fresh file, and holds it against others.
+        let b = acquire(&p, false, true).unwrap().unwrap();
+        assert!(is_named(&b.file, &p));
+        assert!(acquire(&p, false, true).unwrap().is_none());
+        assert!(acquire(&p, true, true).unwrap().is_none());
+        drop(b);
+        assert!(!p.exists());
+        // Without `create`, a missing file is not made.
+        assert!(acquire(&p, false, false).unwrap().is_none());
+        assert!(!p.exists());
+    }
+
+    #[test]
+    fn a_shared_lock_file_goes_with_its_last_holder() {
+        let d = tempfile::tempdir().unwrap();
+        let p = d.path().join(".lock-of-2");
+        let a = acquire(&p, true, true).unwrap().unwrap();
+        let b = acquire(&p, true, true).unwrap().unwrap();
+        assert!(acquire(&p, false, true).unwrap().is_none());
+        drop(a);
+        assert!(p.exists(), "removed while another run holds it");
+        assert!(acquire(&p, false, true).unwrap().is_none());
+        drop(b);
+        assert!(!p.exists());
+    }
+}
