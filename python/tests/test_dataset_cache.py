@@ -36,11 +36,12 @@ def worker(cache: str, start, results) -> None:
         for r in range(ROUNDS):
             ds.cache_dir = os.path.join(cache, f"round{r}")
             for i in range(COUNT):
-                start.wait()
+                start.wait(timeout=120)
                 item = ds.item(i)
                 assert item["index"] == i and item["blurred"].shape == (16, 24, 3)
         results.put((os.getpid(), "ok"))
     except BaseException as e:  # reported to the parent, which fails the test
+        start.abort()  # the others stop waiting for this one
         results.put((os.getpid(), f"{type(e).__name__}: {e}"))
 
 
@@ -52,7 +53,7 @@ def test_three_processes_share_one_cache_dir(tmp_path):
     procs = [ctx.Process(target=worker, args=(str(tmp_path), start, results)) for _ in range(n)]
     for p in procs:
         p.start()
-    got = [results.get(timeout=300) for _ in procs]
+    got = [results.get(timeout=240) for _ in procs]
     for p in procs:
         p.join(timeout=60)
     failures = [g for g in got if g[1] != "ok"]
