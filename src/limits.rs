@@ -117,3 +117,11 @@ pub fn check_len(key: &str, len: usize, max: usize) -> Result<()> {
 // == streams (live) ==
 
 // == datasets ==
+
+/// Smallest WebDataset tar shard size `--shard-bytes` accepts, bytes (64 KiB:
+/// a few tar blocks per item file at least).
+pub const MIN_SHARD_BYTES: u64 = 1 << 16;
+
+/// Largest WebDataset tar shard size `--shard-bytes` accepts, bytes (1 TiB:
+/// far past WebDataset's usual 1 GB; a tar shard is read as one stream).
+pub const MAX_SHARD_BYTES: u64 = 1 << 40;

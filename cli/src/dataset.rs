@@ -14,7 +14,8 @@ of the work gives the same bytes. Item files: DIR/items/NNNNNNNN/{blurred,sharp}
 (linear EXR, sRGB PNG), flow.exr (flow.u, flow.v at exposure start, px/s), maps.exr (path_px,
 disp_px, speed_px_s), item.json (its manifest line: every parameter, the instantaneous MMBM at
 exposure start and the exposure MMBM, file sizes and SHA-256). A rerun skips complete items; DIR/dataset.json holds the
-configuration's fingerprint, and a run with another configuration is refused (use a new --out).
+configuration's fingerprint, and a run with another configuration is refused (use a new --out);
+a larger count grows the set (the items made are kept), a smaller one is refused.
 
 Sharding: --shard K/N (K from 1) makes the items with i mod N = K-1 and writes
 DIR/manifest.part-K-of-N.jsonl; without --shard, a SLURM job array (SLURM_ARRAY_TASK_ID,
@@ -27,7 +28,8 @@ WebDataset: --format webdataset also packs the verified set into DIR/webdataset/
 8-digit index: KEY.json, KEY.blurred.exr, KEY.blurred.png, KEY.sharp.exr, KEY.sharp.png,
 KEY.flow.exr, KEY.maps.exr) and DIR/webdataset/index.json (each shard's items, size, SHA-256).
 The tar bytes depend only on the items, so a sharded run packed at --merge gives the same tars as
-a single run; a rerun keeps complete shards.
+a single run; a rerun keeps complete shards. One packing at a time (a second is refused), all or
+nothing (DIR/webdataset/ appears complete). --verify also checks the shards against the index.
 
 Examples:
   mmbm dataset --print-config > ds.toml
@@ -65,9 +67,10 @@ pub struct DatasetArgs {
     /// DIR/webdataset/mmbm-NNNNNN.tar shards; a sharded run packs at --merge).
     #[arg(long, value_enum, default_value_t = Format::Folder)]
     pub format: Format,
-    /// Most bytes per WebDataset tar shard (with --format webdataset).
-    #[arg(long, value_name = "BYTES", default_value_t = dataset::DEFAULT_SHARD_BYTES)]
-    pub shard_bytes: u64,
+    /// Most bytes per WebDataset tar shard (only with --format webdataset; 65536 to 2^40; default
+    /// 1000000000).
+    #[arg(long, value_name = "BYTES", value_parser = shard_bytes)]
+    pub shard_bytes: Option<u64>,
     /// No progress bar.
     #[arg(long)]
     pub quiet: bool,
@@ -82,12 +85,23 @@ pub enum Format {
     Webdataset,
 }
 
+/// `--shard-bytes`, checked as it is parsed (before any item is made).
+fn shard_bytes(s: &str) -> std::result::Result<u64, String> {
+    let n: u64 = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("'{s}' is not a whole number of bytes"))?;
+    dataset::check_shard_bytes(n).map_err(|e| e.to_string())?;
+    Ok(n)
+}
+
 /// Packs `out` into tar shards when `--format webdataset`.
 fn pack(a: &DatasetArgs, out: &std::path::Path) -> Result<()> {
     if a.format != Format::Webdataset {
         return Ok(());
     }
-    let p = dataset::pack(out, a.shard_bytes, !a.quiet)?;
+    let bytes = a.shard_bytes.unwrap_or(dataset::DEFAULT_SHARD_BYTES);
+    let p = dataset::pack(out, bytes, !a.quiet)?;
     eprintln!(
         "packed {} items into {} WebDataset shard(s) ({} written, {} kept; {:.1} MB) in {}",
         p.items,
@@ -149,6 +163,12 @@ fn shard(a: &DatasetArgs) -> Result<(Shard, &'static str)> {
 }
 
 pub fn run(a: DatasetArgs) -> Result<()> {
+    if a.shard_bytes.is_some() && a.format != Format::Webdataset {
+        return Err(Error::invalid(
+            "--shard-bytes",
+            "sizes the WebDataset tar shards: give it with --format webdataset (or leave it out)",
+        ));
+    }
     if a.print_config {
         print!("{}", DatasetConfig::default().to_toml()?);
         return Ok(());

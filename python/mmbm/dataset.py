@@ -21,7 +21,9 @@ from __future__ import annotations
 
 import json
 import os
+import secrets
 import shutil
+import socket
 import tempfile
 from typing import Any, Dict, Iterator, Optional, Tuple, Union
 
@@ -61,8 +63,10 @@ class BlurDataset(_Base):
 
     ``config``: a TOML file; or ``toml``: TOML text; neither: the defaults
     (``mmbm dataset --print-config``). ``cache_dir``: keep each item's files
-    in ``cache_dir/NNNNNNNN/`` (and reuse a complete one); default: a
-    temporary directory per item, removed once read. Each item is a dict:
+    in ``cache_dir/NNNNNNNN/`` (and reuse a complete one; processes may
+    share one cache: each makes an item in a folder of its own and renames
+    it into place, see ``_make_cached``); default: a temporary directory per
+    item, removed once read. Each item is a dict:
     ``index``, ``key`` (8 digits, as in the WebDataset shards), ``params``
     and ``measures`` (the manifest line's), ``blurred`` and ``sharp``
     ((H, W, 3) float32, linear), ``flow`` (``u``, ``v``: px/s at exposure
@@ -112,11 +116,7 @@ class BlurDataset(_Base):
         if self.cache_dir is not None:
             d = os.path.join(self.cache_dir, f"{index:08d}")
             if not os.path.isfile(os.path.join(d, "item.json")):
-                part = d + ".partial"
-                shutil.rmtree(part, ignore_errors=True)
-                os.makedirs(part)
-                self._maker.make(index, part)
-                os.replace(part, d)
+                self._make_cached(index, d)
             with open(os.path.join(d, "item.json"), encoding="utf-8") as f:
                 line = json.loads(f.read())
             if line.get("fingerprint") != self.fingerprint or line.get("index") != index:
@@ -127,6 +127,36 @@ class BlurDataset(_Base):
         with tempfile.TemporaryDirectory(prefix="mmbm-item-") as d:
             line = json.loads(self._maker.make(index, d))
             return self._read(index, line, d, keep=False)
+
+    def _make_cached(self, index: int, d: str) -> None:
+        """Makes item ``index`` into the cache folder ``d``, safely beside other
+        processes sharing the cache (DataLoader workers, distributed ranks).
+
+        The item is made in a folder of this process's own
+        (``NNNNNNNN.partial-<host>-<pid>-<random>``), then renamed to ``d`` in
+        one step, so a reader sees either no folder or a complete one. When
+        another process renamed its copy into place first, this one's is
+        removed and theirs used (the same bytes: an item depends only on the
+        configuration and its index). Only this process's own partial folder
+        is ever removed: a killed process leaves its ``.partial-*`` folder,
+        which no other process touches (remove it when nothing runs).
+        """
+        os.makedirs(self.cache_dir, exist_ok=True)
+        tag = f"{socket.gethostname()}-{os.getpid()}-{secrets.token_hex(6)}"
+        part = f"{d}.partial-{tag}"
+        os.mkdir(part)
+        try:
+            self._maker.make(index, part)
+            try:
+                os.rename(part, d)
+            except OSError:
+                # Another process's complete copy is in place (a rename onto a
+                # folder that is not empty fails): use it.
+                if not os.path.isfile(os.path.join(d, "item.json")):
+                    raise
+        finally:
+            if os.path.exists(part):
+                shutil.rmtree(part, ignore_errors=True)
 
     @staticmethod
     def _read(index: int, line: Dict[str, Any], d: str, keep: bool) -> Dict[str, Any]:

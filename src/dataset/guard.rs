@@ -1,35 +1,41 @@
-//! What keeps a dataset directory to one configuration and each shard to
-//! one writer.
+//! What keeps a dataset directory to one configuration.
 //!
-//! - The **fingerprint** ([`Record`], `DIR/dataset.json`): SHA-256 of the
-//!   canonical JSON of everything that determines the items, that is every
-//!   configuration key except the texture folder's path, the texture files'
-//!   names, sizes and SHA-256 in its place, and each `log:` source's decoded
-//!   samples. The first run writes it (create-only, so two first runs at once
-//!   cannot both win); a run with another fingerprint is refused, naming
-//!   both; every manifest line carries it, so `--merge` and `--verify` refuse
-//!   items of another configuration.
-//! - The **lock** ([`RunLock`]): a run holds an exclusive advisory lock
-//!   (`flock`) on `DIR/.lock-K-of-N` and a shared one on `DIR/.lock-of-N`;
-//!   the operating system drops them when the process ends, however it ends
-//!   (kill -9 included). A second run of the same shard, or a run with
-//!   another shard count while one is writing, is refused.
+//! The **fingerprint** ([`Record`], `DIR/dataset.json`): SHA-256 of the
+//! canonical JSON of everything that determines the items, that is every
+//! configuration key except `count` and the texture folder's path, the
+//! texture files' names, sizes and SHA-256 in its place, and each `log:`
+//! source's decoded samples. `count` is left out because item `i` depends
+//! only on the configuration and `i`: a set grows (a run with a larger
+//! `count` adds items and keeps the others byte for byte, and records the
+//! new count), and a set of 7 grown from 6 is the set made at 7 at once. A
+//! smaller `count` than recorded is refused (items would be left out of the
+//! manifest while still on disk). The first run writes the record; a run with
+//! another fingerprint is refused, naming both; every manifest line carries
+//! it, so `--merge` and `--verify` refuse items of another configuration.
+//! The record is read and updated under a lock on the directory
+//! ([`super::lock::DirLock`]), so two runs growing a set at once cannot
+//! shrink it again.
+//!
+//! The locks that keep each shard to one writer: [`super::lock`].
 
 use super::config::{DatasetConfig, MotionSource};
 use super::item::Sources;
-use super::shard::Shard;
+use super::lock::DirLock;
 use crate::error::{show_path, Error, Result};
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 use sha2::{Digest, Sha256};
-use std::fs::File;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// The fingerprint file in a dataset directory.
 pub const RECORD: &str = "dataset.json";
 
 /// The `format` of a [`Record`].
-pub const FORMAT: &str = "mmbm-dataset-fingerprint-1";
+pub const FORMAT: &str = "mmbm-dataset-fingerprint-2";
+
+/// The record format of mmbm before sets could grow (its fingerprint covered
+/// `count`).
+const FORMAT_1: &str = "mmbm-dataset-fingerprint-1";
 
 /// `DIR/dataset.json`: the fingerprint of the inputs the items are made
 /// from, and those inputs.
@@ -40,9 +46,11 @@ pub struct Record {
     pub format: String,
     /// SHA-256 (hex) of the canonical JSON of `inputs`.
     pub fingerprint: String,
-    /// Items of the dataset (the configuration's `count`).
+    /// Items of the dataset (the configuration's `count`; not in the
+    /// fingerprint).
     pub count: u64,
-    /// The configuration (texture folder as its files) and the logs' digests.
+    /// The configuration (texture folder as its files, no `count`) and the
+    /// logs' digests.
     pub inputs: Value,
 }
 
@@ -120,6 +128,7 @@ impl Record {
         let obj = inputs
             .as_object_mut()
             .ok_or_else(|| Error::invalid("dataset config", "is not a table"))?;
+        obj.remove("count");
         obj.insert("textures".into(), Value::Array(textures));
         obj.insert("logs".into(), Value::Object(logs));
         Ok(Record {
@@ -149,6 +158,12 @@ impl Record {
             message: crate::error::clip(&e.to_string(), crate::error::MAX_MESSAGE),
         })?;
         let wrong = |m: String| Err(Error::invalid(p.display().to_string(), m));
+        if r.format == FORMAT_1 {
+            return wrong(format!(
+                "made by an older mmbm (format {FORMAT_1}, whose fingerprint covered count): \
+                 remake the set in a new --out"
+            ));
+        }
         if r.format != FORMAT {
             return wrong(format!("format '{}' is not {FORMAT}", r.format));
         }
@@ -159,9 +174,7 @@ impl Record {
                 super::config::MAX_COUNT
             ));
         }
-        if digest(&r.inputs) != r.fingerprint
-            || r.inputs.get("count") != Some(&Value::from(r.count))
-        {
+        if digest(&r.inputs) != r.fingerprint || r.inputs.get("count").is_some() {
             return wrong(
                 "the fingerprint is not the digest of the inputs recorded: the file was edited"
                     .into(),
@@ -175,11 +188,14 @@ impl Record {
         short(&self.fingerprint)
     }
 
-    /// Records `self` in `out` if it has no record yet (create-only), else
-    /// checks that the recorded fingerprint is this one. A directory with
-    /// items but no record is refused (their configuration is unknown).
+    /// Records `self` in `out` if it has no record yet, else checks that the
+    /// recorded fingerprint is this one and that `count` is at least the
+    /// recorded one (a larger one is recorded: the set grows). A directory
+    /// with items but no record is refused (their configuration is unknown).
+    /// Done under [`DirLock`], so concurrent runs see each other's record.
     pub fn claim(&self, out: &Path) -> Result<()> {
         let p = out.join(RECORD);
+        let _dir = DirLock::take(out)?;
         if !p.exists() {
             let items = out.join("items");
             let any = std::fs::read_dir(&items).is_ok_and(|mut r| r.next().is_some());
@@ -192,38 +208,69 @@ impl Record {
                     ),
                 ));
             }
-            let text = serde_json::to_string_pretty(self)
-                .map_err(|e| Error::invalid("dataset.json", e.to_string()))?;
-            let mut tmp = tempfile::Builder::new()
-                .prefix(".mmbm-")
-                .suffix(".tmp.json")
-                .tempfile_in(out)
-                .map_err(|e| Error::io(out, e))?;
-            std::io::Write::write_all(&mut tmp, format!("{text}\n").as_bytes())
-                .map_err(|e| Error::io(&p, e))?;
-            match tmp.persist_noclobber(&p) {
-                Ok(_) => return Ok(()),
-                // Another first run recorded one meanwhile: compare with it.
-                Err(e) if e.error.kind() == std::io::ErrorKind::AlreadyExists => {}
-                Err(e) => return Err(Error::io(&p, e.error)),
+            if self.write(out, false)? {
+                return Ok(());
             }
+            // Recorded meanwhile (a file system without locks): compare.
         }
         let old = Record::read(out)?;
-        if old.fingerprint == self.fingerprint {
-            return Ok(());
+        if old.fingerprint != self.fingerprint {
+            return Err(Error::invalid(
+                out.display().to_string(),
+                format!(
+                    "was made with another configuration (fingerprint {} in {}), not this one \
+                     (fingerprint {}; differs in: {}): use a new --out for this configuration, \
+                     or rerun with the one the directory was made with",
+                    old.short(),
+                    show_path(&p),
+                    self.short(),
+                    differences(&old.inputs, &self.inputs)
+                ),
+            ));
         }
-        Err(Error::invalid(
-            out.display().to_string(),
-            format!(
-                "was made with another configuration (fingerprint {} in {}), not this one \
-                 (fingerprint {}; differs in: {}): use a new --out for this configuration, \
-                 or rerun with the one the directory was made with",
-                old.short(),
-                show_path(&p),
-                self.short(),
-                differences(&old.inputs, &self.inputs)
-            ),
-        ))
+        if self.count < old.count {
+            return Err(Error::invalid(
+                "count",
+                format!(
+                    "{} is less than the {} items {} records: a set grows but does not \
+                     shrink (its manifest would leave out items still on disk); use count = {} \
+                     or more, or a new --out for a smaller set",
+                    self.count,
+                    old.count,
+                    show_path(&p),
+                    old.count
+                ),
+            ));
+        }
+        if self.count > old.count {
+            self.write(out, true)?;
+        }
+        Ok(())
+    }
+
+    /// Writes `self` as `out/dataset.json` (a temporary file renamed: over
+    /// an existing one when `replace`, else create-only), with the
+    /// permissions a new file gets under the process's umask. `Ok(false)`:
+    /// create-only, and a record was there already.
+    fn write(&self, out: &Path, replace: bool) -> Result<bool> {
+        let p = out.join(RECORD);
+        let text = serde_json::to_string_pretty(self)
+            .map_err(|e| Error::invalid("dataset.json", e.to_string()))?;
+        let mut tmp = crate::io::atomic::temp_builder(".mmbm-", ".tmp.json")
+            .tempfile_in(out)
+            .map_err(|e| Error::io(out, e))?;
+        std::io::Write::write_all(&mut tmp, format!("{text}\n").as_bytes())
+            .map_err(|e| Error::io(&p, e))?;
+        let r = if replace {
+            tmp.persist(&p).map(drop)
+        } else {
+            tmp.persist_noclobber(&p).map(drop)
+        };
+        match r {
+            Ok(()) => Ok(true),
+            Err(e) if !replace && e.error.kind() == std::io::ErrorKind::AlreadyExists => Ok(false),
+            Err(e) => Err(Error::io(&p, e.error)),
+        }
     }
 }
 
@@ -249,101 +296,5 @@ fn differences(a: &Value, b: &Value) -> String {
         "the recorded inputs".into()
     } else {
         d.join(", ")
-    }
-}
-
-/// The locks a run holds on its dataset directory (released on drop and
-/// when the process ends).
-#[derive(Debug)]
-pub struct RunLock {
-    _shard: File,
-    _count: File,
-}
-
-fn lock_file(p: &Path) -> Result<File> {
-    std::fs::OpenOptions::new()
-        .read(true)
-        .write(true)
-        .create(true)
-        .truncate(false)
-        .open(p)
-        .map_err(|e| Error::io(p, e))
-}
-
-/// `Ok(true)`: locked; `Ok(false)`: another process holds it.
-fn try_lock(f: &File, p: &Path, shared: bool) -> Result<bool> {
-    use fs4::FileExt;
-    let r = if shared {
-        FileExt::try_lock_shared(f)
-    } else {
-        FileExt::try_lock(f)
-    };
-    match r {
-        Ok(()) => Ok(true),
-        Err(fs4::TryLockError::WouldBlock) => Ok(false),
-        Err(fs4::TryLockError::Error(e)) => Err(Error::io(p, e)),
-    }
-}
-
-impl RunLock {
-    /// Takes the locks of `shard` on `out` (an existing directory), or
-    /// refuses: another run of this shard, or of another shard count, is
-    /// writing `out`.
-    pub fn take(out: &Path, shard: Shard) -> Result<Self> {
-        let busy = |what: String, lock: &Path| {
-            Error::invalid(
-                out.display().to_string(),
-                format!(
-                    "another run is writing this directory ({what}; it holds {}): wait for it \
-                     to end, or use another --out",
-                    show_path(lock)
-                ),
-            )
-        };
-        let own = out.join(format!(".lock-{}-of-{}", shard.k, shard.n));
-        let shard_file = lock_file(&own)?;
-        if !try_lock(&shard_file, &own, false)? {
-            return Err(busy(
-                format!("a run of shard {}/{}", shard.k, shard.n),
-                &own,
-            ));
-        }
-        let count = out.join(format!(".lock-of-{}", shard.n));
-        let count_file = lock_file(&count)?;
-        if !try_lock(&count_file, &count, true)? {
-            return Err(busy(
-                format!("a run split into {} shards is probing it", shard.n),
-                &count,
-            ));
-        }
-        // Shards of another count make some of the same items: refuse while
-        // any such run holds its count's lock (each run takes its own shared
-        // lock before looking, so of two such runs at least one sees the other).
-        let rd = std::fs::read_dir(out).map_err(|e| Error::io(out, e))?;
-        for e in rd {
-            let e = e.map_err(|e| Error::io(out, e))?;
-            let name = e.file_name().to_string_lossy().into_owned();
-            let Some(n) = name.strip_prefix(".lock-of-") else {
-                continue;
-            };
-            if n == shard.n.to_string() {
-                continue;
-            }
-            let p: PathBuf = e.path();
-            let f = lock_file(&p)?;
-            if !try_lock(&f, &p, false)? {
-                return Err(busy(
-                    format!(
-                        "a run split into {n} shard(s), which shares items with this split into {}",
-                        shard.n
-                    ),
-                    &p,
-                ));
-            }
-        }
-        Ok(RunLock {
-            _shard: shard_file,
-            _count: count_file,
-        })
     }
 }

@@ -240,7 +240,7 @@ pub fn merge(out: &Path) -> Result<usize> {
 
 /// The problems `--verify` found: how many, and the first few.
 #[derive(Default)]
-struct Problems {
+pub(crate) struct Problems {
     n: u64,
     first: Vec<String>,
 }
@@ -248,11 +248,32 @@ struct Problems {
 impl Problems {
     const SHOWN: usize = 4;
 
-    fn push(&mut self, p: String) {
+    pub(crate) fn push(&mut self, p: String) {
         self.n += 1;
         if self.first.len() < Self::SHOWN {
             self.first.push(p);
         }
+    }
+
+    /// `Ok(())` when there are none, else the error for `what`: how many,
+    /// and the first few.
+    pub(crate) fn result(&self, what: &Path) -> Result<()> {
+        if self.n == 0 {
+            return Ok(());
+        }
+        Err(Error::invalid(
+            what.display().to_string(),
+            format!(
+                "{} problem(s): {}{}",
+                self.n,
+                self.first.join("; "),
+                if self.n > Self::SHOWN as u64 {
+                    "; ..."
+                } else {
+                    ""
+                }
+            ),
+        ))
     }
 }
 
@@ -380,20 +401,6 @@ pub fn verify(out: &Path) -> Result<usize> {
             rec.count
         ));
     }
-    if problems.n == 0 {
-        return Ok(k as usize);
-    }
-    Err(Error::invalid(
-        out.display().to_string(),
-        format!(
-            "{} problem(s): {}{}",
-            problems.n,
-            problems.first.join("; "),
-            if problems.n > Problems::SHOWN as u64 {
-                "; ..."
-            } else {
-                ""
-            }
-        ),
-    ))
+    problems.result(out)?;
+    Ok(k as usize)
 }

@@ -11,28 +11,35 @@
 //!   shard makes, and the cap on shard counts.
 //! - `manifest`: merging shard manifests, verifying a directory against
 //!   its manifest (which is input: every path it names is confined).
-//! - `guard`: the configuration's fingerprint (`DIR/dataset.json`) and the
-//!   lock that keeps each shard to one writer.
+//! - `guard`: the configuration's fingerprint (`DIR/dataset.json`).
+//! - `lock`: the locks that keep each shard, and the packing, to one
+//!   writer (their files removed when the run ends).
 //! - `sensor`: the camera pipeline of the PNG files (`[sensor]`).
 //! - `webdataset`: the directory packed into WebDataset tar shards
-//!   (`--format webdataset`).
+//!   (`--format webdataset`); `tarcheck`: the shards checked against their
+//!   index (`--verify`).
 
 pub(crate) mod config;
 pub(crate) mod guard;
 pub mod item;
+pub(crate) mod lock;
 pub(crate) mod manifest;
 pub(crate) mod run;
 pub(crate) mod sensor;
 pub(crate) mod shard;
+pub(crate) mod tarcheck;
 pub(crate) mod webdataset;
 
 pub use config::DatasetConfig;
-pub use guard::{Record, RunLock};
+pub use guard::Record;
 pub use item::{ItemParams, Sources};
+pub use lock::{PackLock, RunLock};
 pub use manifest::{merge, verify, ManifestLine};
 pub use run::{make_item, run, writes, RunSummary};
 pub use sensor::SensorPipeline;
 pub use shard::{Shard, MAX_SHARDS};
+pub use tarcheck::verify_tars;
 pub use webdataset::{
-    pack, verify_tars, PackSummary, TarIndex, TarShard, DEFAULT_SHARD_BYTES, MIN_SHARD_BYTES,
+    check_shard_bytes, pack, PackSummary, TarIndex, TarShard, DEFAULT_SHARD_BYTES, MAX_SHARD_BYTES,
+    MIN_SHARD_BYTES,
 };

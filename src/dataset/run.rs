@@ -10,8 +10,9 @@
 //! name, and a rerun skips complete items.
 
 use super::config::DatasetConfig;
-use super::guard::{short, Record, RunLock};
+use super::guard::{short, Record};
 use super::item::{make, plan, Sources, FILES};
+use super::lock::RunLock;
 use super::manifest::{item_dir, sum_file, write_manifest, ManifestLine};
 use super::shard::Shard;
 use crate::error::{show_path, Error, Result};

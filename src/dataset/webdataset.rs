@@ -18,14 +18,21 @@
 //! and since a sharded run's directory equals a single run's, so do its
 //! tar shards. Trust nothing: the directory is verified against its
 //! manifest first (`manifest::verify`), and each file's bytes are hashed
-//! again as they are packed. Resumable: each tar is written under a
-//! temporary name and renamed, `index.json` is rewritten after each shard,
-//! and a rerun keeps a shard whose file still has the listed size and
-//! SHA-256.
+//! again as they are packed. All or nothing, one packer at a time: a
+//! packing holds `DIR/.lock-pack` (a second one is refused), writes its
+//! shards and index into `DIR/.webdataset.partial/` and renames that folder
+//! into place when complete, so `webdataset/` is always one whole packing.
+//! Resumable: each tar is written under a temporary name and renamed,
+//! the partial folder's `index.json` is rewritten after each shard, and a
+//! rerun keeps a shard whose file still has the listed size and SHA-256
+//! (in the partial folder, or in the folder it replaces).
+//! Checking the shards (`--verify`): [`super::tarcheck`].
 
-use super::guard::{read_json_file, Record};
+use super::guard::Record;
 use super::item::FILES;
+use super::lock::PackLock;
 use super::manifest::{each_line, item_dir, verify, ManifestLine};
+use super::tarcheck::{kind, read_index, sum_regular, Kind};
 use crate::error::{show_path, Error, Result};
 use crate::io::atomic::write_atomic;
 use serde::{Deserialize, Serialize};
@@ -35,12 +42,15 @@ use std::path::{Path, PathBuf};
 
 /// Default shard size, bytes (about 1 GB, WebDataset's usual size).
 pub const DEFAULT_SHARD_BYTES: u64 = 1_000_000_000;
-/// The smallest shard size accepted, bytes.
-pub const MIN_SHARD_BYTES: u64 = 1 << 16;
+pub use crate::limits::{MAX_SHARD_BYTES, MIN_SHARD_BYTES};
 /// The folder, under the dataset directory.
 pub const FOLDER: &str = "webdataset";
+/// Where a packing writes before it is complete (then renamed to [`FOLDER`]).
+const STAGE: &str = ".webdataset.partial";
+/// Where the folder it replaces goes for the instant of the swap.
+const OLD: &str = ".webdataset.old";
 /// The `format` of `index.json`.
-const INDEX_FORMAT: &str = "mmbm-webdataset-1";
+pub(crate) const INDEX_FORMAT: &str = "mmbm-webdataset-1";
 /// Tar block, bytes.
 const BLOCK: u64 = 512;
 
@@ -246,49 +256,121 @@ fn write_shard(out: &Path, lines: &[ManifestLine], path: &Path) -> Result<(u64, 
     Ok(sum)
 }
 
-/// Size and SHA-256 of an existing shard file, `None` when there is none.
-fn existing(path: &Path) -> Result<Option<(u64, String)>> {
-    if !path.is_file() {
+/// The index in `dir` (an earlier packing's) if it is for this dataset
+/// and shard size; `None` when there is none, or it is unreadable (then it
+/// counts for nothing: its shards are made again).
+fn previous(dir: &Path, rec: &Record, shard_bytes: u64) -> Result<Option<TarIndex>> {
+    let index = dir.join("index.json");
+    if !matches!(kind(&index)?, Kind::File(_)) {
         return Ok(None);
     }
-    let mut f = crate::io::input::open_file(path)?;
-    super::guard::sha256_of(&mut f, path).map(Some)
-}
-
-/// Reads `index.json` if it exists and is for this dataset and shard size.
-fn previous(index: &Path, rec: &Record, shard_bytes: u64) -> Result<Option<TarIndex>> {
-    if !index.exists() {
+    let Ok(ix) = read_index(&index) else {
         return Ok(None);
-    }
-    let text = read_json_file(index)?;
-    let ix: TarIndex = serde_json::from_str(&text).map_err(|e| Error::Config {
-        path: index.into(),
-        message: crate::error::clip(&e.to_string(), crate::error::MAX_MESSAGE),
-    })?;
+    };
     if ix.format != INDEX_FORMAT || ix.fingerprint != rec.fingerprint {
         return Err(Error::invalid(
-            show_path(index),
+            show_path(&index),
             format!(
                 "made from another dataset (format {}, fingerprint {}): remove {} first",
                 ix.format,
                 super::guard::short(&ix.fingerprint),
-                show_path(index.parent().unwrap_or(index))
+                show_path(dir)
             ),
         ));
     }
     Ok((ix.shard_bytes == shard_bytes).then_some(ix))
 }
 
-/// Packs the dataset directory `out` (complete and merged: it is verified
-/// first) into WebDataset tar shards of at most `shard_bytes` in
-/// `out/webdataset/`, keeping shards a previous run completed.
-pub fn pack(out: &Path, shard_bytes: u64, progress: bool) -> Result<PackSummary> {
-    if shard_bytes < MIN_SHARD_BYTES {
+/// The shard `name` as `ix` lists it, if it holds the items `first..first +
+/// n` and the file `dir/name` is a regular file with the listed size and
+/// SHA-256.
+fn intact(
+    ix: Option<&TarIndex>,
+    dir: &Path,
+    name: &str,
+    first: u64,
+    n: u64,
+) -> Result<Option<TarShard>> {
+    let Some(t) = ix.and_then(|ix| ix.shards.iter().find(|t| t.name == name)) else {
+        return Ok(None);
+    };
+    if t.first != first || t.items != n {
+        return Ok(None);
+    }
+    let ok = sum_regular(&dir.join(name))?.is_some_and(|(b, sha)| b == t.bytes && sha == t.sha256);
+    Ok(ok.then(|| t.clone()))
+}
+
+/// True when `dir` holds exactly the complete packing `cuts` of this
+/// dataset (its index complete, of `count` items, each shard intact, no
+/// other file): nothing to do.
+fn up_to_date(dir: &Path, rec: &Record, shard_bytes: u64, cuts: &[(u64, u64)]) -> Result<bool> {
+    let Some(ix) = previous(dir, rec, shard_bytes)? else {
+        return Ok(false);
+    };
+    if !ix.complete || ix.count != rec.count || ix.shards.len() != cuts.len() {
+        return Ok(false);
+    }
+    for (s, &(first, n)) in cuts.iter().enumerate() {
+        if intact(Some(&ix), dir, &shard_name(s), first, n)?.is_none() {
+            return Ok(false);
+        }
+    }
+    let files = std::fs::read_dir(dir)
+        .map_err(|e| Error::io(dir, e))?
+        .count();
+    Ok(files == cuts.len() + 1)
+}
+
+/// Puts `stage` (a complete packing) in the place of `dir`: `dir` (if any)
+/// is renamed aside, `stage` renamed to `dir`, the old one removed. A
+/// reader sees the old packing, then no folder for an instant, then the
+/// new one; never a mix.
+fn swap_in(stage: &Path, dir: &Path, old: &Path) -> Result<()> {
+    if std::fs::symlink_metadata(dir).is_ok() {
+        std::fs::rename(dir, old).map_err(|e| Error::io(dir, e))?;
+    }
+    std::fs::rename(stage, dir).map_err(|e| Error::io(dir, e))?;
+    if std::fs::symlink_metadata(old).is_ok() {
+        remove_any(old)?;
+    }
+    Ok(())
+}
+
+/// Removes `p`, a folder (with its files) or anything else.
+fn remove_any(p: &Path) -> Result<()> {
+    let m = std::fs::symlink_metadata(p).map_err(|e| Error::io(p, e))?;
+    if m.is_dir() {
+        std::fs::remove_dir_all(p).map_err(|e| Error::io(p, e))
+    } else {
+        std::fs::remove_file(p).map_err(|e| Error::io(p, e))
+    }
+}
+
+/// Checks `--shard-bytes` against [`MIN_SHARD_BYTES`]..=[`MAX_SHARD_BYTES`].
+pub fn check_shard_bytes(shard_bytes: u64) -> Result<()> {
+    if !(MIN_SHARD_BYTES..=MAX_SHARD_BYTES).contains(&shard_bytes) {
         return Err(Error::invalid(
             "--shard-bytes",
-            format!("{shard_bytes}: at least {MIN_SHARD_BYTES} bytes"),
+            format!(
+                "{shard_bytes}: the tar shard size must be in {MIN_SHARD_BYTES}..={MAX_SHARD_BYTES} bytes"
+            ),
         ));
     }
+    Ok(())
+}
+
+/// Packs the dataset directory `out` (complete and merged: it is verified
+/// first) into WebDataset tar shards of at most `shard_bytes` in
+/// `out/webdataset/`, all or nothing: under the packing lock
+/// ([`PackLock`]: a second packer is refused), the shards and the index are
+/// written into `out/.webdataset.partial/` and that folder is renamed into
+/// place when complete. Intact shards of the folder there are kept (linked
+/// into the new one), and so are those of a stopped packing's partial
+/// folder, which a rerun resumes.
+pub fn pack(out: &Path, shard_bytes: u64, progress: bool) -> Result<PackSummary> {
+    check_shard_bytes(shard_bytes)?;
+    let _lock = PackLock::take(out)?;
     let n_items = verify(out)?;
     let rec = Record::read(out)?;
     let mut lines = Vec::with_capacity(n_items);
@@ -307,10 +389,48 @@ pub fn pack(out: &Path, shard_bytes: u64, progress: bool) -> Result<PackSummary>
         sizes.push((l.index, b));
     }
     let cuts = plan(&sizes, shard_bytes);
-    let dir = out.join(FOLDER);
-    std::fs::create_dir_all(&dir).map_err(|e| Error::io(&dir, e))?;
-    let index_path = dir.join("index.json");
-    let before = previous(&index_path, &rec, shard_bytes)?;
+    let (dir, stage, old) = (out.join(FOLDER), out.join(STAGE), out.join(OLD));
+    // A packing stopped between the two renames of `swap_in`: the old
+    // folder is all there is.
+    if std::fs::symlink_metadata(&old).is_ok() {
+        if std::fs::symlink_metadata(&dir).is_err() {
+            std::fs::rename(&old, &dir).map_err(|e| Error::io(&dir, e))?;
+        } else {
+            remove_any(&old)?;
+        }
+    }
+    let summary = |written: usize, ix: &TarIndex| PackSummary {
+        shards: cuts.len(),
+        written,
+        items: lines.len() as u64,
+        bytes: ix.shards.iter().map(|t| t.bytes).sum(),
+    };
+    if up_to_date(&dir, &rec, shard_bytes, &cuts)? {
+        if std::fs::symlink_metadata(&stage).is_ok() {
+            remove_any(&stage)?;
+        }
+        let ix = read_index(&dir.join("index.json"))?;
+        return Ok(summary(0, &ix));
+    }
+    let current = if matches!(kind(&dir)?, Kind::Other) && dir.is_dir() {
+        previous(&dir, &rec, shard_bytes)?
+    } else {
+        None
+    };
+    // The partial folder is this packer's alone (the lock): resume it when
+    // it is one of this packing, else start it afresh.
+    let staged = match kind(&stage)? {
+        Kind::Other if stage.is_dir() => previous(&stage, &rec, shard_bytes).unwrap_or(None),
+        Kind::Missing => None,
+        _ => {
+            remove_any(&stage)?;
+            None
+        }
+    };
+    if staged.is_none() && std::fs::symlink_metadata(&stage).is_ok() {
+        remove_any(&stage)?;
+    }
+    std::fs::create_dir_all(&stage).map_err(|e| Error::io(&stage, e))?;
     let mut ix = TarIndex {
         format: INDEX_FORMAT.into(),
         fingerprint: rec.fingerprint.clone(),
@@ -320,116 +440,73 @@ pub fn pack(out: &Path, shard_bytes: u64, progress: bool) -> Result<PackSummary>
         complete: false,
     };
     let bar = crate::diagnostics::progress(progress, "shards", cuts.len() as u64);
-    let (mut written, mut total) = (0, 0);
+    let mut written = 0;
     let mut at = 0usize;
     for (s, &(first, n)) in cuts.iter().enumerate() {
         let name = shard_name(s);
-        let path = dir.join(&name);
-        let listed = before
-            .as_ref()
-            .and_then(|b| b.shards.iter().find(|t| t.name == name))
-            .filter(|t| t.first == first && t.items == n);
-        let kept = match listed {
-            Some(t) => existing(&path)?
-                .filter(|(b, sha)| *b == t.bytes && *sha == t.sha256)
-                .map(|_| t.clone()),
-            None => None,
-        };
-        let entry = match kept {
+        let path = stage.join(&name);
+        let entry = match intact(staged.as_ref(), &stage, &name, first, n)? {
             Some(t) => t,
-            None => {
-                let (bytes, sha256) = write_shard(out, &lines[at..at + n as usize], &path)?;
-                written += 1;
-                TarShard {
-                    name,
-                    first,
-                    items: n,
-                    bytes,
-                    sha256,
+            None => match link_kept(current.as_ref(), &dir, &path, &name, first, n)? {
+                Some(t) => t,
+                None => {
+                    if std::fs::symlink_metadata(&path).is_ok() {
+                        remove_any(&path)?;
+                    }
+                    let (bytes, sha256) = write_shard(out, &lines[at..at + n as usize], &path)?;
+                    written += 1;
+                    TarShard {
+                        name,
+                        first,
+                        items: n,
+                        bytes,
+                        sha256,
+                    }
                 }
-            }
+            },
         };
         at += n as usize;
-        total += entry.bytes;
         ix.shards.push(entry);
         ix.complete = s + 1 == cuts.len();
-        write_index(&index_path, &ix)?;
+        write_index(&stage.join("index.json"), &ix)?;
         bar.advance(1);
     }
     drop(bar);
-    // Shards of an earlier, longer plan are not this dataset's.
-    for s in cuts.len().. {
-        let p = dir.join(shard_name(s));
-        if !p.exists() {
-            break;
+    // Nothing in the new folder but its shards and index.
+    let keep: Vec<String> = ix.shards.iter().map(|t| t.name.clone()).collect();
+    for e in std::fs::read_dir(&stage).map_err(|e| Error::io(&stage, e))? {
+        let e = e.map_err(|e| Error::io(&stage, e))?;
+        let name = e.file_name().to_string_lossy().into_owned();
+        if name != "index.json" && !keep.contains(&name) {
+            remove_any(&e.path())?;
         }
-        std::fs::remove_file(&p).map_err(|e| Error::io(&p, e))?;
     }
-    Ok(PackSummary {
-        shards: cuts.len(),
-        written,
-        items: lines.len() as u64,
-        bytes: total,
-    })
+    swap_in(&stage, &dir, &old)?;
+    Ok(summary(written, &ix))
 }
 
-/// Checks `out/webdataset/` against its `index.json` (each listed shard
-/// present with its size and SHA-256, the index for this dataset and
-/// complete); returns the number of shards, `None` when there is no index.
-pub fn verify_tars(out: &Path) -> Result<Option<usize>> {
-    let index = out.join(FOLDER).join("index.json");
-    if !index.exists() {
+/// Brings an intact shard of the current folder into the new one (a hard
+/// link, or a copy where links are not possible), checked again there.
+fn link_kept(
+    current: Option<&TarIndex>,
+    dir: &Path,
+    path: &Path,
+    name: &str,
+    first: u64,
+    n: u64,
+) -> Result<Option<TarShard>> {
+    let Some(t) = intact(current, dir, name, first, n)? else {
         return Ok(None);
+    };
+    if std::fs::symlink_metadata(path).is_ok() {
+        remove_any(path)?;
     }
-    let rec = Record::read(out)?;
-    let text = read_json_file(&index)?;
-    let ix: TarIndex = serde_json::from_str(&text).map_err(|e| Error::Config {
-        path: index.clone(),
-        message: crate::error::clip(&e.to_string(), crate::error::MAX_MESSAGE),
-    })?;
-    let bad = |m: String| Err(Error::invalid(show_path(&index), m));
-    if ix.format != INDEX_FORMAT || ix.fingerprint != rec.fingerprint {
-        return bad(format!(
-            "made from another dataset (fingerprint {})",
-            super::guard::short(&ix.fingerprint)
-        ));
+    let from = dir.join(name);
+    if std::fs::hard_link(&from, path).is_err() {
+        std::fs::copy(&from, path).map_err(|e| Error::io(path, e))?;
     }
-    if !ix.complete {
-        return bad(
-            "incomplete (a packing run was stopped): rerun with --format webdataset".into(),
-        );
-    }
-    let mut next = 0u64;
-    for (s, t) in ix.shards.iter().enumerate() {
-        if t.name != shard_name(s) || t.first != next || t.items == 0 {
-            return bad(format!(
-                "shard {s} listed as {} from item {}",
-                t.name, t.first
-            ));
-        }
-        next += t.items;
-        let p = out.join(FOLDER).join(&t.name);
-        match existing(&p)? {
-            Some((b, sha)) if b == t.bytes && sha == t.sha256 => {}
-            Some((b, sha)) => {
-                return bad(format!(
-                    "{}: {b} bytes, SHA-256 {}, where the index lists {} bytes, {}",
-                    t.name,
-                    &sha[..12],
-                    t.bytes,
-                    super::guard::short(&t.sha256)
-                ))
-            }
-            None => return bad(format!("{} is missing", t.name)),
-        }
-    }
-    if next != rec.count {
-        return bad(format!(
-            "the shards hold {next} items where the dataset has {}",
-            rec.count
-        ));
-    }
-    Ok(Some(ix.shards.len()))
+    let same = sum_regular(path)?.is_some_and(|(b, sha)| b == t.bytes && sha == t.sha256);
+    Ok(same.then_some(t))
 }
 
 fn write_index(path: &Path, ix: &TarIndex) -> Result<()> {

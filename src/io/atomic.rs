@@ -287,6 +287,21 @@ impl Drop for PendingDir {
     }
 }
 
+/// A builder of temporary files (`PREFIX*SUFFIX`) created with mode 0666
+/// less the process's umask, as any new file (`tempfile`'s default, 0600,
+/// would make every output private): 0644 under the usual umask 022, 0640
+/// under 027. The mode is the kernel's, applied at creation.
+pub fn temp_builder<'a>(prefix: &'a str, suffix: &'a str) -> tempfile::Builder<'a, 'a> {
+    let mut b = tempfile::Builder::new();
+    b.prefix(prefix).suffix(suffix);
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        b.permissions(std::fs::Permissions::from_mode(0o666));
+    }
+    b
+}
+
 /// A temporary file registered in [`PENDING`] for its lifetime.
 struct Temp {
     file: Option<tempfile::NamedTempFile>,
@@ -295,9 +310,8 @@ struct Temp {
 
 impl Temp {
     fn new_in(dir: &Path, ext: &str) -> Result<Self> {
-        let file = tempfile::Builder::new()
-            .prefix(".mmbm-")
-            .suffix(&format!(".tmp{ext}"))
+        let suffix = format!(".tmp{ext}");
+        let file = temp_builder(".mmbm-", &suffix)
             .tempfile_in(dir)
             .map_err(|e| Error::io(dir, e))?;
         let path = file.path().to_path_buf();
@@ -321,14 +335,9 @@ impl Temp {
             .ok_or_else(|| Error::io(&self.path, std::io::Error::other("temporary file closed")))
     }
 
-    /// Renames onto `path` (permissions 0644 as for any new file).
+    /// Renames onto `path` (its permissions those of any new file: see
+    /// [`temp_builder`]).
     fn publish(mut self, path: &Path) -> Result<()> {
-        #[cfg(unix)]
-        {
-            use std::os::unix::fs::PermissionsExt;
-            std::fs::set_permissions(&self.path, std::fs::Permissions::from_mode(0o644))
-                .map_err(|e| Error::io(path, e))?;
-        }
         match self.file.take() {
             Some(f) => f
                 .persist(path)
