@@ -14,6 +14,8 @@
 //! - `guard`: the configuration's fingerprint (`DIR/dataset.json`) and the
 //!   lock that keeps each shard to one writer.
 //! - `sensor`: the camera pipeline of the PNG files (`[sensor]`).
+//! - [`textures`]: the built-in textures (`textures = "builtin:"`, the
+//!   default), compiled in from `assets/textures/`.
 //! - `webdataset`: the directory packed into WebDataset tar shards
 //!   (`--format webdataset`).
 
@@ -24,9 +26,10 @@ pub(crate) mod manifest;
 pub(crate) mod run;
 pub(crate) mod sensor;
 pub(crate) mod shard;
+pub mod textures;
 pub(crate) mod webdataset;
 
-pub use config::DatasetConfig;
+pub use config::{DatasetConfig, Origin, MAX_COUNT};
 pub use guard::{Record, RunLock};
 pub use item::{ItemParams, Sources};
 pub use manifest::{merge, verify, ManifestLine};
