@@ -367,3 +367,37 @@ fn sharp_frame_offsets_follow_the_convention() {
         "start {start} and end {end} px not opposite"
     );
 }
+
+/// Items of earlier versions (the seed a JSON number, no `sharp` key: they
+/// were all `start`) still read: a `sharp = "start"` directory rewritten in
+/// that form verifies, and a rerun resumes it (its fingerprint unchanged),
+/// making nothing.
+#[test]
+fn earlier_items_with_numeric_seeds_still_verify_and_resume() {
+    let cfg = DatasetConfig {
+        count: 3,
+        resolution: [16, 12],
+        sharp: SharpAt::Start,
+        ..DatasetConfig::default()
+    };
+    let d = tempfile::tempdir().unwrap();
+    dataset::run(&cfg, d.path(), Shard::ALL, false).unwrap();
+    let manifest = d.path().join("manifest.jsonl");
+    let mut old = String::new();
+    for line in std::fs::read_to_string(&manifest).unwrap().lines() {
+        let mut v: Value = serde_json::from_str(line).unwrap();
+        let p = v["params"].as_object_mut().unwrap();
+        let seed: u64 = p["seed"].as_str().unwrap().parse().unwrap();
+        p.insert("seed".into(), Value::from(seed));
+        assert_eq!(p.remove("sharp"), Some(Value::from("start")));
+        let text = serde_json::to_string(&v).unwrap();
+        assert!(text.contains(&format!("\"seed\":{seed},")));
+        let dir = d.path().join(v["dir"].as_str().unwrap());
+        std::fs::write(dir.join("item.json"), format!("{text}\n")).unwrap();
+        old += &format!("{text}\n");
+    }
+    std::fs::write(&manifest, &old).unwrap();
+    assert_eq!(dataset::verify(d.path()).unwrap(), 3);
+    let s = dataset::run(&cfg, d.path(), Shard::ALL, false).unwrap();
+    assert_eq!((s.items, s.made), (3, 0));
+}
