@@ -115,6 +115,11 @@ def test_hugging_face_streaming_reads_every_sample(shards):
         for f in ("flow.exr", "maps.exr", "sharp.exr"):
             assert s[f] == (out / "items" / s["__key__"] / f).read_bytes(), f
     assert keys == [f"{i:08d}" for i in range(COUNT)]
+    # As Arrow too (where a seed above 2^63 - 1 raised OverflowError).
+    tables = list(ds.with_format("arrow"))
+    assert sum(t.num_rows for t in tables) == COUNT
+    seeds = [str(r["params"]["seed"]) for t in tables for r in t.column("json").to_pylist()]
+    assert seeds == [line["params"]["seed"] for line in lines]
 
 
 def test_webdataset_package_reads_every_sample(shards):
