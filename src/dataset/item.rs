@@ -180,9 +180,7 @@ impl Sources {
         if super::textures::is_builtin(&self.textures_dir) {
             return super::textures::builtin_sum(name);
         }
-        let p = self.textures_dir.join(name);
-        let mut f = crate::io::input::open_file(&p)?;
-        super::guard::sha256_of(&mut f, &p)
+        super::textures::file_sum(&self.textures_dir.join(name))
     }
 }
 

@@ -81,6 +81,14 @@ pub fn builtin_sum(name: &str) -> Result<(u64, String)> {
     Ok((bytes.len() as u64, format!("{:x}", Sha256::digest(bytes))))
 }
 
+/// Size and SHA-256 (hex) of the texture file `p`, read in bounded memory.
+pub fn file_sum(p: &Path) -> Result<(u64, String)> {
+    let mut f = crate::io::input::open_file(p)?;
+    let mut h = Sha256::new();
+    let n = std::io::copy(&mut f, &mut h).map_err(|e| Error::io(p, e))?;
+    Ok((n, format!("{:x}", h.finalize())))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
