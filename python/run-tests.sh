@@ -10,7 +10,7 @@ if [ ! -x "$VENV/bin/python" ]; then
 fi
 VENV=$(cd "$VENV" && pwd)
 "$VENV/bin/python" -m pip install -q --disable-pip-version-check --upgrade pip >/dev/null
-"$VENV/bin/python" -m pip install -q --disable-pip-version-check numpy pytest webdataset
+"$VENV/bin/python" -m pip install -q --disable-pip-version-check numpy pytest webdataset datasets pillow
 echo "== building and installing the Python package (pip install ./python)"
 "$VENV/bin/python" -m pip install -q --disable-pip-version-check --force-reinstall --no-deps .
 echo "== pytest"

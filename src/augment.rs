@@ -8,10 +8,11 @@
 //! length and pitch unless a camera is given, which must have that size);
 //! the image, `zoom` times the field of view wide (1: it fills the view), is
 //! a plane `distance_m` in front of the camera, facing it, at the reference
-//! pose. The reference pose is the camera at exposure start, or with
-//! `centre` at mid-exposure (the motion re-based on its middle pose: no net
-//! shift, the blur spread around each point's place). Where the moving view
-//! leaves the image, the background colour shows.
+//! pose. The reference pose, where the image is the sharp frame, is the
+//! camera at the instant `sharp` ([`SharpAt`]): exposure start (default), its
+//! middle (the motion re-based on its middle pose: no net shift, the blur
+//! spread around each point's place, the GoPro / REDS convention) or its end.
+//! Where the moving view leaves the image, the background colour shows.
 //!
 //! Homographies: `H(t)` maps image pixel coordinates (fractional, `(0, 0)`
 //! the top-left corner, as [`crate::render::project`]'s) to the frame's
@@ -23,12 +24,14 @@ use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::io::gyro::GyroSample;
 use crate::model::motion::Twist;
-use crate::render::{self, Backend, BlurMaps, Pose, Quality, RenderJob, Target, Trajectory};
+use crate::render::{
+    self, Backend, BlurMaps, Pose, Quality, RenderJob, SharpAt, Target, Trajectory,
+};
 use crate::sim::{simulate, Gait, GaitConfig};
 use glam::{DMat3, DVec3};
 use rand::{Rng, SeedableRng};
 
-/// Poses in the table of a re-based (centred) trajectory.
+/// Poses in the table of a re-based trajectory (`sharp` not at the start).
 const CENTRED_POSES: usize = 1024;
 /// Seconds of simulated walk before a drawn exposure may start.
 const SETTLE_S: f64 = 1.0;
@@ -68,8 +71,9 @@ pub struct Augment {
     pub distance_m: f64,
     /// The image's width over the field of view's at the reference pose.
     pub zoom: f64,
-    /// Reference pose at mid-exposure (no net shift) instead of at its start.
-    pub centre: bool,
+    /// The reference pose (where the image is the sharp frame): at exposure
+    /// start, its middle (no net shift) or its end.
+    pub sharp: SharpAt,
     /// Seed (simulated motion, the renderer's sample shifts).
     pub seed: u64,
     /// Render preset.
@@ -82,7 +86,7 @@ pub struct Augment {
 
 impl Augment {
     /// Defaults: `exposure_s` of the given motion, thesis camera, 2 m, zoom
-    /// 1, exposure start as reference, seed 0, `default` preset, black
+    /// 1, exposure start as reference (`sharp` [`SharpAt::Start`]), seed 0, `default` preset, black
     /// background, translation used.
     pub fn new(motion: Motion, exposure_s: f64) -> Self {
         Augment {
@@ -91,7 +95,7 @@ impl Augment {
             camera: None,
             distance_m: 2.0,
             zoom: 1.0,
-            centre: false,
+            sharp: SharpAt::Start,
             seed: 0,
             quality: Quality::default(),
             background: [0.0; 3],
@@ -232,14 +236,14 @@ pub fn augment(w: u32, h: u32, rgb: &[f32], a: &Augment) -> Result<Augmented> {
     target.background = a.background;
     let span = a.exposure_s + cam.shutter.readout_s;
     let (traj, what) = trajectory(a, span)?;
-    let traj = if a.centre {
-        // Re-based on the middle pose (of the exposure, or of the whole
-        // rolling-shutter span).
-        let mid = traj.pose_at(0.5 * span);
+    let traj = if !a.sharp.is_start() {
+        // Re-based on the pose at that instant (of the exposure, or of the
+        // whole rolling-shutter span).
+        let reference = traj.pose_at(a.sharp.fraction() * span);
         let poses = traj
             .table(CENTRED_POSES)
             .iter()
-            .map(|p| relative(&mid, p))
+            .map(|p| relative(&reference, p))
             .collect();
         Trajectory::from_poses(span, poses)?
     } else {

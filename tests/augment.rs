@@ -81,7 +81,7 @@ fn homographies_carry_a_point_to_its_streak() {
 fn centring_removes_the_net_shift() {
     let img = dot(40, 30);
     let mut a = Augment::new(motion(), 0.03);
-    a.centre = true;
+    a.sharp = mmbm::render::SharpAt::Mid;
     let out = augment(W, H, &img, &a).unwrap();
     let (x1, y1) = apply(&out.homographies[1], 40.0, 30.0);
     assert!(

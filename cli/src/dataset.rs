@@ -13,9 +13,16 @@ use std::path::PathBuf;
 of the work gives the same bytes. Item files: DIR/items/NNNNNNNN/{blurred,sharp}.{exr,png}
 (linear EXR, sRGB PNG), flow.exr (flow.u, flow.v at exposure start, px/s), maps.exr (path_px,
 disp_px, speed_px_s), item.json (its manifest line: every parameter, the instantaneous MMBM at
-exposure start and the exposure MMBM, file sizes and SHA-256). A rerun skips complete items; DIR/dataset.json holds the
+exposure start and the exposure MMBM, file sizes and SHA-256; the item's seed as a decimal string, so
+every number loads as int64 in Arrow / Hugging Face datasets). The sharp frame shows the middle of
+the motion by default (sharp = \"mid\", as GoPro / REDS pair a blurred frame with its middle frame;
+\"start\" or \"end\" in the configuration). A rerun skips complete items; DIR/dataset.json holds the
 configuration's fingerprint, and a run with another configuration is refused (use a new --out);
 a larger count grows the set (the items made are kept), a smaller one is refused.
+
+Without --config the defaults are used, textures included: textures = \"builtin:\" is the five
+textures compiled into mmbm (CC0 / public domain, from scikit-image), so it runs from any
+directory. Relative paths in a configuration file are relative to that file's folder.
 
 Sharding: --shard K/N (K from 1) makes the items with i mod N = K-1 and writes
 DIR/manifest.part-K-of-N.jsonl; without --shard, a SLURM job array (SLURM_ARRAY_TASK_ID,
@@ -34,6 +41,7 @@ nothing (DIR/webdataset/ appears complete). --verify also checks the shards agai
 Examples:
   mmbm dataset --print-config > ds.toml
   mmbm dataset --config ds.toml --out data/
+  mmbm dataset --out data/ --count 1000         (the defaults, 1000 items)
   mmbm dataset --config ds.toml --out data/ --shard 2/8
   mmbm dataset --merge --out data/ && mmbm dataset --verify --out data/
   mmbm dataset --config ds.toml --out data/ --format webdataset
@@ -41,9 +49,13 @@ Examples:
   sbatch --array=1-8 examples/dataset.sbatch     (see examples/dataset-job.yaml for Kubernetes)"
 )]
 pub struct DatasetArgs {
-    /// TOML configuration (missing keys take the defaults; see --print-config).
+    /// TOML configuration (missing keys take the defaults; see --print-config). Relative paths in it
+    /// (textures, log:PATH) are relative to its folder.
     #[arg(long, value_name = "FILE")]
     pub config: Option<PathBuf>,
+    /// Number of items, over the configuration's `count` (1..=100000000).
+    #[arg(long, value_name = "N", conflicts_with_all = ["merge", "verify", "print_config"])]
+    pub count: Option<u64>,
     /// Dataset directory.
     #[arg(long, value_name = "DIR", required_unless_present = "print_config")]
     pub out: Option<PathBuf>,
@@ -199,10 +211,19 @@ pub fn run(a: DatasetArgs) -> Result<()> {
         }
         return Ok(());
     }
-    let cfg = match &a.config {
+    let mut cfg = match &a.config {
         Some(p) => DatasetConfig::load(p)?,
         None => DatasetConfig::default(),
     };
+    if let Some(n) = a.count {
+        if n == 0 || n > dataset::MAX_COUNT {
+            return Err(Error::invalid(
+                "--count",
+                format!("{n} is not in 1..={}", dataset::MAX_COUNT),
+            ));
+        }
+        cfg.count = n;
+    }
     // The dataset folder writable and none of its inputs under a name
     // written there, before any work.
     mmbm::io::guard::OutputGuard::new()

@@ -393,13 +393,26 @@ def _linear_to_srgb(x: np.ndarray) -> np.ndarray:
     return np.where(x <= 0.0031308, 12.92 * x, 1.055 * x ** (1 / 2.4) - 0.055)
 
 
+def _sharp(sharp: Optional[str], centre: Optional[bool]) -> str:
+    """``augment``'s ``sharp``, with ``centre`` (True: ``"mid"``, False:
+    ``"start"``) as its alias; both given must agree."""
+    alias = None if centre is None else ("mid" if centre else "start")
+    if sharp is None:
+        return alias or "start"
+    if sharp not in ("start", "mid", "end"):
+        raise ValueError(f"sharp: 'start', 'mid' or 'end' expected, got {sharp!r}")
+    if alias is not None and alias != sharp:
+        raise ValueError(f"centre={centre} is sharp={alias!r}, which contradicts sharp={sharp!r}")
+    return sharp
+
+
 def augment(
     image: ArrayLike,
     motion: Union[str, Dict[str, Any]] = "shake",
     exposure: float = 0.03,
     camera: Optional[Camera] = None,
     seed: int = 0,
-    centre: bool = False,
+    centre: Optional[bool] = None,
     zoom: float = 1.0,
     distance: float = 2.0,
     at: Optional[float] = None,
@@ -407,6 +420,7 @@ def augment(
     quality: str = "default",
     background: Sequence[float] = (0.0, 0.0, 0.0),
     use_velocity: bool = True,
+    sharp: Optional[str] = None,
 ) -> Dict[str, Any]:
     """Motion blur of ``image`` along a real or simulated camera motion.
 
@@ -416,8 +430,12 @@ def augment(
     drawn from ``seed``), ``"sim:slow"``, ``"sim:moderate"``, ``"sim:fast"``
     (a simulated walk), ``{"omega": [wx, wy, wz], "velocity": [vx, vy, vz]}``
     (a constant twist, rad/s and m/s, camera frame) or a ``read_gyro`` dict
-    with ``at`` (a window of a real log starting at ``at`` s). ``centre``:
-    the reference pose at mid-exposure, so the blur has no net shift.
+    with ``at`` (a window of a real log starting at ``at`` s). ``sharp``:
+    the instant at which ``image`` is the sharp frame (the reference pose):
+    ``"start"`` (default), ``"mid"`` (no net shift: the blur spreads around
+    each point, as GoPro / REDS pair a blurred frame with its middle sharp
+    frame) or ``"end"``; ``centre=True`` is ``sharp="mid"`` (``False``:
+    ``"start"``).
     ``camera``: default the thesis focal length and pitch at the image's
     size (a given camera must have that size; lens distortion is refused).
 
@@ -469,7 +487,7 @@ def augment(
         None if camera is None else camera._spec(),
         float(distance),
         float(zoom),
-        bool(centre),
+        _sharp(sharp, centre),
         int(seed),
         quality,
         [float(v) for v in background],

@@ -84,7 +84,7 @@ def augment(
     cam: Optional[Dict[str, Any]],
     distance: float,
     zoom: float,
-    centre: bool,
+    sharp: str,
     seed: int,
     quality: str,
     background: Sequence[float],

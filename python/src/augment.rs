@@ -26,7 +26,7 @@ type Out<'py> = (
 /// `sim:GAIT`, `twist` (with `omega`, `velocity`) or `log` (with `gyro`,
 /// `at`). Returns (image, maps, homographies (3, 3, 3), motion drawn).
 #[pyfunction]
-#[pyo3(signature = (image, motion, omega, velocity, gyro, at, exposure, cam, distance, zoom, centre,
+#[pyo3(signature = (image, motion, omega, velocity, gyro, at, exposure, cam, distance, zoom, sharp,
     seed, quality, background, use_velocity))]
 #[allow(clippy::too_many_arguments)]
 pub fn augment<'py>(
@@ -41,7 +41,7 @@ pub fn augment<'py>(
     cam: Option<Bound<'py, PyDict>>,
     distance: f64,
     zoom: f64,
-    centre: bool,
+    sharp: &str,
     seed: u64,
     quality: &str,
     background: [f32; 3],
@@ -79,7 +79,7 @@ pub fn augment<'py>(
     job.camera = cam.map(|c| camera(&c)).transpose()?;
     job.distance_m = distance;
     job.zoom = zoom;
-    job.centre = centre;
+    job.sharp = sharp.parse().map_err(err)?;
     job.seed = seed;
     job.quality = quality.parse::<Quality>().map_err(err)?;
     job.background = background;

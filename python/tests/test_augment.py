@@ -82,3 +82,23 @@ def test_bad_inputs_are_clear_errors():
         mmbm.augment(dot(), motion="shake", exposure=0.0)
     with pytest.raises(ValueError, match="640 x 480 px where the image is 64 x 48"):
         mmbm.augment(dot(), motion="shake", camera=mmbm.Camera())
+
+
+def test_sharp_names_the_reference_instant():
+    """``sharp``: the image is the frame at exposure start, middle or end (that
+    homography is the identity); ``centre=True`` is ``sharp="mid"``."""
+    kw = dict(motion={"omega": [0.0, 0.9, 0.2]}, exposure=0.03)
+    for k, at in enumerate(["start", "mid", "end"]):
+        out = mmbm.augment(dot(), sharp=at, **kw)
+        np.testing.assert_allclose(out["homographies"][k], np.eye(3), atol=1e-9)
+        assert np.abs(out["homographies"][2 - k] - np.eye(3)).max() > 1e-3 or k == 1
+    mid = mmbm.augment(dot(), sharp="mid", **kw)
+    alias = mmbm.augment(dot(), centre=True, **kw)
+    np.testing.assert_array_equal(mid["image"], alias["image"])
+    np.testing.assert_array_equal(
+        mmbm.augment(dot(), centre=False, **kw)["image"], mmbm.augment(dot(), **kw)["image"]
+    )
+    with pytest.raises(ValueError, match="contradicts"):
+        mmbm.augment(dot(), centre=True, sharp="end", **kw)
+    with pytest.raises(ValueError, match="middle"):
+        mmbm.augment(dot(), sharp="middle", **kw)

@@ -3,7 +3,7 @@
 use super::sensor::SensorPipeline;
 use crate::camera::{Camera, CameraFile};
 use crate::error::{Error, Result};
-use crate::render::Quality;
+use crate::render::{Quality, SharpAt};
 use crate::sim::Gait;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -17,10 +17,14 @@ pub struct DatasetConfig {
     pub count: u64,
     /// Master seed: item `i`'s random draws depend only on it and `i`.
     pub seed: u64,
-    /// Folder of texture images (PNG/JPEG), relative to the working directory.
+    /// Folder of texture images (PNG/JPEG); a relative path is relative to
+    /// the configuration file's folder (the working directory for TOML text
+    /// or no file). `builtin:` (the default): the five textures compiled
+    /// into mmbm, the files of `assets/textures/` ([`super::textures`]).
     pub textures: PathBuf,
     /// Motion sources, one drawn per item: `sim:slow|moderate|fast` (a
-    /// simulated walk) or `log:PATH` (a gyro CSV or MCAP log; a window of it).
+    /// simulated walk) or `log:PATH` (a gyro CSV or MCAP log; a window of it;
+    /// a relative path as `textures`).
     pub motion: Vec<String>,
     /// Exposure range, s.
     pub exposure_s: [f64; 2],
@@ -38,6 +42,10 @@ pub struct DatasetConfig {
     /// Use the motion's linear velocity where it has one (simulated walks do;
     /// logs without vx,vy,vz are rotation only).
     pub use_velocity: bool,
+    /// The instant the sharp frame shows: `mid` (default: the middle of the
+    /// motion, as GoPro / REDS pair a blurred frame with its middle sharp
+    /// frame), `start` (what mmbm made before this key) or `end`.
+    pub sharp: SharpAt,
     /// The `[camera]` section: any of the camera file's keys ([`CameraFile`])
     /// over the thesis camera at `resolution` ([`DatasetConfig::camera`]), as
     /// the experiment's. Left out when empty, so a configuration without it
@@ -50,6 +58,21 @@ pub struct DatasetConfig {
     /// configuration without it gives the items it always gave.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub sensor: Option<SensorPipeline>,
+    /// The file the configuration was read from (not a key): relative paths
+    /// are resolved against its folder, and errors name it.
+    #[serde(skip)]
+    pub origin: Origin,
+}
+
+/// Where a configuration came from: its file, if any. Not part of what the
+/// configuration is (two configurations equal whatever their files).
+#[derive(Debug, Clone, Default)]
+pub struct Origin(pub Option<PathBuf>);
+
+impl PartialEq for Origin {
+    fn eq(&self, _: &Self) -> bool {
+        true
+    }
 }
 
 /// True for a `[camera]` section with no keys.
@@ -62,7 +85,7 @@ impl Default for DatasetConfig {
         DatasetConfig {
             count: 100,
             seed: 1,
-            textures: PathBuf::from("assets/textures"),
+            textures: PathBuf::from(super::textures::BUILTIN),
             motion: vec!["sim:slow".into(), "sim:moderate".into(), "sim:fast".into()],
             exposure_s: [0.01, 0.07],
             distance_m: [1.0, 3.0],
@@ -73,6 +96,8 @@ impl Default for DatasetConfig {
             use_velocity: true,
             camera: CameraFile::default(),
             sensor: None,
+            sharp: SharpAt::Mid,
+            origin: Origin::default(),
         }
     }
 }
@@ -83,13 +108,55 @@ pub const MAX_COUNT: u64 = 100_000_000;
 impl DatasetConfig {
     /// Loads a TOML file; missing keys take the defaults. Errors name the
     /// file and the key.
+    /// Relative paths in it (`textures`, `log:PATH`) are relative to the
+    /// file's folder.
     pub fn load(path: &Path) -> Result<Self> {
         let text = crate::io::input::read_text(path)?;
-        Self::from_toml(&text, &path.display().to_string())
+        let mut cfg = Self::from_toml(&text, &path.display().to_string())?;
+        cfg.origin = Origin(Some(path.to_path_buf()));
+        Ok(cfg)
+    }
+
+    /// `p` resolved against the configuration file's folder (as it is when
+    /// absolute, or when the configuration has no file).
+    pub fn resolve(&self, p: &Path) -> PathBuf {
+        match self.origin.0.as_deref().and_then(Path::parent) {
+            Some(base) if !p.is_absolute() => base.join(p),
+            _ => p.to_path_buf(),
+        }
+    }
+
+    /// An error about `path`, written as `value` under `key`: names the
+    /// key and the file, and the resolved path when it differs.
+    pub(crate) fn key_error(
+        &self,
+        key: &str,
+        value: &str,
+        path: &Path,
+        message: impl Into<String>,
+    ) -> Error {
+        let file = match &self.origin.0 {
+            Some(f) => format!(" in {}", crate::error::show_path(f)),
+            None => String::new(),
+        };
+        let mut message = message.into();
+        let resolved = self.resolve(path);
+        let shown = crate::error::show_path(&resolved);
+        if resolved != path && !message.contains(&shown) {
+            message = format!("{message} (resolved against the configuration's folder: {shown})");
+        }
+        Error::invalid(
+            format!(
+                "{key} = \"{}\" (key '{key}'{file})",
+                crate::error::shown(value, 200)
+            ),
+            message,
+        )
     }
 
     /// Parses TOML text (`origin` names it in errors); missing keys take the
-    /// defaults. Relative paths are relative to the working directory.
+    /// defaults. Relative paths are relative to the working directory (see
+    /// [`Self::load`] for a file).
     pub fn from_toml(text: &str, origin: &str) -> Result<Self> {
         let cfg: DatasetConfig = toml::from_str(text).map_err(|e| {
             Error::invalid(
@@ -153,6 +220,22 @@ impl DatasetConfig {
         }
         let cam = self.camera();
         cam.validate().map_err(|e| key("camera", e.to_string()))?;
+        // Items' JSON carries the section: every number in it must be an
+        // int64 (Arrow, pandas, Python's C long).
+        if let Some(n) = self
+            .camera
+            .noise
+            .as_ref()
+            .filter(|n| n.seed > i64::MAX as u64)
+        {
+            return Err(key(
+                "camera.noise.seed",
+                format!(
+                    "{} is above 2^63 - 1 (items' JSON must load as int64 in Arrow / Hugging Face datasets)",
+                    n.seed
+                ),
+            ));
+        }
         if cam.width as u64 * cam.height as u64 > crate::render::MAX_PIXELS {
             return Err(key(
                 "camera",

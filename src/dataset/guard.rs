@@ -114,9 +114,7 @@ impl Record {
         let mut inputs = serde_json::to_value(cfg).map_err(bad)?;
         let mut textures = Vec::new();
         for name in &src.textures {
-            let p = src.textures_dir.join(name);
-            let mut f = crate::io::input::open_file(&p)?;
-            let (bytes, sha256) = sha256_of(&mut f, &p)?;
+            let (bytes, sha256) = src.texture_sum(name)?;
             textures.push(serde_json::json!({"name": name, "bytes": bytes, "sha256": sha256}));
         }
         let mut logs = serde_json::Map::new();
@@ -130,6 +128,11 @@ impl Record {
             .ok_or_else(|| Error::invalid("dataset config", "is not a table"))?;
         obj.remove("count");
         obj.insert("textures".into(), Value::Array(textures));
+        // `sharp = "start"` was what every configuration made before the key
+        // existed: left out, so those directories keep their fingerprint.
+        if cfg.sharp.is_start() {
+            obj.remove("sharp");
+        }
         obj.insert("logs".into(), Value::Object(logs));
         Ok(Record {
             format: FORMAT.into(),

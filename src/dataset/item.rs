@@ -12,7 +12,7 @@ use crate::io::input::{image_dimensions, is_regular_file};
 use crate::metric::{mmbm, Method, Scene};
 use crate::model::log::ImuLog;
 use crate::model::motion::{Plane, Twist};
-use crate::render::{self, Backend, Quality, RenderJob, RenderOutput, Target, Trajectory};
+use crate::render::{self, Backend, Quality, RenderJob, RenderOutput, SharpAt, Target, Trajectory};
 use crate::sim::{simulate, GaitConfig};
 use glam::DVec3;
 use rand::{Rng, SeedableRng};
@@ -30,7 +30,11 @@ const SIM_SETTLE_S: f64 = 1.0;
 pub struct ItemParams {
     /// Item index.
     pub index: u64,
-    /// The item's seed (renderer shifts, simulated walk).
+    /// The item's seed (renderer shifts, simulated walk). Written as a
+    /// decimal string: a u64 may pass 2^63 - 1, which Arrow (Hugging Face
+    /// `datasets`), pandas and Python's C long cannot hold as a number; read
+    /// from a string or (items of earlier versions) a number.
+    #[serde(with = "seed_text")]
     pub seed: u64,
     /// Texture file name in the texture folder.
     pub texture: String,
@@ -59,6 +63,37 @@ pub struct ItemParams {
     /// The configuration's `[sensor]` pipeline (absent when there is none).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub sensor: Option<SensorPipeline>,
+    /// The instant the sharp frame shows (`start`, `mid`, `end`); absent in
+    /// items of earlier versions, which were `start`.
+    #[serde(default = "SharpAt::legacy")]
+    pub sharp: SharpAt,
+}
+
+/// A u64 as a decimal string in JSON (read from a string or a number).
+mod seed_text {
+    use serde::{de, Deserialize, Deserializer, Serializer};
+
+    pub fn serialize<S: Serializer>(v: &u64, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(&v.to_string())
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<u64, D::Error> {
+        #[derive(Deserialize)]
+        #[serde(untagged)]
+        enum Seed {
+            Text(String),
+            Number(u64),
+        }
+        match Seed::deserialize(d)? {
+            Seed::Number(n) => Ok(n),
+            Seed::Text(t) => t.parse().map_err(|_| {
+                de::Error::custom(format!(
+                    "seed {:?} is not a whole number in 0..=18446744073709551615",
+                    crate::error::clip(&t, 64)
+                ))
+            }),
+        }
+    }
 }
 
 /// The seed of item `i` (SplitMix64 of the master seed and `i`).
@@ -82,77 +117,117 @@ pub struct Sources {
 impl Sources {
     /// Lists the textures (each checked to be a readable image) and reads
     /// the logs of `cfg` (each checked to outlast the longest exposure).
+    /// Relative paths are resolved against the configuration's folder
+    /// ([`DatasetConfig::resolve`]); errors about them name the key.
     pub fn open(cfg: &DatasetConfig) -> Result<Self> {
-        let dir = &cfg.textures;
-        let rd = std::fs::read_dir(dir).map_err(|e| Error::io(dir, e))?;
-        let mut textures = Vec::new();
-        for e in rd {
-            let e = e.map_err(|e| Error::io(dir, e))?;
-            let file_name = e.file_name();
-            let lossy = file_name.to_string_lossy();
-            let ext = lossy.rsplit('.').next().unwrap_or("").to_ascii_lowercase();
-            let p = dir.join(&file_name);
-            // Only regular files are textures (a pipe named f.png would
-            // block the read; a folder or a device is not an image).
-            if ["png", "jpg", "jpeg"].contains(&ext.as_str()) && is_regular_file(&p) {
-                // Items and manifests name their texture as text: a name
-                // that is not UTF-8 is refused as it is (not read as another).
-                let name = file_name.to_str().map(str::to_string).ok_or_else(|| {
-                    Error::invalid(
-                        "texture",
-                        format!(
-                            "{}: the file name is not valid UTF-8 (items and manifests name \
-                             their texture as text); rename the file",
-                            crate::error::show_path(&p)
-                        ),
-                    )
-                })?;
-                image_dimensions(&p).map_err(|e| match e {
-                    Error::Image { path, message } => Error::Image {
-                        path,
-                        message: format!("not a readable image: {message}"),
-                    },
-                    e => e,
-                })?;
-                textures.push(name);
-            }
-        }
-        textures.sort();
-        if textures.is_empty() {
-            return Err(Error::invalid(
-                dir.display().to_string(),
-                "no texture images (.png, .jpg, .jpeg) in this folder",
-            ));
-        }
+        let written = &cfg.textures;
+        let (textures_dir, textures) = if super::textures::is_builtin(written) {
+            let names = super::textures::BUILTIN_FILES.map(|(n, _)| n.to_string());
+            (written.clone(), names.to_vec())
+        } else {
+            let dir = cfg.resolve(written);
+            let textures = list_textures(&dir).map_err(|e| {
+                cfg.key_error(
+                    "textures",
+                    &written.display().to_string(),
+                    written,
+                    e.to_string(),
+                )
+            })?;
+            (dir, textures)
+        };
         let mut logs = HashMap::new();
         let readout_s = cfg.camera().shutter.readout_s;
         for m in &cfg.motion {
             if let MotionSource::Log(p) = MotionSource::parse(m)? {
-                let s = read_log(&p, GyroOptions::default())?;
+                let bad = |e: String| cfg.key_error("motion", m, &p, e);
+                let s = read_log(&cfg.resolve(&p), GyroOptions::default())
+                    .map_err(|e| bad(e.to_string()))?;
                 let span = s.last().map_or(0.0, |l| l.t) - s.first().map_or(0.0, |f| f.t);
                 if span < cfg.exposure_s[1] + readout_s {
-                    return Err(Error::invalid(
-                        p.display().to_string(),
-                        format!(
-                            "the log spans {span:.4} s, shorter than the longest exposure ({} s){}",
-                            cfg.exposure_s[1],
-                            if readout_s > 0.0 {
-                                format!(" plus the camera's readout ({readout_s} s)")
-                            } else {
-                                String::new()
-                            }
-                        ),
-                    ));
+                    return Err(bad(format!(
+                        "the log spans {span:.4} s, shorter than the longest exposure ({} s){}",
+                        cfg.exposure_s[1],
+                        if readout_s > 0.0 {
+                            format!(" plus the camera's readout ({readout_s} s)")
+                        } else {
+                            String::new()
+                        }
+                    )));
                 }
+                // Keyed as written: items name their motion as written.
                 logs.insert(p, s);
             }
         }
         Ok(Sources {
-            textures_dir: dir.clone(),
+            textures_dir,
             textures,
             logs,
         })
     }
+
+    /// The texture `name` (of [`Self::textures`]), decoded.
+    pub fn texture(&self, name: &str) -> Result<crate::render::texture::MipTexture> {
+        if super::textures::is_builtin(&self.textures_dir) {
+            super::textures::load_builtin(name)
+        } else {
+            crate::render::texture::MipTexture::load(&self.textures_dir.join(name))
+        }
+    }
+
+    /// Size and SHA-256 (hex) of the texture file `name`.
+    pub fn texture_sum(&self, name: &str) -> Result<(u64, String)> {
+        if super::textures::is_builtin(&self.textures_dir) {
+            return super::textures::builtin_sum(name);
+        }
+        super::textures::file_sum(&self.textures_dir.join(name))
+    }
+}
+
+/// The texture images of the folder `dir`, sorted, each checked to be a
+/// readable image.
+fn list_textures(dir: &Path) -> Result<Vec<String>> {
+    let rd = std::fs::read_dir(dir).map_err(|e| Error::io(dir, e))?;
+    let mut textures = Vec::new();
+    for e in rd {
+        let e = e.map_err(|e| Error::io(dir, e))?;
+        let file_name = e.file_name();
+        let lossy = file_name.to_string_lossy();
+        let ext = lossy.rsplit('.').next().unwrap_or("").to_ascii_lowercase();
+        let p = dir.join(&file_name);
+        // Only regular files are textures (a pipe named f.png would
+        // block the read; a folder or a device is not an image).
+        if ["png", "jpg", "jpeg"].contains(&ext.as_str()) && is_regular_file(&p) {
+            // Items and manifests name their texture as text: a name
+            // that is not UTF-8 is refused as it is (not read as another).
+            let name = file_name.to_str().map(str::to_string).ok_or_else(|| {
+                Error::invalid(
+                    "texture",
+                    format!(
+                        "{}: the file name is not valid UTF-8 (items and manifests name \
+                             their texture as text); rename the file",
+                        crate::error::show_path(&p)
+                    ),
+                )
+            })?;
+            image_dimensions(&p).map_err(|e| match e {
+                Error::Image { path, message } => Error::Image {
+                    path,
+                    message: format!("not a readable image: {message}"),
+                },
+                e => e,
+            })?;
+            textures.push(name);
+        }
+    }
+    textures.sort();
+    if textures.is_empty() {
+        return Err(Error::invalid(
+            dir.display().to_string(),
+            "no texture images (.png, .jpg, .jpeg) in this folder",
+        ));
+    }
+    Ok(textures)
 }
 
 impl Sources {
@@ -236,6 +311,7 @@ pub fn plan(cfg: &DatasetConfig, src: &Sources, i: u64) -> Result<ItemParams> {
         use_velocity: cfg.use_velocity && has_velocity,
         camera: cfg.camera.clone(),
         sensor: cfg.sensor.clone(),
+        sharp: cfg.sharp,
     })
 }
 
@@ -344,9 +420,9 @@ pub fn make(p: &ItemParams, src: &Sources, dir: &Path) -> Result<ItemMeasures> {
     // The motion spans the readout (none for a global shutter) plus the exposure.
     let span = cam.shutter.readout_s + p.exposure_s;
     let traj = Trajectory::from_imu_log(&s, p.start_s, span, p.use_velocity)?;
-    let tex = src.textures_dir.join(&p.texture);
-    let spec = format!("image:{}:{}", tex.display(), p.texture_width_m);
-    let mut target = Target::parse(&spec, p.distance_m)?;
+    crate::check::positive("texture_width_m", p.texture_width_m)?;
+    let mut target =
+        Target::from_texture(src.texture(&p.texture)?, p.texture_width_m, p.distance_m);
     target.tilt_deg = p.tilt_deg;
     let mut job = RenderJob::new(cam, p.exposure_s, traj, target.clone());
     job.quality = p.quality.parse::<Quality>()?;
@@ -354,14 +430,15 @@ pub fn make(p: &ItemParams, src: &Sources, dir: &Path) -> Result<ItemMeasures> {
     job.seed = p.seed as u32;
     job.with_maps = true;
     let blurred = render::render_frame(&job)?;
+    // The camera held at the pose of `p.sharp`'s instant.
     let sharp = match &p.sensor {
         // The sharp frame without noise, unless asked.
         Some(s) if !s.sharp_noise => {
             let mut quiet = job.clone();
             quiet.camera.noise = None;
-            render::render_sharp(&quiet)?
+            render::render_sharp_at(&quiet, p.sharp)?
         }
-        _ => render::render_sharp(&job)?,
+        _ => render::render_sharp_at(&job, p.sharp)?,
     };
     let maps = blurred
         .maps

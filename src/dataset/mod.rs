@@ -15,6 +15,8 @@
 //! - `lock`: the locks that keep each shard, and the packing, to one
 //!   writer (their files removed when the run ends).
 //! - `sensor`: the camera pipeline of the PNG files (`[sensor]`).
+//! - [`textures`]: the built-in textures (`textures = "builtin:"`, the
+//!   default), compiled in from `assets/textures/`.
 //! - `webdataset`: the directory packed into WebDataset tar shards
 //!   (`--format webdataset`); `tarcheck`: the shards checked against their
 //!   index (`--verify`).
@@ -27,10 +29,11 @@ pub(crate) mod manifest;
 pub(crate) mod run;
 pub(crate) mod sensor;
 pub(crate) mod shard;
+pub mod textures;
 pub(crate) mod tarcheck;
 pub(crate) mod webdataset;
 
-pub use config::DatasetConfig;
+pub use config::{DatasetConfig, Origin, MAX_COUNT};
 pub use guard::Record;
 pub use item::{ItemParams, Sources};
 pub use lock::{PackLock, RunLock};

@@ -28,6 +28,7 @@ pub mod maps;
 pub mod poster;
 pub(crate) mod psf;
 mod sampling;
+pub mod sharp;
 pub(crate) mod target;
 pub mod texture;
 
@@ -36,6 +37,7 @@ pub use crate::model::trajectory::{Pose, Trajectory};
 pub use maps::{blur_maps, BlurMaps, BlurMeans};
 pub use poster::Background;
 pub use psf::{psf, Psf};
+pub use sharp::{render_sharp_at, SharpAt};
 pub use target::{project, Target, TargetKind, DEFAULT_BACKGROUND};
 
 use crate::camera::Camera;

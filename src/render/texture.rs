@@ -81,7 +81,11 @@ impl MipTexture {
 
     /// Loads a PNG/JPEG (sRGB) as linear light.
     pub fn load(path: &Path) -> Result<Self> {
-        let img = read_rgb8(path)?;
+        Self::from_srgb8(&read_rgb8(path)?)
+    }
+
+    /// An 8-bit sRGB image as linear light.
+    pub fn from_srgb8(img: &image::RgbImage) -> Result<Self> {
         let (w, h) = img.dimensions();
         let lut: Vec<f32> = (0..=255u8).map(srgb8_to_linear).collect();
         let rgb = img.as_raw().iter().map(|&v| lut[v as usize]).collect();
