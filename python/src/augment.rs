@@ -177,7 +177,7 @@ pub fn augment<'py>(
         run(
             py,
             a,
-            Pixels::U8,
+            |s| Pixels::U8(s),
             |b| match b {
                 PixelBuf::U8(v) => Some(v),
                 _ => None,
@@ -189,7 +189,7 @@ pub fn augment<'py>(
         run(
             py,
             a,
-            Pixels::U16,
+            |s| Pixels::U16(s),
             |b| match b {
                 PixelBuf::U16(v) => Some(v),
                 _ => None,
@@ -201,7 +201,7 @@ pub fn augment<'py>(
         run(
             py,
             a,
-            Pixels::F32,
+            |s| Pixels::F32(s),
             |b| match b {
                 PixelBuf::F32(v) => Some(v),
                 _ => None,
@@ -213,7 +213,7 @@ pub fn augment<'py>(
         run(
             py,
             a,
-            Pixels::F64,
+            |s| Pixels::F64(s),
             |b| match b {
                 PixelBuf::F64(v) => Some(v),
                 _ => None,

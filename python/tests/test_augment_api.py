@@ -6,12 +6,15 @@ pixel cap refused from the shape before any copy."""
 
 import io
 import tarfile
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 import mmbm
 
+TEX = (Path(__file__).resolve().parents[2] / "assets" / "textures").as_posix()
+DS = f'count = 2\nseed = 7\ntextures = "{TEX}"\nresolution = [32, 24]\n'
 STILL = {"omega": [0.0, 0.0, 0.0]}
 YAW = {"omega": [0.0, 0.7, 0.1]}  # about 20 px over 30 ms at 160 px wide
 
@@ -73,7 +76,7 @@ def test_alpha_is_blurred_as_coverage_with_premultiplied_colour():
     img[:, 20:40] = [1.0, 0.0, 0.0, 1.0]  # an opaque red band on transparent black
     out = mmbm.augment(img, motion=YAW, seed=0, centre=True)["image"]
     edge = out[:, :, 3]
-    assert 0.05 < edge.min() + 1 and ((edge > 0.05) & (edge < 0.95)).any()
+    assert ((edge > 0.05) & (edge < 0.95)).any()
     visible = edge > 0.01
     # Where any of the band shows, its colour is pure red, not darkened.
     np.testing.assert_allclose(out[visible][:, 0], 1.0, atol=1e-4)
@@ -144,7 +147,7 @@ def test_pixel_cap_is_refused_from_the_shape_before_any_copy():
 
 def test_read_exr_from_bytes(tmp_path):
     # An item's maps, written by the dataset maker.
-    mmbm.BlurDataset(toml="count = 1\nresolution = [32, 24]\n", cache_dir=tmp_path).item(0)
+    mmbm.BlurDataset(toml=DS, cache_dir=tmp_path).item(0)
     out = tmp_path / "00000000" / "maps.exr"
     by_path = mmbm.read_exr(out)
     by_bytes = mmbm.read_exr(out.read_bytes())
@@ -170,7 +173,7 @@ def test_blur_dataset_applies_the_transform():
         seen.append(item["index"])
         return mmbm.augment(item["sharp"], motion=STILL)["image"], item["index"]
 
-    ds = mmbm.BlurDataset(toml="count = 2\nresolution = [32, 24]\n", transform=t)
+    ds = mmbm.BlurDataset(toml=DS, transform=t)
     got = list(ds)
     assert [i for _, i in got] == [0, 1] and seen == [0, 1]
     assert got[0][0].shape == (24, 32, 3)

@@ -419,7 +419,8 @@ pub fn augment_image(img: &Image, a: &Augment) -> Result<AugmentedImage> {
             speed_mm_s: zero,
         }
     } else {
-        let steps = (lmax.ceil() as usize).clamp(16, 4096);
+        // Chords of about 2 px (the maps are a measure, not the image).
+        let steps = ((0.5 * lmax).ceil() as usize).clamp(8, 4096);
         render::maps::blur_maps(&cam, &target, &traj, a.exposure_s, steps)
     };
     crate::cancel::check()?;

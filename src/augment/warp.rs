@@ -84,7 +84,8 @@ impl Src<'_> {
         let (x0, y0) = (u.floor(), v.floor());
         let (fx, fy) = (u - x0, v - y0);
         let (x0, y0) = (x0 as i64, y0 as i64);
-        let c = self.c;
+        // acc has the image's channel count (a constant once inlined).
+        let c = acc.len();
         let (w, h) = (self.w as i64, self.h as i64);
         let wts = [
             (1.0 - fx) * (1.0 - fy),
@@ -96,7 +97,7 @@ impl Src<'_> {
             let i = (y0 as usize * self.w + x0 as usize) * c;
             let r = self.w * c;
             let offs = [i, i + c, i + r, i + r + c];
-            for (k, a) in acc.iter_mut().enumerate().take(c) {
+            for (k, a) in acc.iter_mut().enumerate() {
                 let v = &self.v;
                 *a += wts[0] * v[offs[0] + k]
                     + wts[1] * v[offs[1] + k]
@@ -163,15 +164,22 @@ pub fn max_shift(m: &DMat3, w: f64, h: f64) -> f64 {
 
 /// The warp average of `src` over `maps`: linear values, `c` channels.
 pub fn integrate(src: &Src, maps: &Maps) -> Vec<f32> {
-    let (w, h, c) = (src.w, src.h, src.c);
+    match src.c {
+        1 => integrate_c::<1>(src, maps),
+        3 => integrate_c::<3>(src, maps),
+        _ => integrate_c::<4>(src, maps),
+    }
+}
+
+fn integrate_c<const C: usize>(src: &Src, maps: &Maps) -> Vec<f32> {
+    let (w, h) = (src.w, src.h);
     let n = maps.n;
     let scale = 1.0 / n as f32;
-    let mut out = vec![0.0f32; w * h * c];
-    out.par_chunks_mut(w * c).enumerate().for_each(|(j, row)| {
+    let mut out = vec![0.0f32; w * h * C];
+    out.par_chunks_mut(w * C).enumerate().for_each(|(j, row)| {
         let y = j as f32 + 0.5;
-        let mut acc = [0.0f32; 4];
         for m in 0..n {
-            for i in 0..w {
+            for (i, px) in row.chunks_exact_mut(C).enumerate() {
                 let line = match maps.mode {
                     0 => 0,
                     1 => j,
@@ -180,18 +188,16 @@ pub fn integrate(src: &Src, maps: &Maps) -> Vec<f32> {
                 let g = &maps.m[line * n + m];
                 let x = i as f32 + 0.5;
                 let z = g[6] * x + g[7] * y + g[8];
-                let px = &mut row[i * c..(i + 1) * c];
+                let mut acc = [0.0f32; C];
                 if z <= 0.0 {
-                    for k in 0..c {
-                        px[k] += src.fill[k];
-                    }
-                    continue;
+                    acc.copy_from_slice(&src.fill[..C]);
+                } else {
+                    let r = 1.0 / z;
+                    let u = (g[0] * x + g[1] * y + g[2]) * r - 0.5;
+                    let v = (g[3] * x + g[4] * y + g[5]) * r - 0.5;
+                    src.add(u, v, &mut acc);
                 }
-                let u = (g[0] * x + g[1] * y + g[2]) / z - 0.5;
-                let v = (g[3] * x + g[4] * y + g[5]) / z - 0.5;
-                acc[..c].fill(0.0);
-                src.add(u, v, &mut acc[..c]);
-                for k in 0..c {
+                for k in 0..C {
                     px[k] += acc[k];
                 }
             }
