@@ -1,9 +1,11 @@
-//! `augment` (`cargo bench --bench augment`): calls per second at 256 x 256
-//! and 640 x 480 with about 20 px of blur, and the accuracy of the same
-//! frame against the exact exposure integral at 2, 20 and 80 px of blur,
-//! next to the 30-pose warp-and-average that gyro-driven generators use
-//! (SynIMU2Blurry-style: 30 bilinear warps at evenly spaced instants,
-//! averaged). Times are printed, never asserted.
+//! `augment` (`cargo bench --bench augment`): seconds per call at 256 x 256
+//! and 640 x 480 with about 20 px of blur for each integrator (fast, the
+//! default; exact; render), and the accuracy against the exact exposure
+//! integral at 2, 20 and 80 px of blur of the renderer, of the fast warp
+//! integrator, and of the 30-pose warp-and-average that gyro-driven
+//! generators use (SynIMU2Blurry-style: 30 bilinear warps at evenly spaced
+//! instants, averaged). Times are printed, never asserted.
+//! `bench/augment_bench.py` times the same against albumentations.
 //!
 //! Accuracy case: a lateral translation (image x) of a fronto-parallel
 //! image, whose exact integrals are written here in closed form per axis:
@@ -14,7 +16,7 @@
 //! own spatial model and only the time integration differs.
 
 use glam::DVec3;
-use mmbm::augment::{augment, Augment, Motion};
+use mmbm::augment::{augment, Augment, Border, Integrator, Motion};
 use mmbm::Twist;
 use std::time::Instant;
 
@@ -93,38 +95,45 @@ fn main() {
     let yaw = 20.0 / (f_px() * 0.03);
     for (w, h) in [(256u32, 256u32), (640, 480)] {
         let img = texture(w as usize, h as usize);
-        let a = Augment::new(
-            Motion::Twist(Twist::new(DVec3::new(0.0, yaw, 0.0), DVec3::ZERO)),
-            0.03,
-        );
-        let t0 = Instant::now();
-        let mut n = 0;
-        while n < 2 || t0.elapsed().as_secs_f64() < 5.0 {
-            augment(w, h, &img, &a).expect("augment");
-            n += 1;
+        for integrator in [Integrator::Fast, Integrator::Exact, Integrator::Render] {
+            let mut a = Augment::new(
+                Motion::Twist(Twist::new(DVec3::new(0.0, yaw, 0.0), DVec3::ZERO)),
+                0.03,
+            );
+            a.integrator = integrator;
+            a.border = Border::Constant;
+            let t0 = Instant::now();
+            let mut n = 0;
+            while n < 2 || t0.elapsed().as_secs_f64() < 5.0 {
+                augment(w, h, &img, &a).expect("augment");
+                n += 1;
+            }
+            let s = t0.elapsed().as_secs_f64() / n as f64;
+            println!(
+                "  {w} x {h}, 20 px of blur, {integrator:?}: {s:.3} s per call ({:.2} calls/s, {n} calls)",
+                1.0 / s
+            );
         }
-        let s = t0.elapsed().as_secs_f64() / n as f64;
-        println!(
-            "  {w} x {h}, 20 px of blur: {s:.3} s per call ({:.2} calls/s, {n} calls)",
-            1.0 / s
-        );
     }
     // Accuracy: translation of L px along x over the exposure.
     let (w, h) = (320usize, 96usize);
     let img = texture(w, h);
     println!("  accuracy, {w} x {h}, lateral translation (8-bit levels, pixels whose motion stays on the image):");
-    println!("  | blur px | mmbm mean | mmbm p99 | 30 warps mean | 30 warps p99 |");
-    println!("  |---|---|---|---|---|");
+    println!("  | blur px | render mean | render p99 | fast mean | fast p99 | 30 warps mean | 30 warps p99 |");
+    println!("  |---|---|---|---|---|---|---|");
     for l in [2.0f64, 20.0, 80.0] {
         let (d, t) = (2.0, 0.03);
         let v = l * d / (f_px() * t);
         // The camera moves +x: the image moves -x on the frame, texture x = frame x + s.
-        let a = Augment::new(
+        let mut a = Augment::new(
             Motion::Twist(Twist::new(DVec3::ZERO, DVec3::new(v, 0.0, 0.0))),
             t,
         );
+        let fast = augment(w as u32, h as u32, &img, &a).expect("augment");
+        a.integrator = Integrator::Render;
+        a.border = Border::Constant;
         let out = augment(w as u32, h as u32, &img, &a).expect("augment");
-        let (mut e_m, mut e_w) = (Vec::new(), Vec::new());
+        let (mut e_m, mut e_w, mut e_f) = (Vec::new(), Vec::new(), Vec::new());
         let rows: Vec<Row> = (0..h)
             .flat_map(|j| (0..3).map(move |c| (j, c)))
             .map(|(j, c)| Row::new(&img[j * w * 3..(j + 1) * w * 3], c, w))
@@ -152,6 +161,7 @@ fn main() {
                     let got = out.rgb[(j * w + i) * 3 + c] as f64;
                     e_m.push((got - exact).abs() * 255.0);
                     e_w.push((warps - point).abs() * 255.0);
+                    e_f.push((fast.rgb[(j * w + i) * 3 + c] as f64 - point).abs() * 255.0);
                 }
             }
         }
@@ -163,6 +173,7 @@ fn main() {
             )
         };
         let ((mm, mp), (wm, wp)) = (stat(&mut e_m), stat(&mut e_w));
-        println!("  | {l} | {mm:.3} | {mp:.3} | {wm:.3} | {wp:.3} |");
+        let (fm, fp) = stat(&mut e_f);
+        println!("  | {l} | {mm:.3} | {mp:.3} | {fm:.3} | {fp:.3} | {wm:.3} | {wp:.3} |");
     }
 }

@@ -53,6 +53,20 @@ pub fn check_pixels(what: &str, doing: &str, width: u64, height: u64, max: u64) 
     Ok(())
 }
 
+/// Most pixels (width x height) of an image `augment` takes, px; checked
+/// from the shape before any value is read or copied (Python included).
+pub const AUGMENT_MAX_PIXELS: u64 = 1 << 26;
+
+/// Most warp instants per pixel of `augment` (the `exact` integrator at
+/// 1/32 px spacing reaches it at 128 px of blur), count.
+pub const AUGMENT_MAX_WARP_SAMPLES: usize = 4096;
+
+/// Most pixel-samples (pixels x warp instants) of one `augment` image, count.
+pub const AUGMENT_MAX_PIXEL_SAMPLES: u64 = 1 << 33;
+
+/// Largest `blur_px` (mean path of an augmentation's blur), px.
+pub const AUGMENT_MAX_BLUR_PX: f64 = 2000.0;
+
 // == light and sensor noise ==
 
 /// Most light a sensor may be given, e-/s for a white pixel (`--light`,

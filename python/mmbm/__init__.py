@@ -379,18 +379,39 @@ def trigger(
     return _mmbm.trigger(tt, mm, policies, float(exposure), float(delay), float(readout), float(min_interval), float(pitch_mm))
 
 
-def read_exr(path: PathLike) -> Dict[str, np.ndarray]:
-    """Reads a float EXR (mmbm's outputs): ``{channel: (H, W) float32}``."""
-    return _mmbm.read_exr(os.fspath(path))
+def read_exr(src: Union[PathLike, bytes]) -> Dict[str, np.ndarray]:
+    """Reads a float EXR (mmbm's outputs) from a path or from the file's
+    bytes (e.g. a WebDataset sample's ``exr`` field): ``{channel: (H, W) float32}``."""
+    if isinstance(src, (bytes, bytearray, memoryview)):
+        return _mmbm.read_exr(bytes(src))
+    return _mmbm.read_exr(os.fspath(src))
 
 
-def _srgb_to_linear(x: np.ndarray) -> np.ndarray:
-    return np.where(x <= 0.04045, x / 12.92, ((x + 0.055) / 1.055) ** 2.4)
+_AUGMENT_DTYPES = (np.uint8, np.uint16, np.float32, np.float64)
 
 
-def _linear_to_srgb(x: np.ndarray) -> np.ndarray:
-    x = np.clip(x, 0.0, 1.0)
-    return np.where(x <= 0.0031308, 12.92 * x, 1.055 * x ** (1 / 2.4) - 0.055)
+def _motion_args(motion: Union[str, Dict[str, Any]]) -> Tuple[str, List[float], List[float], Optional[Dict[str, np.ndarray]]]:
+    omega, velocity, gyro = [0.0] * 3, [0.0] * 3, None
+    if isinstance(motion, str):
+        return motion, omega, velocity, gyro
+    if isinstance(motion, dict) and "t" in motion:
+        gyro = {k: np.asarray(motion[k], dtype=np.float64) for k in ("t", "omega", "velocity") if k in motion}
+        return "log", omega, velocity, gyro
+    if isinstance(motion, dict) and "omega" in motion:
+        omega = [float(v) for v in np.asarray(motion["omega"], dtype=np.float64).ravel()]
+        velocity = [float(v) for v in np.asarray(motion.get("velocity", (0, 0, 0)), dtype=np.float64).ravel()]
+        return "twist", omega, velocity, gyro
+    raise ValueError("motion: 'shake', 'sim:GAIT', {'omega': ..., 'velocity': ...} or a read_gyro dict")
+
+
+def _check_pixels(h: int, w: int) -> None:
+    # From the shape alone, before any value is read or copied.
+    if int(h) * int(w) > _mmbm.AUGMENT_MAX_PIXELS:
+        raise ValueError(f"image: {w} x {h} px: at most {_mmbm.AUGMENT_MAX_PIXELS} px")
+
+
+def _draw_seed() -> int:
+    return int(np.random.SeedSequence().generate_state(1, np.uint64)[0] >> np.uint64(1))
 
 
 def _sharp(sharp: Optional[str], centre: Optional[bool]) -> str:
@@ -406,12 +427,94 @@ def _sharp(sharp: Optional[str], centre: Optional[bool]) -> str:
     return sharp
 
 
+def _augment_nhwc(
+    x: np.ndarray,
+    seeds: List[int],
+    p: float,
+    motion: Union[str, Dict[str, Any]],
+    exposure: float,
+    camera: Optional[Camera],
+    sharp: str,
+    zoom: float,
+    distance: float,
+    at: Optional[float],
+    srgb: Optional[bool],
+    quality: str,
+    background: Sequence[float],
+    use_velocity: bool,
+    integrator: str,
+    border: str,
+    blur_px: Optional[float],
+    return_fields: bool,
+) -> Dict[str, Any]:
+    """The images of ``x`` ((N, H, W, C), any supported dtype, a view is
+    fine), image ``k`` applied with probability ``p`` under ``seeds[k]``."""
+    n, h, w, c = x.shape
+    if not 0.0 <= float(p) <= 1.0:
+        raise ValueError(f"p: {p}: expected 0 to 1")
+    applied = [bool(np.random.default_rng([s, 0x70]).random() < p) for s in seeds]
+    kind, omega, velocity, gyro = _motion_args(motion)
+    dtype = x.dtype
+    native = any(dtype == d for d in _AUGMENT_DTYPES)
+    if not (native or np.issubdtype(dtype, np.floating)):
+        raise ValueError(f"image: uint8, uint16 or float expected, got {dtype}")
+    idx = [k for k in range(n) if applied[k]]
+    out = {
+        "image": np.array(x, copy=True) if idx else x,
+        "maps": {k: np.zeros((n, h, w), np.float32) for k in ("path_px", "disp_px", "speed_px_s")},
+        "homographies": np.tile(np.eye(3), (n, 3, 1, 1)),
+        "motion": ["none"] * n,
+        "seed": list(seeds),
+        "applied": applied,
+        "samples": [0] * n,
+    }
+    if return_fields:
+        out["fields"] = np.zeros((n, 3, h, w, 2), np.float32)
+    if not idx:
+        return out
+    sub = x[idx] if len(idx) < n else x
+    sub = np.ascontiguousarray(sub, dtype=dtype if native else np.float32)
+    use_srgb = (dtype.kind == "u") if srgb is None else bool(srgb)
+    img, maps, hs, fields, drawn, samples = _mmbm.augment(
+        sub,
+        [seeds[k] for k in idx],
+        kind,
+        omega,
+        velocity,
+        gyro,
+        None if at is None else float(at),
+        float(exposure),
+        None if camera is None else camera._spec(),
+        float(distance),
+        float(zoom),
+        sharp,
+        quality,
+        [float(v) for v in background],
+        bool(use_velocity),
+        use_srgb,
+        integrator,
+        border,
+        None if blur_px is None else float(blur_px),
+        bool(return_fields),
+    )
+    out["image"][idx] = img.astype(dtype, copy=False)
+    for key in out["maps"]:
+        out["maps"][key][idx] = maps[key]
+    out["homographies"][idx] = hs
+    if return_fields:
+        out["fields"][idx] = fields
+    for j, k in enumerate(idx):
+        out["motion"][k] = drawn[j]
+        out["samples"][k] = samples[j]
+    return out
+
+
 def augment(
     image: ArrayLike,
     motion: Union[str, Dict[str, Any]] = "shake",
     exposure: float = 0.03,
     camera: Optional[Camera] = None,
-    seed: int = 0,
+    seed: Optional[int] = None,
     centre: Optional[bool] = None,
     zoom: float = 1.0,
     distance: float = 2.0,
@@ -420,6 +523,12 @@ def augment(
     quality: str = "default",
     background: Sequence[float] = (0.0, 0.0, 0.0),
     use_velocity: bool = True,
+    *,
+    p: float = 1.0,
+    integrator: str = "fast",
+    border: str = "reflect",
+    blur_px: Optional[float] = None,
+    return_fields: bool = False,
     sharp: Optional[str] = None,
 ) -> Dict[str, Any]:
     """Motion blur of ``image`` along a real or simulated camera motion.
@@ -439,94 +548,125 @@ def augment(
     ``camera``: default the thesis focal length and pitch at the image's
     size (a given camera must have that size; lens distortion is refused).
 
-    ``image``: (H, W, 3) or (H, W); uint8 (sRGB, ``srgb`` default True) or
-    float (linear, ``srgb`` default False). Returns ``{"image"`` (same shape
-    and dtype), ``"maps"`` (``path_px``, ``disp_px``, ``speed_px_s``, (H, W)
-    float32), ``"homographies"`` ((3, 3, 3) float64: image pixel coordinates
-    to the blurred frame's at exposure start, middle and end; pixel
-    coordinates with (0, 0) the top-left corner), ``"motion"`` (what was
-    drawn, e.g. ``sim:moderate@2.7141s``)``}``.
+    ``seed``: None (default) draws one from OS entropy (returned as
+    ``"seed"``); a given seed reproduces the call. ``p``: the probability
+    of applying (drawn from the seed); when not applied the input itself is
+    returned. ``blur_px``: the motion scaled so that the mean path over the
+    frame (the mean of ``maps["path_px"]``) is that many px. ``border``:
+    ``"reflect"`` (mirrored about the edge pixels, OpenCV's REFLECT_101),
+    ``"replicate"`` or ``"constant"`` (``background``, linear RGB;
+    transparent with alpha). ``integrator``: ``"fast"`` (warp samples at
+    most 0.5 px apart: within 0.5/255 mean, 3/255 p99 of the exact time
+    integral), ``"exact"`` (1/32 px apart) or ``"render"`` (the renderer's
+    pixel-area integral, ``quality``; border ``"constant"`` only).
+    Without motion the input comes back bit for bit.
+
+    ``image``: (H, W) or (H, W, C) with C 1, 3 or 4 (straight alpha, blurred
+    with the colour premultiplied); uint8 or uint16 (sRGB, ``srgb`` default
+    True) or float (linear, ``srgb`` ignored). Returns ``{"image"`` (same
+    shape and dtype), ``"maps"`` (``path_px``, ``disp_px``, ``speed_px_s``,
+    (H, W) float32), ``"homographies"`` ((3, 3, 3) float64: image pixel
+    coordinates to the blurred frame's at exposure start, middle and end;
+    (0, 0) the top-left corner), ``"motion"`` (what was drawn, e.g.
+    ``sim:moderate@2.7141s``; ``"none"`` when not applied), ``"seed"``,
+    ``"applied"``, ``"samples"`` (warp instants; 0: returned as given) and
+    with ``return_fields`` ``"fields"`` ((3, H, W, 2) float32: for each
+    pixel the displacement (x, y) px to the image point it sees at its
+    exposure's start, middle and end)``}``.
 
     >>> out = augment(np.zeros((24, 32, 3), np.uint8), motion="sim:fast", exposure=0.02)
     >>> out["image"].shape, out["homographies"].shape
     ((24, 32, 3), (3, 3, 3))
     """
     a = np.asarray(image)
-    gray = a.ndim == 2
-    if a.ndim not in (2, 3) or (a.ndim == 3 and a.shape[2] != 3):
-        raise ValueError(f"image: (H, W) or (H, W, 3) expected, got shape {a.shape}")
-    u8 = a.dtype == np.uint8
-    if not (u8 or np.issubdtype(a.dtype, np.floating)):
-        raise ValueError(f"image: uint8 or float expected, got {a.dtype}")
-    x = a.astype(np.float64) / (255.0 if u8 else 1.0)
-    if gray:
-        x = np.repeat(x[:, :, None], 3, axis=2)
-    use_srgb = u8 if srgb is None else bool(srgb)
-    if use_srgb:
-        x = _srgb_to_linear(x)
-    omega, velocity, gyro, kind = [0.0] * 3, [0.0] * 3, None, None
-    if isinstance(motion, str):
-        kind = motion
-    elif isinstance(motion, dict) and "t" in motion:
-        kind = "log"
-        gyro = {k: np.asarray(motion[k], dtype=np.float64) for k in ("t", "omega", "velocity") if k in motion}
-    elif isinstance(motion, dict) and "omega" in motion:
-        kind = "twist"
-        omega = [float(v) for v in np.asarray(motion["omega"], dtype=np.float64).ravel()]
-        velocity = [float(v) for v in np.asarray(motion.get("velocity", (0, 0, 0)), dtype=np.float64).ravel()]
-    else:
-        raise ValueError("motion: 'shake', 'sim:GAIT', {'omega': ..., 'velocity': ...} or a read_gyro dict")
-    img, maps, hs, drawn = _mmbm.augment(
-        np.ascontiguousarray(x, dtype=np.float32),
-        kind,
-        omega,
-        velocity,
-        gyro,
-        None if at is None else float(at),
-        float(exposure),
-        None if camera is None else camera._spec(),
-        float(distance),
-        float(zoom),
-        _sharp(sharp, centre),
-        int(seed),
-        quality,
-        [float(v) for v in background],
-        bool(use_velocity),
+    if a.ndim not in (2, 3) or (a.ndim == 3 and a.shape[2] not in (1, 3, 4)):
+        raise ValueError(f"image: (H, W) or (H, W, C) with C 1, 3 or 4 expected, got shape {a.shape}")
+    _check_pixels(a.shape[0], a.shape[1])
+    x = a[None, :, :, None] if a.ndim == 2 else a[None]
+    s = _draw_seed() if seed is None else int(seed)
+    out = _augment_nhwc(
+        x, [s], p, motion, exposure, camera, _sharp(sharp, centre), zoom, distance, at, srgb, quality, background,
+        use_velocity, integrator, border, blur_px, return_fields,
     )
-    y = np.asarray(img, dtype=np.float64)
-    if use_srgb:
-        y = _linear_to_srgb(y)
-    if gray:
-        y = y[:, :, 1]
-    if u8:
-        y = np.clip(np.round(y * 255.0), 0, 255).astype(np.uint8)
-    else:
-        y = y.astype(a.dtype)
-    return {"image": y, "maps": maps, "homographies": hs, "motion": drawn}
+    res = {
+        "image": a if not out["applied"][0] else out["image"][0].reshape(a.shape),
+        "maps": {k: v[0] for k, v in out["maps"].items()},
+        "homographies": out["homographies"][0],
+        "motion": out["motion"][0],
+        "seed": s,
+        "applied": out["applied"][0],
+        "samples": out["samples"][0],
+    }
+    if return_fields:
+        res["fields"] = out["fields"][0]
+    return res
 
 
 def augment_batch(
-    images: ArrayLike, seeds: Optional[Sequence[int]] = None, **kwargs: Any
+    images: ArrayLike,
+    seeds: Optional[Sequence[int]] = None,
+    layout: Optional[str] = None,
+    **kwargs: Any,
 ) -> Dict[str, Any]:
-    """``augment`` over a batch ((N, H, W[, 3]) or a list of images), each
-    with its own seed (default ``seed + k`` for image ``k``, ``seed`` from
-    ``kwargs``, default 0): each image its own motion. Returns the same keys
-    with a leading batch axis where the images share a shape (``"motion"``
-    a list), else lists."""
-    imgs = list(images)
-    base = int(kwargs.pop("seed", 0))
-    seeds = [base + k for k in range(len(imgs))] if seeds is None else [int(s) for s in seeds]
-    if len(seeds) != len(imgs):
-        raise ValueError(f"seeds: {len(seeds)} for {len(imgs)} images")
-    outs = [augment(im, seed=s, **kwargs) for im, s in zip(imgs, seeds)]
-    same = len({o["image"].shape for o in outs}) <= 1
-    join = (lambda xs: np.stack(xs)) if same and outs else (lambda xs: xs)
-    return {
-        "image": join([o["image"] for o in outs]),
-        "maps": {k: join([o["maps"][k] for o in outs]) for k in ("path_px", "disp_px", "speed_px_s")} if outs else {},
-        "homographies": join([o["homographies"] for o in outs]),
-        "motion": [o["motion"] for o in outs],
-    }
+    """``augment`` over a batch, in parallel (one task per image, the GIL
+    released), each image with its own seed and so its own motion: ``seeds``,
+    else ``seed + k`` for image ``k`` when ``seed`` is given, else each drawn
+    from OS entropy. ``images``: an array (N, H, W) (gray), (N, H, W, C)
+    (``layout="NHWC"``) or (N, C, H, W) (``layout="NCHW"``), C 1, 3 or 4;
+    without ``layout`` the last axis of size 1, 3 or 4 is taken as the
+    channels, else the second (NHWC when both are), or a list of images.
+    Returns ``augment``'s keys with a leading batch axis (the images in the
+    input's layout and dtype; ``"motion"``, ``"seed"``, ``"applied"`` and
+    ``"samples"`` lists); a list of images of different shapes gives lists."""
+    base = kwargs.pop("seed", None)
+    if isinstance(images, (list, tuple)):
+        shapes = {np.shape(im) for im in images}
+        if len(shapes) > 1:
+            seeds = _batch_seeds(len(images), seeds, base)
+            outs = [augment(im, seed=s, **kwargs) for im, s in zip(images, seeds)]
+            return {k: [o[k] for o in outs] for k in outs[0]} if outs else {}
+        images = np.stack([np.asarray(im) for im in images]) if images else np.zeros((0, 2, 2, 3), np.float32)
+    a = np.asarray(images)
+    if a.ndim == 3:
+        lay = "NHW"
+    elif a.ndim == 4:
+        lay = layout
+        if lay is None:
+            lay = "NHWC" if a.shape[3] in (1, 3, 4) else "NCHW" if a.shape[1] in (1, 3, 4) else None
+        if lay not in ("NHWC", "NCHW"):
+            raise ValueError(f"layout: {layout!r} for shape {a.shape}: give 'NHWC' or 'NCHW' (channels 1, 3 or 4)")
+    else:
+        raise ValueError(f"images: (N, H, W), (N, H, W, C) or (N, C, H, W) expected, got shape {a.shape}")
+    h, w = (a.shape[2], a.shape[3]) if lay == "NCHW" else (a.shape[1], a.shape[2])
+    _check_pixels(h, w)
+    x = a[..., None] if lay == "NHW" else np.moveaxis(a, 1, -1) if lay == "NCHW" else a
+    if x.shape[3] not in (1, 3, 4):
+        raise ValueError(f"images: {x.shape[3]} channels: expected 1, 3 or 4")
+    seeds = _batch_seeds(a.shape[0], seeds, base)
+    defaults = dict(
+        motion="shake", exposure=0.03, camera=None, centre=None, sharp=None, zoom=1.0, distance=2.0, at=None, srgb=None,
+        quality="default", background=(0.0, 0.0, 0.0), use_velocity=True, integrator="fast", border="reflect",
+        blur_px=None, return_fields=False,
+    )
+    p = kwargs.pop("p", 1.0)
+    unknown = set(kwargs) - set(defaults)
+    if unknown:
+        raise TypeError(f"augment_batch: unknown arguments {sorted(unknown)}")
+    defaults.update(kwargs)
+    defaults["sharp"] = _sharp(defaults.pop("sharp"), defaults.pop("centre"))
+    out = _augment_nhwc(x, seeds, p, **defaults)
+    img = out["image"]
+    out["image"] = img[..., 0] if lay == "NHW" else np.moveaxis(img, -1, 1) if lay == "NCHW" else img
+    return out
+
+
+def _batch_seeds(n: int, seeds: Optional[Sequence[int]], base: Optional[int]) -> List[int]:
+    if seeds is None:
+        return [_draw_seed() for _ in range(n)] if base is None else [int(base) + k for k in range(n)]
+    seeds = [int(s) for s in seeds]
+    if len(seeds) != n:
+        raise ValueError(f"seeds: {len(seeds)} for {n} images")
+    return seeds
 
 
 def __getattr__(name: str) -> Any:

@@ -1,6 +1,6 @@
 # Type stubs of the native module (python/src/lib.rs). The public API, with
 # docstrings and units, is mmbm/__init__.py.
-from typing import Any, Dict, List, Optional, Sequence, Tuple
+from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -64,7 +64,7 @@ def simulate(gait: str, duration: float, rate: float, seed: int, config: Optiona
 def trigger(
     t: F64, mmbm_mm_s: F64, policies: List[str], exposure: float, delay: float, readout: float, min_interval: float, pitch_mm: float
 ) -> List[Dict[str, Any]]: ...
-def read_exr(path: str) -> Dict[str, F32]: ...
+def read_exr(src: Union[str, bytes]) -> Dict[str, F32]: ...
 
 class DatasetMaker:
     def __init__(self, path: Optional[str] = ..., toml: Optional[str] = ...) -> None: ...
@@ -74,7 +74,8 @@ class DatasetMaker:
     def fingerprint(self) -> str: ...
     def make(self, index: int, dir: str) -> str: ...
 def augment(
-    image: F32,
+    images: Any,
+    seeds: List[int],
     motion: str,
     omega: Sequence[float],
     velocity: Sequence[float],
@@ -85,8 +86,14 @@ def augment(
     distance: float,
     zoom: float,
     sharp: str,
-    seed: int,
     quality: str,
     background: Sequence[float],
     use_velocity: bool,
-) -> Tuple[F32, Dict[str, F32], F64, str]: ...
+    srgb: bool,
+    integrator: str,
+    border: str,
+    blur_px: Optional[float],
+    fields: bool,
+) -> Tuple[Any, Dict[str, F32], F64, Optional[F32], List[str], List[int]]: ...
+
+AUGMENT_MAX_PIXELS: int

@@ -25,7 +25,7 @@ import secrets
 import shutil
 import socket
 import tempfile
-from typing import Any, Dict, Iterator, Optional, Tuple, Union
+from typing import Any, Callable, Dict, Iterator, Optional, Tuple, Union
 
 import numpy as np
 
@@ -72,6 +72,10 @@ class BlurDataset(_Base):
     ((H, W, 3) float32, linear), ``flow`` (``u``, ``v``: px/s at exposure
     start) and ``maps`` (``path_px``, ``disp_px``, ``speed_px_s``), and
     ``dir`` (the item's folder when ``cache_dir`` is set, else None).
+    ``transform``: a function applied to each item that iteration and
+    indexing (``ds[i]``, ``i`` counted from ``start``) return (e.g. one
+    calling ``mmbm.augment`` on ``item["sharp"]``); ``item(index)`` returns
+    the item as made.
     """
 
     def __init__(
@@ -82,7 +86,9 @@ class BlurDataset(_Base):
         start: int = 0,
         stop: Optional[int] = None,
         cache_dir: Optional[PathLike] = None,
+        transform: Optional[Callable[[Dict[str, Any]], Any]] = None,
     ) -> None:
+        self.transform = transform
         self._maker = _mmbm.DatasetMaker(
             path=None if config is None else os.fspath(config), toml=toml
         )
@@ -178,6 +184,13 @@ class BlurDataset(_Base):
             "dir": d if keep else None,
         }
 
-    def __iter__(self) -> Iterator[Dict[str, Any]]:
+    def __getitem__(self, k: int) -> Any:
+        """Item ``start + k``, through ``transform``."""
+        if not 0 <= k < len(self):
+            raise IndexError(f"item {k}: this dataset has {len(self)} items")
+        it = self.item(self.start + k)
+        return it if self.transform is None else self.transform(it)
+
+    def __iter__(self) -> Iterator[Any]:
         for i in self.indices():
-            yield self.item(i)
+            yield self[i - self.start]

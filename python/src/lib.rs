@@ -562,10 +562,18 @@ fn trigger<'py>(
         .collect()
 }
 
-/// Reads a float EXR: `{channel: (H, W) float32}`.
+/// Reads a float EXR, from a path or from its bytes: `{channel: (H, W) float32}`.
 #[pyfunction]
-fn read_exr<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bound<'py, PyDict>> {
-    let (w, h, chans) = interruptible(py, err, || mmbm::io::images::read_exr(&path))?;
+fn read_exr<'py>(py: Python<'py>, src: Bound<'py, PyAny>) -> PyResult<Bound<'py, PyDict>> {
+    let (w, h, chans) = if let Ok(b) = src.cast::<pyo3::types::PyBytes>() {
+        let bytes = b.as_bytes().to_vec();
+        interruptible(py, err, move || {
+            mmbm::io::images::read_exr_bytes(&bytes, "<EXR bytes>")
+        })?
+    } else {
+        let path: PathBuf = src.extract()?;
+        interruptible(py, err, || mmbm::io::images::read_exr(&path))?
+    };
     let d = PyDict::new(py);
     for (name, v) in chans {
         let a =
@@ -602,6 +610,7 @@ fn _mmbm(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<dataset::DatasetMaker>()?;
     m.add_function(wrap_pyfunction!(augment::augment, m)?)?;
     // The camera timing's defaults, from their one place in the library.
+    m.add("AUGMENT_MAX_PIXELS", mmbm::limits::AUGMENT_MAX_PIXELS)?;
     m.add("DEFAULT_DELAY_S", CameraTiming::DEFAULT_DELAY_S)?;
     m.add("DEFAULT_EXPOSURE_S", CameraTiming::DEFAULT_EXPOSURE_S)?;
     m.add("DEFAULT_READOUT_S", CameraTiming::DEFAULT_READOUT_S)?;

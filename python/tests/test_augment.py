@@ -47,13 +47,10 @@ def test_uint8_and_gray_images_round_trip():
     out = mmbm.augment(u8, motion="sim:moderate", exposure=0.02, seed=3)
     assert out["image"].dtype == np.uint8 and out["image"].shape == u8.shape
     assert out["motion"].startswith("sim:moderate@")
-    # Without motion, each pixel is the mean of the image's bilinear
-    # interpolant over it: per axis the kernel (1/8, 3/4, 1/8).
+    # Without motion the image comes back as given (never resampled).
     lin = rng.random((24, 32, 3)).astype(np.float32)
     still = mmbm.augment(lin, motion={"omega": [0, 0, 0]}, exposure=0.02)["image"]
-    k = np.array([0.125, 0.75, 0.125])
-    want = sum(k[a] * k[b] * lin[a : a + 22, b : b + 30] for a in range(3) for b in range(3))
-    assert np.abs(still[1:-1, 1:-1] - want).max() < 0.01
+    np.testing.assert_array_equal(still, lin)
     gray = mmbm.augment(u8[:, :, 0], motion="shake", exposure=0.02, seed=3)
     assert gray["image"].shape == (24, 32)
 

@@ -29,8 +29,8 @@ pub(crate) mod manifest;
 pub(crate) mod run;
 pub(crate) mod sensor;
 pub(crate) mod shard;
-pub mod textures;
 pub(crate) mod tarcheck;
+pub mod textures;
 pub(crate) mod webdataset;
 
 pub use config::{DatasetConfig, Origin, MAX_COUNT};

@@ -56,12 +56,45 @@ pub fn read_exr(path: &Path) -> Result<(usize, usize, ExrChannels)> {
     // A missing or unreadable file is an I/O error (as for every input), and
     // only a regular file is read (never a device or a pipe).
     super::input::open_file(path)?;
-    // The header first: a file that claims more samples than any mmbm output
-    // has is refused before anything is allocated for it.
     let meta = exr::meta::MetaData::read_from_file(path, false).map_err(|e| Error::Image {
         path: path.into(),
         message: e.to_string(),
     })?;
+    check_exr_samples(&meta, path)?;
+    let img = read_all_flat_layers_from_file(path).map_err(|e| Error::Image {
+        path: path.into(),
+        message: e.to_string(),
+    })?;
+    exr_channels(img, path)
+}
+
+/// [`read_exr`] of an EXR file's bytes (e.g. a WebDataset sample's);
+/// errors name `what` in place of a path.
+pub fn read_exr_bytes(bytes: &[u8], what: &str) -> Result<(usize, usize, ExrChannels)> {
+    let path = Path::new(what);
+    let meta = exr::meta::MetaData::read_from_buffered(std::io::Cursor::new(bytes), false)
+        .map_err(|e| Error::Image {
+            path: path.into(),
+            message: e.to_string(),
+        })?;
+    check_exr_samples(&meta, path)?;
+    let img = read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .all_channels()
+        .all_layers()
+        .all_attributes()
+        .from_buffered(std::io::Cursor::new(bytes))
+        .map_err(|e| Error::Image {
+            path: path.into(),
+            message: e.to_string(),
+        })?;
+    exr_channels(img, path)
+}
+
+/// The header first: a file that claims more samples than any mmbm output
+/// has is refused before anything is allocated for it.
+fn check_exr_samples(meta: &exr::meta::MetaData, path: &Path) -> Result<()> {
     let samples: u128 = meta
         .headers
         .iter()
@@ -79,10 +112,11 @@ pub fn read_exr(path: &Path) -> Result<(usize, usize, ExrChannels)> {
             ),
         });
     }
-    let img = read_all_flat_layers_from_file(path).map_err(|e| Error::Image {
-        path: path.into(),
-        message: e.to_string(),
-    })?;
+    Ok(())
+}
+
+/// The first layer's channels as f32.
+fn exr_channels(img: FlatImage, path: &Path) -> Result<(usize, usize, ExrChannels)> {
     let layer = img.layer_data.first().ok_or_else(|| Error::Image {
         path: path.into(),
         message: "no layers".into(),
