@@ -305,12 +305,16 @@ impl ImuRows {
 /// for it ([`FRAME_READOUT`]).
 pub type ImageListRow = (f64, f64, Option<f64>);
 
+/// An image list's header: the time, exposure and readout (with its unit,
+/// s per unit) columns, and every column's name.
+type ImageListHeader = (usize, usize, Option<(usize, f64)>, Vec<String>);
+
 /// The frames of an image list ([`ImageListRow`] per row, in file order).
 /// The header is the first non-blank line ([`is_image_list_header`]); each
 /// exposure must be > 0, a readout >= 0.
 pub fn read_image_list(path: &Path) -> Result<Vec<ImageListRow>> {
     let mut lines = TextLines::open(path)?;
-    let mut header: Option<(usize, usize, Option<(usize, f64)>, Vec<String>)> = None;
+    let mut header: Option<ImageListHeader> = None;
     let mut out = Vec::new();
     while let Some((line, text)) = lines.next_line()? {
         let t = text.trim();
