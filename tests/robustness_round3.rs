@@ -68,16 +68,22 @@ fn time_bases_too_coarse_for_the_exposure_are_refused() {
     let out = String::from_utf8_lossy(&o.stdout);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert!(out.contains("fixed:5: 10 frames"), "{out}");
-    // live: the first sample is refused (exit 1), not decided with a zero exposure.
-    let o = common::mmbm_cmd()
-        .current_dir(dir.path())
-        .args([
-            "live", "--replay", "ns.csv", "--speed", "0", "--policy", "fixed:5",
-        ])
-        .output()
-        .unwrap();
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert!(!o.status.success() && err.contains("--time-unit"), "{err}");
+    // live: no sample is decided with a zero exposure; each is reported
+    // with the hint and skipped (issue 35: one bad sample does not stop a
+    // stream), and --strict stops at the first (exit 2).
+    for (strict, code) in [(false, 0), (true, 2)] {
+        let o = common::mmbm_cmd()
+            .current_dir(dir.path())
+            .args([
+                "live", "--replay", "ns.csv", "--speed", "0", "--policy", "fixed:5",
+            ])
+            .args(strict.then_some("--strict"))
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(code), "{err}");
+        assert!(err.contains("--time-unit") && o.stdout.is_empty(), "{err}");
+    }
 }
 
 /// A small render every output case shares (CPU, 32 x 24: seconds at most);

@@ -99,6 +99,7 @@ pub fn run(a: FramesArgs) -> Result<()> {
         mmbm::series::maps::check_size(&camera)?;
     }
     let frames = read_frame_table(&a.frames, a.exposure)?;
+    mmbm::series::select::check_frame_start(a.choice.frame_start, frames.len())?;
     let samples = read_log(&a.gyro, a.gyro_opts.options()?)?;
     let camera = super::args::with_log_readout(camera, samples.readout(), &a.gyro)?;
     let opts = SeriesOptions {

@@ -24,8 +24,9 @@ Output (stdout, one JSON object per line, flushed at once):
   {\"t\":..,\"policy\":..,\"trigger\":false,\"mmbm_mm_s\":..}   (every other sample, with --all)
 
 Causal policies only (no oracle), thresholds in mm/s (no pNN). A malformed line, or a sample
-whose MMBM is not finite (rates near the float range), is reported on stderr with its line
-number and skipped (--strict: stop, exit code 2); a sample whose time does not increase is
+whose MMBM is not finite (rates near the float range) or whose time the time base cannot
+resolve (t = 1e308), is reported on stderr with its line number and why, and skipped: the
+stream goes on (--strict: stop, exit code 2); a sample whose time does not increase is
 reported and dropped. A replayed log is read one sample at a time as it is played.
 
 Examples:
@@ -56,7 +57,8 @@ pub struct LiveArgs {
     /// Feed a recorded log (any --gyro format) at its own pace instead of stdin.
     #[arg(long, value_name = "FILE")]
     pub replay: Option<PathBuf>,
-    /// With --replay: play X times faster than real time (0: as fast as possible).
+    /// With --replay: play X times faster than real time (0: as fast as possible;
+    /// else 0.001 to 1e6, a slower replay would wait for ever).
     #[arg(long, value_name = "X", default_value_t = 1.0, requires = "replay", value_parser = parse_speed)]
     pub speed: f64,
     /// Write a line for every sample, not only triggers.
@@ -76,7 +78,7 @@ pub struct LiveArgs {
     pub camera: CameraArgs,
 }
 
-/// `--speed`: 0 or a finite number > 0.
+/// `--speed`: 0, or from `MIN_REPLAY_SPEED` to `MAX_REPLAY_SPEED` (`mmbm::limits`).
 fn parse_speed(s: &str) -> std::result::Result<f64, String> {
     let x: f64 = s.parse().map_err(|_| format!("'{s}' is not a number"))?;
     mmbm::trigger::check_speed(x).map_err(|e| e.to_string())

@@ -104,8 +104,9 @@ class Camera:
             "focal_mm": float(self.focal_mm),
             "pitch_x_mm": float(self.pitch_x_mm),
             "pitch_y_mm": float(self.pitch_y_mm),
-            "width": int(self.width),
-            "height": int(self.height),
+            # As given: the native side refuses a non-integral width (1.7), by name.
+            "width": self.width,
+            "height": self.height,
             "cx": float(self.cx),  # type: ignore[arg-type]
             "cy": float(self.cy),  # type: ignore[arg-type]
             "skew": float(self.skew),
@@ -117,6 +118,14 @@ class Camera:
             if v is not None:
                 x[k] = v
         return x
+
+
+def _int(x: Any, name: str) -> int:
+    """An integer parameter: an int, or a float of integral value (``2.0``);
+    ``1.7`` is a ``ValueError`` naming ``name``, never truncated to 1."""
+    if isinstance(x, (float, np.floating)) and not float(x).is_integer():
+        raise ValueError(f"{name}: must be an integer, got {x}")
+    return int(x)
 
 
 def _cam(camera: Optional[Camera]) -> Dict[str, Any]:
@@ -312,7 +321,7 @@ def render(
     frame at exposure start instead."""
     cam = camera or Camera()
     if resolution is not None:
-        cam = cam.with_resolution(int(resolution[0]), int(resolution[1]))
+        cam = cam.with_resolution(_int(resolution[0], "resolution[0]"), _int(resolution[1], "resolution[1]"))
     w = None if omega is None else [float(x) for x in np.asarray(omega, dtype=np.float64).ravel()]
     v = [0.0, 0.0, 0.0] if velocity is None else [float(x) for x in np.asarray(velocity, dtype=np.float64).ravel()]
     bg = None if background is None else [float(x) for x in background]
@@ -335,7 +344,7 @@ def render(
         quality,
         integrator,
         backend,
-        int(seed),
+        _int(seed, "seed"),
         bool(maps),
         bool(sharp),
     )
@@ -351,7 +360,7 @@ def simulate(
     """A seeded legged-gait log, as ``mmbm simulate``: ``{"t": (N,) s,
     "omega": (N, 3) rad/s, "velocity": (N, 3) m/s}``. ``gait``: slow,
     moderate or fast; ``config``: a gait TOML file over the preset."""
-    return _mmbm.simulate(gait, float(duration), float(rate), int(seed), None if config is None else os.fspath(config))
+    return _mmbm.simulate(gait, float(duration), float(rate), _int(seed, "seed"), None if config is None else os.fspath(config))
 
 
 def trigger(

@@ -13,7 +13,10 @@ use pyo3::types::PyDict;
 /// checked by the library first ([`Camera::size_from`]), so a negative one
 /// is a `ValueError` that names the resolution.
 pub fn camera(spec: &Bound<'_, PyDict>) -> PyResult<Camera> {
-    let v = json(spec.as_any(), "camera")?;
+    let mut v = json(spec.as_any(), "camera")?;
+    for path in INTEGER_KEYS {
+        integer(&mut v, path)?;
+    }
     if let (Some(w), Some(h)) = (v["width"].as_i64(), v["height"].as_i64()) {
         Camera::size_from(w, h).map_err(err)?;
     }
@@ -22,6 +25,42 @@ pub fn camera(spec: &Bound<'_, PyDict>) -> PyResult<Camera> {
     let cam = file.camera().map_err(err)?;
     cam.validate().map_err(err)?;
     Ok(cam)
+}
+
+/// The camera keys that are integers (`noise.bits` is the `bits` of the
+/// `noise` dict).
+const INTEGER_KEYS: [&[&str]; 4] = [
+    &["width"],
+    &["height"],
+    &["noise", "bits"],
+    &["noise", "seed"],
+];
+
+/// The integer key at `path` of `v`: a float with an integral value (`640.0`)
+/// becomes that integer; any other float (`1.7`) is a `ValueError` naming
+/// the key, never truncated to an integer.
+fn integer(v: &mut serde_json::Value, path: &[&str]) -> PyResult<()> {
+    let mut x = &mut *v;
+    for k in path {
+        match x.get_mut(*k) {
+            Some(next) => x = next,
+            None => return Ok(()),
+        }
+    }
+    if x.is_i64() || x.is_u64() {
+        return Ok(());
+    }
+    if let Some(f) = x.as_f64() {
+        let name = format!("camera.{}", path.join("."));
+        // Integral and within i64 (a u32 or u64 key refuses the rest by name).
+        if f.fract() != 0.0 || f.abs() >= 9.2e18 {
+            return Err(PyValueError::new_err(format!(
+                "{name}: must be an integer, got {f}"
+            )));
+        }
+        *x = serde_json::Value::from(f as i64);
+    }
+    Ok(())
 }
 
 /// A camera for the Python half: every key of its camera file, as JSON

@@ -109,6 +109,15 @@ pub struct CameraFile {
     pub lens: Option<Lens>,
 }
 
+/// Keys only a Gyroflow lens profile has (a JSON camera file with one of
+/// them and no `fisheye_params` is a profile missing that key).
+const GYROFLOW_KEYS: [&str; 4] = [
+    "calib_dimension",
+    "compatible_settings",
+    "interpolations",
+    "calibrated_by",
+];
+
 /// The keys a camera file on its own must give.
 const NEEDED: &str = "a camera file gives focal_mm, pitch_mm (or pitch_x_mm and pitch_y_mm), \
                       width and height";
@@ -220,6 +229,20 @@ impl CameraFile {
         if value.get("fisheye_params").is_some() {
             return super::gyroflow::from_gyroflow(&value, choice)
                 .map_err(|e| config(e.to_string()));
+        }
+        // A Gyroflow profile's own keys without its `fisheye_params`: the
+        // missing key, not "unknown field calib_dimension".
+        if let Some(key) = GYROFLOW_KEYS.iter().find(|k| value.get(**k).is_some()) {
+            return Err(config(
+                Error::invalid(
+                    "fisheye_params",
+                    format!(
+                        "missing: the file reads as a Gyroflow lens profile (it has {key}), which \
+                         needs fisheye_params {{camera_matrix, distortion_coeffs}}"
+                    ),
+                )
+                .to_string(),
+            ));
         }
         let file: CameraFile = serde_json::from_value(value).map_err(|e| config(e.to_string()))?;
         file.camera().map_err(|e| config(e.to_string()))

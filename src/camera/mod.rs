@@ -13,6 +13,7 @@ pub(crate) mod distortion;
 pub(crate) mod file;
 pub(crate) mod fisheye;
 pub(crate) mod gyroflow;
+pub(crate) mod gyroflow_choice;
 pub(crate) mod insta360;
 pub(crate) mod intrinsics;
 pub(crate) mod lens;

@@ -4,7 +4,8 @@
 //! shutter, s). Other columns are ignored. Errors name the file, line and column.
 //!
 //! [`read_frame_table`] also reads a phone's image list
-//! ([`super::phone::read_image_list`]: nanosecond timestamp and exposure)
+//! ([`super::phone::read_image_list`]: nanosecond timestamp and exposure,
+//! and each frame's readout when it has a `readout_ns` or `readout_s` column)
 //! and ffprobe's frame output ([`super::ffprobe`]: presentation times, the
 //! exposure given), chosen by the first line.
 
@@ -28,16 +29,30 @@ impl VideoFrame {
     /// `(column, message)`.
     pub fn check(&self) -> std::result::Result<(), (&'static str, String)> {
         if !self.t_start.is_finite() {
-            return Err(("t_start", format!("must be finite, got {}", self.t_start)));
+            return Err((
+                "t_start",
+                format!("must be a finite number, got {}", self.t_start),
+            ));
         }
-        if !(self.exposure_s.is_finite() && self.exposure_s > 0.0) {
+        if !self.exposure_s.is_finite() {
+            return Err((
+                "exposure_s",
+                format!("must be a finite number, got {}", self.exposure_s),
+            ));
+        }
+        if self.exposure_s <= 0.0 {
             return Err((
                 "exposure_s",
                 format!("must be > 0 s, got {}", self.exposure_s),
             ));
         }
-        if self.readout_s.is_some_and(|r| !(r.is_finite() && r >= 0.0)) {
-            return Err(("readout_s", "must be >= 0 s".into()));
+        if let Some(r) = self.readout_s {
+            if !r.is_finite() {
+                return Err(("readout_s", format!("must be a finite number, got {r}")));
+            }
+            if r < 0.0 {
+                return Err(("readout_s", format!("must be >= 0 s, got {r}")));
+            }
         }
         Ok(())
     }
@@ -83,7 +98,8 @@ pub fn table_kind(path: &Path) -> TableKind {
 /// Reads a frame table of any [`TableKind`]. `exposure_s` (s, > 0) is the
 /// exposure of every frame of a table without one (ffprobe's); a table
 /// with its own exposure refuses it. The readout is the camera's unless a
-/// plain table has `readout_s`.
+/// plain table has `readout_s` or an image list `readout_ns` / `readout_s`
+/// (each frame's own).
 pub fn read_frame_table(path: &Path, exposure_s: Option<f64>) -> Result<Vec<VideoFrame>> {
     let kind = table_kind(path);
     if let Some(e) = exposure_s {
@@ -107,10 +123,10 @@ pub fn read_frame_table(path: &Path, exposure_s: Option<f64>) -> Result<Vec<Vide
         TableKind::Plain => read_frames(path),
         TableKind::ImageList => Ok(super::phone::read_image_list(path)?
             .into_iter()
-            .map(|(t_start, exposure_s)| VideoFrame {
+            .map(|(t_start, exposure_s, readout_s)| VideoFrame {
                 t_start,
                 exposure_s,
-                readout_s: None,
+                readout_s,
             })
             .collect()),
         TableKind::Ffprobe => {

@@ -20,7 +20,7 @@ use super::mcap::ImuStream;
 use super::phone::ImuRows;
 use crate::error::{Error, Result};
 pub use crate::model::log::GyroSample;
-use crate::model::log::{is_gap, ImuLog, LogReadout};
+use crate::model::log::{gap_reference, is_gap, ImuLog, LogReadout, GAP_REFERENCE_INTERVALS};
 use glam::{DMat3, DVec3};
 use plain::CsvSource;
 use raw::Raw;
@@ -236,7 +236,9 @@ pub struct GyroReader {
     source: Source,
     opts: GyroOptions,
     last_t: Option<(f64, u64)>,
-    intervals: Vec<f64>,
+    /// The first intervals (s) with the time (s) and line that ends each,
+    /// until the gap rule's reference is known.
+    intervals: Vec<(f64, f64, u64)>,
     median_dt: Option<f64>,
     warnings: Vec<String>,
     count: u64,
@@ -418,6 +420,7 @@ impl GyroReader {
                     message: "the log has no samples".into(),
                 });
             }
+            self.finish_gaps();
             return Ok(None);
         };
         if self.count == 0 {
@@ -461,16 +464,20 @@ impl GyroReader {
     }
 
     /// Gap detection in constant memory: the median of the first 101 intervals
-    /// is the reference; any later interval over 5x it is a warning.
+    /// is the reference; any later interval over 5x it is a warning. A
+    /// shorter log's reference is the median of all its intervals (from 3
+    /// samples up, [`Self::finish_gaps`]).
     fn check_gap(&mut self, dt: f64, t: f64, line: u64) {
-        const N: usize = 101;
+        const N: usize = GAP_REFERENCE_INTERVALS;
         match self.median_dt {
             None => {
-                self.intervals.push(dt);
+                self.intervals.push((dt, t, line));
                 if self.intervals.len() == N {
-                    let mut v = std::mem::take(&mut self.intervals);
-                    v.sort_by(f64::total_cmp);
-                    let med = v[N / 2];
+                    let mut v: Vec<f64> = self.intervals.iter().map(|i| i.0).collect();
+                    self.intervals = Vec::new();
+                    let Some(med) = gap_reference(&mut v) else {
+                        return;
+                    };
                     self.median_dt = Some(med);
                     for &d in &v {
                         if is_gap(d, med) {
@@ -484,6 +491,28 @@ impl GyroReader {
                 self.path.display()
             )),
             Some(_) => {}
+        }
+    }
+
+    /// At the end of a log shorter than the gap rule's reference: its gaps
+    /// against the median of the intervals it has (none below 3 samples).
+    fn finish_gaps(&mut self) {
+        if self.median_dt.is_some() {
+            return;
+        }
+        let first = std::mem::take(&mut self.intervals);
+        let mut v: Vec<f64> = first.iter().map(|i| i.0).collect();
+        let Some(med) = gap_reference(&mut v) else {
+            return;
+        };
+        self.median_dt = Some(med);
+        for (dt, t, line) in first {
+            if is_gap(dt, med) {
+                self.warn(format!(
+                    "{}:{line}: gap of {dt:.6} s before t = {t} s (median interval {med:.6} s of a short log)",
+                    self.path.display()
+                ));
+            }
         }
     }
 

@@ -8,7 +8,9 @@
 //!   (and named in the error when the file has no gyro row at all).
 //! - **Image list** ([`read_image_list`]): one row per video frame with its
 //!   nanosecond timestamp (exposure start of the first line) and exposure
-//!   time, e.g. `timestamp_ns,exposure_ns`; the readout comes from the camera.
+//!   time, e.g. `timestamp_ns,exposure_ns`, and optionally each frame's
+//!   rolling-shutter readout (`readout_ns`, or `readout_s` in seconds; the
+//!   frame table's per-frame readout); without one the camera's.
 //!
 //! Header names are matched without case, spaces or a leading `#`, and
 //! `name [ns]` is `name_ns` (`#timestamp [ns]`). Lines starting with `#`
@@ -55,6 +57,12 @@ const IMU_TYPE: [&str; 3] = ["type", "sensor", "sensor_type"];
 const FRAME_TIME: [&str; 3] = ["timestamp_ns", "timestamp", "t_ns"];
 /// Exposure columns of an image list (nanoseconds).
 const FRAME_EXPOSURE: [&str; 2] = ["exposure_ns", "exposure_time_ns"];
+/// Readout columns of an image list and their unit (s per unit).
+const FRAME_READOUT: [(&str, f64); 3] = [
+    ("readout_ns", 1e-9),
+    ("rolling_shutter_skew_ns", 1e-9),
+    ("readout_s", 1.0),
+];
 
 /// The column positions of an IMU-row header: time, type, x, y, z.
 fn imu_columns(names: &[String]) -> Option<[usize; 5]> {
@@ -292,19 +300,28 @@ impl ImuRows {
     }
 }
 
-/// The frames of an image list: (exposure start of the first line, s;
-/// exposure, s) per row, in file order. The header is the first non-blank
-/// line ([`is_image_list_header`]); each exposure must be > 0.
-pub fn read_image_list(path: &Path) -> Result<Vec<(f64, f64)>> {
+/// One row of an image list, s: exposure start of the first line, exposure,
+/// and the frame's own rolling-shutter readout when the list has a column
+/// for it ([`FRAME_READOUT`]).
+pub type ImageListRow = (f64, f64, Option<f64>);
+
+/// An image list's header: the time, exposure and readout (with its unit,
+/// s per unit) columns, and every column's name.
+type ImageListHeader = (usize, usize, Option<(usize, f64)>, Vec<String>);
+
+/// The frames of an image list ([`ImageListRow`] per row, in file order).
+/// The header is the first non-blank line ([`is_image_list_header`]); each
+/// exposure must be > 0, a readout >= 0.
+pub fn read_image_list(path: &Path) -> Result<Vec<ImageListRow>> {
     let mut lines = TextLines::open(path)?;
-    let mut header: Option<(usize, usize, Vec<String>)> = None;
+    let mut header: Option<ImageListHeader> = None;
     let mut out = Vec::new();
     while let Some((line, text)) = lines.next_line()? {
         let t = text.trim();
         if t.is_empty() {
             continue;
         }
-        let Some((it, ie, names)) = &header else {
+        let Some((it, ie, ir, names)) = &header else {
             let n = names(t);
             let (Some(it), Some(ie)) = (position(&n, &FRAME_TIME), position(&n, &FRAME_EXPOSURE))
             else {
@@ -318,7 +335,10 @@ pub fn read_image_list(path: &Path) -> Result<Vec<(f64, f64)>> {
                     ),
                 });
             };
-            header = Some((it, ie, n));
+            let ir = FRAME_READOUT
+                .iter()
+                .find_map(|(name, unit)| n.iter().position(|h| h == name).map(|i| (i, *unit)));
+            header = Some((it, ie, ir, n));
             continue;
         };
         if t.starts_with('#') {
@@ -347,7 +367,22 @@ pub fn read_image_list(path: &Path) -> Result<Vec<(f64, f64)>> {
                 message: format!("the exposure must be > 0 ns, got {te}"),
             });
         }
-        out.push((ts * 1e-9, te * 1e-9));
+        let readout = match ir {
+            Some((i, unit)) => {
+                let r = get(*i)?;
+                if r < 0.0 {
+                    return Err(Error::Parse {
+                        path: path.into(),
+                        line,
+                        column: names[*i].clone(),
+                        message: format!("the readout must be >= 0, got {r}"),
+                    });
+                }
+                Some(r * unit)
+            }
+            None => None,
+        };
+        out.push((ts * 1e-9, te * 1e-9, readout));
     }
     if header.is_none() {
         return Err(Error::Parse {

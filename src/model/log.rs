@@ -53,6 +53,26 @@ pub fn is_gap(dt: f64, median_dt: f64) -> bool {
     dt > GAP_FACTOR * median_dt
 }
 
+/// How many intervals the streamed gap rule reads for its reference (the
+/// first 101 of a long log); a shorter log uses all it has.
+pub const GAP_REFERENCE_INTERVALS: usize = 101;
+
+/// The fewest intervals (3 samples) the gap rule needs for a reference.
+pub const MIN_GAP_INTERVALS: usize = 2;
+
+/// The reference interval of the gap rule over `intervals` (s, sorted in
+/// place): their median, the lower one of an even count (of 2 intervals,
+/// the shorter: a 5 s gap after 10 ms is a gap). None for fewer than
+/// [`MIN_GAP_INTERVALS`]. Of [`GAP_REFERENCE_INTERVALS`] (odd) it is the
+/// middle one.
+pub fn gap_reference(intervals: &mut [f64]) -> Option<f64> {
+    if intervals.len() < MIN_GAP_INTERVALS {
+        return None;
+    }
+    intervals.sort_by(f64::total_cmp);
+    Some(intervals[(intervals.len() - 1) / 2])
+}
+
 /// Checks a time column: every time finite and strictly after the one before.
 /// `what` names the series in the error (e.g. `"gyro log"`); the error gives
 /// the index and both times.
@@ -413,6 +433,18 @@ mod tests {
             velocity: None,
             depth: None,
         }
+    }
+
+    #[test]
+    fn the_gap_reference_of_short_and_long_logs() {
+        assert_eq!(gap_reference(&mut [0.01]), None);
+        let r = gap_reference(&mut [5.0, 0.01]).unwrap();
+        assert_eq!(r, 0.01);
+        assert!(is_gap(5.0, r));
+        // An odd count: the middle one, as the reference of 101 intervals.
+        let mut v: Vec<f64> = (0..GAP_REFERENCE_INTERVALS).map(|i| i as f64).collect();
+        v.reverse();
+        assert_eq!(gap_reference(&mut v), Some(50.0));
     }
 
     #[test]

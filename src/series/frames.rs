@@ -26,7 +26,7 @@ use crate::io::frames::VideoFrame;
 use crate::io::gyro::GyroSample;
 use crate::metric::{exact_with, gauss_points, riemann_points, GridRule, Method};
 use crate::model::flow::FlowPoly;
-use crate::model::log::check_times;
+use crate::model::log::{check_resolution, check_times, max_abs_time};
 use std::collections::BTreeMap;
 
 /// The exposure MMBM of one frame.
@@ -133,6 +133,27 @@ fn line_groups(cam: &Camera, method: Method) -> Result<Vec<(f64, GridRule, f64)>
     Ok(out)
 }
 
+/// Checks every frame ([`VideoFrame::check`]) and that the time stamps of
+/// the log and the frames resolve each frame's exposure (and readout):
+/// the rule of `trigger` ([`check_resolution`]), so that nanosecond epoch
+/// stamps read as seconds are refused with a hint at `--time-unit`, not
+/// turned into confident blur.
+fn check_frame_times(samples: &[GyroSample], frames: &[VideoFrame]) -> Result<()> {
+    let t_max = frames
+        .iter()
+        .map(|f| f.t_start.abs())
+        .fold(max_abs_time(samples), f64::max);
+    for (k, f) in frames.iter().enumerate() {
+        f.check()
+            .map_err(|(column, message)| Error::invalid(format!("frame {k}: {column}"), message))?;
+        check_resolution(t_max, f.exposure_s, &format!("frame {k}'s exposure"))?;
+        if let Some(r) = f.readout_s {
+            check_resolution(t_max, r, &format!("frame {k}'s readout"))?;
+        }
+    }
+    Ok(())
+}
+
 /// Exposure MMBM (and the instantaneous MMBM at the start) of every frame.
 /// A frame's readout is its own (`readout_s` of the table) or else the
 /// camera's. Frames whose window `[t_start, t_start + t_r + t_e]` is not
@@ -149,6 +170,7 @@ pub fn frame_mmbm(
         return Err(Error::invalid("gyro log", "needs at least 2 samples"));
     }
     check_times(samples, "gyro log")?;
+    check_frame_times(samples, frames)?;
     let groups = match opts.method {
         Method::Riemann { .. } | Method::Gauss { .. } => Some(line_groups(&cam, opts.method)?),
         Method::Exact { .. } => None,

@@ -258,6 +258,15 @@ pub fn run<W: Write>(
             if batch.is_empty() {
                 break;
             }
+            // The exposure of blur_px must be resolved by the time stamps
+            // (`trigger`'s rule: ns epoch stamps read as seconds are refused).
+            if let Some(te) = exposure_s {
+                crate::model::log::check_resolution(
+                    crate::model::log::max_abs_time(&batch),
+                    te,
+                    "the exposure (--exposure)",
+                )?;
+            }
             let vals = eval(&batch)?;
             if vals.len() != batch.len() {
                 return Err(Error::invalid(

@@ -193,13 +193,30 @@ impl FrameName {
     }
 }
 
+/// Checks `--frame-start`: the number of the last of `frames` frames
+/// (`start + frames - 1`) must fit in a u64, else the names would wrap.
+pub fn check_frame_start(start: u64, frames: usize) -> Result<()> {
+    let last = (frames.max(1) - 1) as u64;
+    if start.checked_add(last).is_none() {
+        return Err(Error::invalid(
+            "--frame-start",
+            format!(
+                "{start} numbers the last of {frames} frames {start} + {last}, past the largest \
+                 frame number {}",
+                u64::MAX
+            ),
+        ));
+    }
+    Ok(())
+}
+
 /// The image list of `frames` (0-based rows, in order): one name per line,
 /// frame `k` named with number `k + start` (ffmpeg's image2 numbers the
 /// first frame 1 unless told `-start_number`).
 pub fn image_list(frames: &[usize], name: &FrameName, start: u64) -> String {
     let mut out = String::new();
     for &k in frames {
-        out.push_str(&name.name(k as u64 + start));
+        out.push_str(&name.name((k as u64).saturating_add(start)));
         out.push('\n');
     }
     out

@@ -105,17 +105,12 @@ impl Live {
         self.t.last().copied()
     }
 
-    /// Takes the sample at time `t` (s, after the previous one) with MMBM
-    /// `mmbm_mm_s` and returns what it produced: a trigger at it, and frames
-    /// whose exposure it completed.
-    pub fn push(&mut self, t: f64, mmbm_mm_s: f64) -> Result<Vec<Event>> {
-        self.push_px(t, mmbm_mm_s, None)
-    }
-
-    /// [`Live::push`] with the sample's MMBM in px/s too (the true pixel
-    /// speed): pixel budgets convert with its mm per px
-    /// ([`super::policy::Observation::pitch_mm`]), else the timing's pitch.
-    pub fn push_px(&mut self, t: f64, mmbm_mm_s: f64, px_s: Option<f64>) -> Result<Vec<Event>> {
+    /// Checks a sample before it is taken, changing nothing: its time
+    /// finite, resolved by the log's time base for the exposure, after the
+    /// previous sample's; its MMBM a finite number >= 0. [`Live::push_px`]
+    /// refuses the same samples; a stream checks every policy's runner
+    /// first, so that a bad sample is skipped by all or none.
+    pub fn check(&self, t: f64, mmbm_mm_s: f64) -> Result<()> {
         crate::check::finite("sample time", t)?;
         crate::model::log::check_resolution(t, self.timing.exposure, "the exposure")?;
         if let Some(prev) = self.last_time() {
@@ -132,6 +127,21 @@ impl Live {
                 format!("value {mmbm_mm_s} at t = {t} s is not a finite number >= 0"),
             ));
         }
+        Ok(())
+    }
+
+    /// Takes the sample at time `t` (s, after the previous one) with MMBM
+    /// `mmbm_mm_s` and returns what it produced: a trigger at it, and frames
+    /// whose exposure it completed.
+    pub fn push(&mut self, t: f64, mmbm_mm_s: f64) -> Result<Vec<Event>> {
+        self.push_px(t, mmbm_mm_s, None)
+    }
+
+    /// [`Live::push`] with the sample's MMBM in px/s too (the true pixel
+    /// speed): pixel budgets convert with its mm per px
+    /// ([`super::policy::Observation::pitch_mm`]), else the timing's pitch.
+    pub fn push_px(&mut self, t: f64, mmbm_mm_s: f64, px_s: Option<f64>) -> Result<Vec<Event>> {
+        self.check(t, mmbm_mm_s)?;
         if self.t.len() >= 2 * Observation::RECENT {
             self.t.drain(..Observation::RECENT);
             self.m.drain(..Observation::RECENT);

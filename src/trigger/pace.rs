@@ -3,6 +3,7 @@
 //! that end early when the stream is told to stop.
 
 use crate::error::{Error, Result};
+pub use crate::limits::{MAX_REPLAY_SPEED, MIN_REPLAY_SPEED};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
@@ -14,14 +15,19 @@ const SPIN: Duration = Duration::from_micros(300);
 /// The longest single sleep: how soon a stop request is seen during a wait.
 pub(crate) const SLICE: Duration = Duration::from_millis(50);
 
-/// Checks a replay speed: 0 (as fast as possible) or a finite number > 0.
+/// Checks a replay speed: 0 (as fast as possible) or a finite number in
+/// [`MIN_REPLAY_SPEED`, `MAX_REPLAY_SPEED`] (a slower replay would wait
+/// forever: `--speed 1e-300`).
 pub fn check_speed(speed: f64) -> Result<f64> {
-    if speed.is_finite() && speed >= 0.0 {
+    if speed == 0.0 || (MIN_REPLAY_SPEED..=MAX_REPLAY_SPEED).contains(&speed) {
         Ok(speed)
     } else {
         Err(Error::invalid(
             "replay speed",
-            format!("must be a finite number >= 0 (0: as fast as possible), got {speed}"),
+            format!(
+                "must be 0 (as fast as possible) or from {MIN_REPLAY_SPEED} to {MAX_REPLAY_SPEED:e} \
+                 times real time, got {speed}"
+            ),
         ))
     }
 }
@@ -89,10 +95,19 @@ mod tests {
 
     #[test]
     fn speeds_checked() {
-        for ok in [0.0, 1e-300, 5e-324, 4.0] {
+        for ok in [0.0, 1e-3, 4.0, 1e6] {
             assert_eq!(check_speed(ok).unwrap(), ok);
         }
-        for bad in [-1.0, f64::NAN, f64::INFINITY, -0.0 - 1e-300] {
+        for bad in [
+            -1.0,
+            f64::NAN,
+            f64::INFINITY,
+            -0.0 - 1e-300,
+            1e-300,
+            5e-324,
+            9.99e-4,
+            1.01e6,
+        ] {
             let e = check_speed(bad).unwrap_err().to_string();
             assert!(e.contains("replay speed"), "{e}");
         }
@@ -101,14 +116,14 @@ mod tests {
     #[test]
     fn an_endless_wait_ends_at_stop() {
         let stop = AtomicBool::new(false);
-        let mut p = Pacer::new(1e-300).unwrap();
+        let mut p = Pacer::new(MIN_REPLAY_SPEED).unwrap();
         assert!(p.wait(0.0, &stop), "the first sample is due at once");
         std::thread::scope(|s| {
             s.spawn(|| {
                 std::thread::sleep(Duration::from_millis(100));
                 stop.store(true, Ordering::Relaxed);
             });
-            assert!(!p.wait(0.01, &stop));
+            assert!(!p.wait(1000.0, &stop));
         });
     }
 

@@ -28,6 +28,25 @@ fn parse_fps(s: &str, what: &str, spec: &str) -> Result<f64> {
     Ok(fps)
 }
 
+/// Refuses a `key=value` argument whose key was given before (`ae:5:cap=10ms:cap=3ms`):
+/// neither value silently wins.
+fn unique_keys(keys: &[&str], spec: &str) -> Result<()> {
+    let mut seen = std::collections::HashSet::new();
+    for kv in keys {
+        let Some((k, _)) = kv.split_once('=') else {
+            continue;
+        };
+        let k = k.trim();
+        if !seen.insert(k) {
+            return Err(Error::invalid(
+                "policy",
+                format!("'{spec}': key '{k}' is given twice; give each key once"),
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// Parses `FPS[@PHASE]`.
 fn parse_rate(s: &str, spec: &str) -> Result<(f64, f64)> {
     let (f, p) = match s.split_once('@') {
@@ -293,10 +312,12 @@ impl PolicySpec {
                 out.fixed_exposure_s = te;
             }
             (Family::Ae, [r, keys @ ..]) => {
+                unique_keys(keys, spec)?;
                 out.rate = Some(rate(r)?);
                 out.ae = Some(parse_ae(keys, spec)?);
             }
             (Family::Task, [f, keys @ ..]) => {
+                unique_keys(keys, spec)?;
                 out.rate = Some(fps_only(f, "frame rate")?);
                 out.task = Some(parse_task(keys, spec)?);
             }

@@ -412,9 +412,17 @@ impl Stream {
         }
         // The MMBM and, on pixels that are not square, its px/s (for the
         // pixel budgets).
+        // Every runner checks the sample before any takes it (its time base
+        // for the exposure, above all): a bad one is skipped by all.
         let values = sample_mmbm(s, &self.series, &self.eval)
             .and_then(|m| check_values(std::slice::from_ref(s), &[m]).map(|_| m))
-            .and_then(|m| crate::series::sample_px(s, &self.series, &self.eval, m).map(|p| (m, p)));
+            .and_then(|m| crate::series::sample_px(s, &self.series, &self.eval, m).map(|p| (m, p)))
+            .and_then(|v| {
+                self.runs
+                    .iter()
+                    .try_for_each(|r| r.check(s.t, v.0))
+                    .map(|_| v)
+            });
         let (m, px) = match values {
             Ok(v) => v,
             Err(e) => {
