@@ -428,7 +428,7 @@ def _sharp(sharp: Optional[str], centre: Optional[bool]) -> str:
     ``"start"``) as its alias; both given must agree."""
     alias = None if centre is None else ("mid" if centre else "start")
     if sharp is None:
-        return alias or "start"
+        return alias or "mid"
     if sharp not in ("start", "mid", "end"):
         raise ValueError(f"sharp: 'start', 'mid' or 'end' expected, got {sharp!r}")
     if alias is not None and alias != sharp:
@@ -550,9 +550,9 @@ def augment(
     (a constant twist, rad/s and m/s, camera frame) or a ``read_gyro`` dict
     with ``at`` (a window of a real log starting at ``at`` s). ``sharp``:
     the instant at which ``image`` is the sharp frame (the reference pose):
-    ``"start"`` (default), ``"mid"`` (no net shift: the blur spreads around
-    each point, as GoPro / REDS pair a blurred frame with its middle sharp
-    frame) or ``"end"``; ``centre=True`` is ``sharp="mid"`` (``False``:
+    ``"mid"`` (default: no net shift, the blur spreads around each point, as
+    GoPro / REDS pair a blurred frame with its middle sharp frame and as
+    ``mmbm dataset`` does), ``"start"`` or ``"end"``; ``centre=True`` is ``sharp="mid"`` (``False``:
     ``"start"``).
     ``camera``: default the thesis focal length and pitch at the image's
     size (a given camera must have that size; lens distortion is refused).

@@ -156,7 +156,7 @@ fn stop_ends_an_endless_replay_wait_with_the_statistics() {
     let control = StreamControl::default();
     let opts = StreamOptions { stats: true, ..ALL };
     let mut s = stream(&["threshold:0.4"], opts, control.clone());
-    // The second sample is due in 1e298 s.
+    // The second sample is due in 10 s (0.01 s at the slowest speed).
     let log = [sample(0.0, 0.3), sample(0.01, 0.3)];
     let mut out = Vec::new();
     let o = std::thread::scope(|scope| {
@@ -169,7 +169,13 @@ fn stop_ends_an_endless_replay_wait_with_the_statistics() {
             c.stop();
             assert!(c.wait_ended(Duration::from_secs(10)));
         });
-        s.replay(log.map(Ok), "log", 1e-300, &mut out).unwrap()
+        s.replay(
+            log.map(Ok),
+            "log",
+            crate::limits::MIN_REPLAY_SPEED,
+            &mut out,
+        )
+        .unwrap()
     });
     assert!(matches!(o.end, StreamEnd::Stopped));
     assert_eq!(o.samples, 1);
