@@ -30,6 +30,7 @@ pub(crate) mod run;
 pub(crate) mod sensor;
 pub(crate) mod shard;
 pub(crate) mod tarcheck;
+pub(crate) mod tarindex;
 pub mod textures;
 pub(crate) mod webdataset;
 

@@ -1,5 +1,5 @@
 //! Checking WebDataset tar shards against their index without trusting
-//! either (`mmbm dataset --verify`; packing reuses [`sum_regular`]).
+//! either (`mmbm dataset --verify`).
 //!
 //! A shard is read only when it is a regular file under its own name: a
 //! symlink (wherever it leads), a pipe, a device or a directory among the
@@ -9,82 +9,12 @@
 //! must be there with its size and SHA-256, every file there must be listed,
 //! and its item count must be the dataset's.
 
-use super::guard::{read_json_file, short, Record};
+use super::guard::{short, Record};
 use super::manifest::Problems;
-use super::webdataset::{shard_name, TarIndex, FOLDER, INDEX_FORMAT};
+use super::tarindex::{kind, read_index, shard_name, sum_regular, Kind, FOLDER, INDEX_FORMAT};
 use crate::error::{show_path, Error, Result};
 use std::collections::BTreeSet;
-use std::fs::File;
 use std::path::Path;
-
-/// What a name in the shard folder is (links not followed).
-pub(crate) enum Kind {
-    /// Nothing by that name.
-    Missing,
-    /// A symbolic link.
-    Symlink,
-    /// A pipe, device, socket or directory.
-    Other,
-    /// A regular file of this many bytes.
-    File(u64),
-}
-
-/// What `p` is, without following a link.
-pub(crate) fn kind(p: &Path) -> Result<Kind> {
-    match std::fs::symlink_metadata(p) {
-        Ok(m) if m.file_type().is_symlink() => Ok(Kind::Symlink),
-        Ok(m) if m.is_file() => Ok(Kind::File(m.len())),
-        Ok(_) => Ok(Kind::Other),
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(Kind::Missing),
-        Err(e) => Err(Error::io(p, e)),
-    }
-}
-
-/// Opens `p` when it is a regular file under its own name (not a link);
-/// `None` otherwise. The opened file is checked to be the one looked at.
-fn open_regular(p: &Path) -> Result<Option<File>> {
-    let Ok(seen) = std::fs::symlink_metadata(p) else {
-        return Ok(None);
-    };
-    if !seen.is_file() {
-        return Ok(None);
-    }
-    let f = File::open(p).map_err(|e| Error::io(p, e))?;
-    let got = f.metadata().map_err(|e| Error::io(p, e))?;
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::MetadataExt;
-        if (got.dev(), got.ino()) != (seen.dev(), seen.ino()) {
-            return Ok(None);
-        }
-    }
-    Ok(got.is_file().then_some(f))
-}
-
-/// Size and SHA-256 of `p` when it is a regular file under its own name,
-/// `None` otherwise (missing, a link, not a regular file).
-pub(crate) fn sum_regular(p: &Path) -> Result<Option<(u64, String)>> {
-    match open_regular(p)? {
-        Some(mut f) => super::guard::sha256_of(&mut f, p).map(Some),
-        None => Ok(None),
-    }
-}
-
-/// Reads and parses `DIR/webdataset/index.json` (a regular file under its
-/// own name).
-pub(crate) fn read_index(index: &Path) -> Result<TarIndex> {
-    if !matches!(kind(index)?, Kind::File(_)) {
-        return Err(Error::invalid(
-            show_path(index),
-            "is not a regular file (a link or another kind of file is not read)",
-        ));
-    }
-    let text = read_json_file(index)?;
-    serde_json::from_str(&text).map_err(|e| Error::Config {
-        path: index.into(),
-        message: crate::error::clip(&e.to_string(), crate::error::MAX_MESSAGE),
-    })
-}
 
 /// Checks `out/webdataset/` against its `index.json`: the index present,
 /// for this dataset, complete and of its item count; each listed shard a

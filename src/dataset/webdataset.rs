@@ -32,10 +32,10 @@ use super::guard::Record;
 use super::item::FILES;
 use super::lock::PackLock;
 use super::manifest::{each_line, item_dir, verify, ManifestLine};
-use super::tarcheck::{kind, read_index, sum_regular, Kind};
+use super::tarindex::{kind, read_index, sum_regular, Kind, INDEX_FORMAT};
+pub use super::tarindex::{shard_name, TarIndex, TarShard, FOLDER};
 use crate::error::{show_path, Error, Result};
 use crate::io::atomic::write_atomic;
-use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
@@ -43,50 +43,12 @@ use std::path::{Path, PathBuf};
 /// Default shard size, bytes (about 1 GB, WebDataset's usual size).
 pub const DEFAULT_SHARD_BYTES: u64 = 1_000_000_000;
 pub use crate::limits::{MAX_SHARD_BYTES, MIN_SHARD_BYTES};
-/// The folder, under the dataset directory.
-pub const FOLDER: &str = "webdataset";
 /// Where a packing writes before it is complete (then renamed to [`FOLDER`]).
 const STAGE: &str = ".webdataset.partial";
 /// Where the folder it replaces goes for the instant of the swap.
 const OLD: &str = ".webdataset.old";
-/// The `format` of `index.json`.
-pub(crate) const INDEX_FORMAT: &str = "mmbm-webdataset-1";
 /// Tar block, bytes.
 const BLOCK: u64 = 512;
-
-/// One tar shard, as `index.json` lists it.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct TarShard {
-    /// File name in `DIR/webdataset/`.
-    pub name: String,
-    /// Index of its first item.
-    pub first: u64,
-    /// Items in it (consecutive indices).
-    pub items: u64,
-    /// File size, bytes.
-    pub bytes: u64,
-    /// SHA-256 of the file, hex.
-    pub sha256: String,
-}
-
-/// `DIR/webdataset/index.json`.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct TarIndex {
-    /// `mmbm-webdataset-1`.
-    pub format: String,
-    /// The dataset's fingerprint (`dataset.json`).
-    pub fingerprint: String,
-    /// The shard size the shards were cut at, bytes.
-    pub shard_bytes: u64,
-    /// Items in the dataset.
-    pub count: u64,
-    /// The shards made so far, in order.
-    pub shards: Vec<TarShard>,
-    /// True once every item is in a shard.
-    pub complete: bool,
-}
 
 /// What [`pack`] did.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -104,11 +66,6 @@ pub struct PackSummary {
 /// The tar member name of item file `file` (e.g. `blurred.exr`) of item `i`.
 pub fn member_name(i: u64, file: &str) -> String {
     format!("{i:08}.{file}")
-}
-
-/// The name of tar shard `s` (0-based).
-pub fn shard_name(s: usize) -> String {
-    format!("mmbm-{s:06}.tar")
 }
 
 /// Bytes a member of `n` bytes takes in a tar (header and padding).

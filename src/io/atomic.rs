@@ -197,11 +197,7 @@ pub fn check_output_dir(path: &Path) -> Result<()> {
                 path,
                 std::io::Error::new(
                     e.kind(),
-                    format!(
-                        "cannot write in '{}': {}",
-                        show_path(dir),
-                        super::guard::plain(&e)
-                    ),
+                    format!("cannot write in '{}': {}", show_path(dir), plain(&e)),
                 ),
             )
         })
@@ -468,5 +464,12 @@ where
                 w.write_all(&bytes).map_err(|e| Error::io(path, e))
             })
         }
+    }
+}
+/// `e` without the probe file's name that `tempfile` adds.
+pub(crate) fn plain(e: &std::io::Error) -> std::io::Error {
+    match e.raw_os_error() {
+        Some(code) => std::io::Error::from_raw_os_error(code),
+        None => std::io::Error::from(e.kind()),
     }
 }

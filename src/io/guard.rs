@@ -16,7 +16,7 @@
 //!
 //! Nothing is read or written by the check but the probe files.
 
-use super::atomic::{check_output_dir, check_outputs, Destination};
+use super::atomic::{check_output_dir, check_outputs, plain, Destination};
 use crate::error::{show_path, Error, Result};
 use std::path::{Component, Path, PathBuf};
 
@@ -187,14 +187,6 @@ fn probe_file(flag: &str, p: &Path, d: &Destination) -> Result<()> {
                     )
                 })
         }
-    }
-}
-
-/// `e` without the probe file's name that `tempfile` adds.
-pub(crate) fn plain(e: &std::io::Error) -> std::io::Error {
-    match e.raw_os_error() {
-        Some(code) => std::io::Error::from_raw_os_error(code),
-        None => std::io::Error::from(e.kind()),
     }
 }
 
