@@ -126,7 +126,7 @@ pub(crate) fn fit_blur(
     blur_px: f64,
 ) -> Result<Trajectory> {
     let l0 = mean_path_px(cam, target, traj);
-    if !(l0 > 1e-9) {
+    if l0.is_nan() || l0 <= 1e-9 {
         return Err(Error::invalid(
             "blur_px",
             format!("{blur_px} px asked of a motion without blur (mean path {l0:.2e} px)"),
@@ -136,7 +136,7 @@ pub(crate) fn fit_blur(
     let mut out = scaled(traj, k)?;
     for _ in 1..BLUR_ROUNDS {
         let l = mean_path_px(cam, target, &out);
-        if !(l > 1e-9) || (l / blur_px - 1.0).abs() < 1e-3 {
+        if l.is_nan() || l <= 1e-9 || (l / blur_px - 1.0).abs() < 1e-3 {
             break;
         }
         k *= blur_px / l;

@@ -114,13 +114,13 @@ impl Src<'_> {
             match (wrap(x, w, self.border), wrap(y, h, self.border)) {
                 (Some(x), Some(y)) => {
                     let i = (y * self.w + x) * c;
-                    for k in 0..c {
-                        acc[k] += wt * self.v[i + k];
+                    for (a, v) in acc[..c].iter_mut().zip(&self.v[i..i + c]) {
+                        *a += wt * v;
                     }
                 }
                 _ => {
-                    for k in 0..c {
-                        acc[k] += wt * self.fill[k];
+                    for (a, f) in acc[..c].iter_mut().zip(&self.fill[..c]) {
+                        *a += wt * f;
                     }
                 }
             }
