@@ -211,6 +211,18 @@ fn table() -> BTreeMap<String, String> {
     rows
 }
 
+/// What is wrong with the row of cap `name` (value `v`, from `what`, e.g.
+/// `NAME = EXPR`): missing, or a value other than `v`.
+fn row_fault(rows: &BTreeMap<String, String>, name: &str, v: f64, what: &str) -> Option<String> {
+    match rows.get(name) {
+        None => Some(format!("{what}: no row `{name}` in docs/limits.md")),
+        Some(cell) if doc_value(cell) != Some(v) => {
+            Some(format!("{what} ({v}): docs/limits.md says '{cell}'"))
+        }
+        _ => None,
+    }
+}
+
 #[test]
 fn every_cap_in_limits_rs_is_in_the_table_with_its_value() {
     let src = read("src/limits.rs");
@@ -228,15 +240,7 @@ fn every_cap_in_limits_rs_is_in_the_table_with_its_value() {
             }
         };
         known.insert(name.clone(), v);
-        match rows.get(&name).map(|c| (c, doc_value(c))) {
-            None => problems.push(format!(
-                "{name} = {expr}: no row `{name}` in docs/limits.md"
-            )),
-            Some((cell, d)) if d != Some(v) => problems.push(format!(
-                "{name} = {expr} ({v}): docs/limits.md says '{cell}'"
-            )),
-            _ => {}
-        }
+        problems.extend(row_fault(&rows, &name, v, &format!("{name} = {expr}")));
     }
     assert!(problems.is_empty(), "{}", problems.join("\n"));
 }
@@ -250,13 +254,7 @@ fn caps_elsewhere_are_in_the_table_with_their_values() {
             problems.push(format!("{name}: no evaluable const {konst} in {file}"));
             continue;
         };
-        match rows.get(name).map(|c| (c, doc_value(c))) {
-            None => problems.push(format!("{name}: no row in docs/limits.md")),
-            Some((cell, d)) if d != Some(v) => {
-                problems.push(format!("{name} ({v}): docs/limits.md says '{cell}'"))
-            }
-            _ => {}
-        }
+        problems.extend(row_fault(&rows, name, v, name));
     }
     assert!(problems.is_empty(), "{}", problems.join("\n"));
 }

@@ -305,29 +305,9 @@ fn random_bytes_never_crash_the_reader() {
     assert_eq!(json_lines(&o).len(), 1000, "every good line decided");
 }
 
-/// `mmbm live --udp` on a free local port (`fixed:5 --all`, idle exit after
-/// 1.5 s), a socket to send from, and the address, once it listens.
-fn udp_live() -> (std::process::Child, std::net::UdpSocket, String) {
-    let port = {
-        let s = std::net::UdpSocket::bind("127.0.0.1:0").unwrap();
-        s.local_addr().unwrap().port()
-    };
-    let addr = format!("127.0.0.1:{port}");
-    let child = common::mmbm_cmd()
-        .args(["live", "--policy", "fixed:5", "--all", "--idle-exit", "1.5"])
-        .args(["--udp", &addr])
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let sock = std::net::UdpSocket::bind("127.0.0.1:0").unwrap();
-    std::thread::sleep(std::time::Duration::from_millis(500));
-    (child, sock, addr)
-}
-
 #[test]
 fn udp_datagrams_are_decided() {
-    let (child, sock, addr) = udp_live();
+    let (child, sock, addr) = common::udp_live();
     sock.send_to(b"t,wx,wy,wz", &addr).unwrap();
     for k in 0..20 {
         let line = format!("{},0.1,0.2,0.3", k as f64 * 0.01);
@@ -378,11 +358,7 @@ fn endless_waits_never_panic_and_ctrl_c_ends_them() {
     std::fs::write(&walk, "t,wx,wy,wz\n0,0.1,0.2,0.3\n0.01,0.1,0.2,0.3\n").unwrap();
     let huge = dir.path().join("huge.csv");
     std::fs::write(&huge, "t,wx,wy,wz\n0,0,0,0.1\n1.7e308,0,0,0.1\n").unwrap();
-    let port = {
-        let s = std::net::UdpSocket::bind("127.0.0.1:0").unwrap();
-        s.local_addr().unwrap().port()
-    };
-    let addr = format!("127.0.0.1:{port}");
+    let addr = common::free_udp_addr();
     let w = walk.to_str().unwrap();
     let h = huge.to_str().unwrap();
     let cases: Vec<Vec<&str>> = vec![
@@ -508,7 +484,7 @@ fn a_non_finite_sample_is_skipped_like_a_malformed_line() {
 /// Issue 23: a single such datagram stopped the UDP listener.
 #[test]
 fn a_bad_datagram_does_not_stop_the_listener() {
-    let (child, sock, addr) = udp_live();
+    let (child, sock, addr) = common::udp_live();
     for d in [
         "t,wx,wy,wz",
         "0,0,0,0.1",

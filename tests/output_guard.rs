@@ -3,6 +3,7 @@
 //! nothing. Each case runs the `mmbm` command in a folder of its own.
 
 mod common;
+mod robust;
 
 use std::path::{Path, PathBuf};
 use std::process::Output;
@@ -94,16 +95,7 @@ fn refused(d: &Path, cases: &[(String, &[&str])]) -> Vec<String> {
         let before = snapshot(d);
         let argv: Vec<&str> = args.split_whitespace().collect();
         let o = common::mmbm_in(d, &argv);
-        let err = stderr(&o);
-        let mut why = Vec::new();
-        if o.status.code() != Some(1) {
-            why.push(format!("exit code {:?}", o.status.code()));
-        }
-        for w in *words {
-            if !err.contains(w) {
-                why.push(format!("error does not say '{w}'"));
-            }
-        }
+        let mut why = robust::refusal_faults(&o, &[1], words);
         let after = snapshot(d);
         if after != before {
             let changed: Vec<_> = after
@@ -118,11 +110,7 @@ fn refused(d: &Path, cases: &[(String, &[&str])]) -> Vec<String> {
             inputs(d);
         }
         if !why.is_empty() {
-            failures.push(format!(
-                "mmbm {args}: {}\n    {}",
-                why.join("; "),
-                err.trim()
-            ));
+            failures.push(robust::failure(args, &why, &o));
         }
     }
     failures

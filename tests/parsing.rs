@@ -255,20 +255,7 @@ fn live_skips_a_bad_sample_on_stdin() {
 /// The same sample in a UDP datagram on 127.0.0.1 no longer ends the listener.
 #[test]
 fn live_skips_a_bad_datagram() {
-    let port = {
-        let s = std::net::UdpSocket::bind("127.0.0.1:0").unwrap();
-        s.local_addr().unwrap().port()
-    };
-    let addr = format!("127.0.0.1:{port}");
-    let child = common::mmbm_cmd()
-        .args(["live", "--policy", "fixed:5", "--all", "--idle-exit", "1.5"])
-        .args(["--udp", &addr])
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let sock = std::net::UdpSocket::bind("127.0.0.1:0").unwrap();
-    std::thread::sleep(Duration::from_millis(500));
+    let (child, sock, addr) = common::udp_live();
     for d in [
         "t,wx,wy,wz",
         "1e308,0.1,0.2,0.3",

@@ -191,6 +191,29 @@ pub fn mmbm_within(dir: &Path, args: &[&str], stdin: Vec<u8>, secs: u64) -> Outp
     child.wait_with_output().unwrap()
 }
 
+/// A free local UDP address (`127.0.0.1:PORT`): a port the system handed out
+/// a moment ago, for `mmbm live --udp`.
+pub fn free_udp_addr() -> String {
+    let s = std::net::UdpSocket::bind("127.0.0.1:0").unwrap();
+    format!("127.0.0.1:{}", s.local_addr().unwrap().port())
+}
+
+/// `mmbm live --udp` on a free local port (`fixed:5 --all`, idle exit after
+/// 1.5 s), a socket to send from, and the address, once it listens.
+pub fn udp_live() -> (std::process::Child, std::net::UdpSocket, String) {
+    let addr = free_udp_addr();
+    let child = mmbm_cmd()
+        .args(["live", "--policy", "fixed:5", "--all", "--idle-exit", "1.5"])
+        .args(["--udp", &addr])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let sock = std::net::UdpSocket::bind("127.0.0.1:0").unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(500));
+    (child, sock, addr)
+}
+
 /// A PNG file whose header claims `w` x `h` RGB pixels (no image data).
 pub fn png_header(w: u32, h: u32) -> Vec<u8> {
     fn crc32(bytes: &[u8]) -> u32 {

@@ -1,4 +1,5 @@
-//! Helpers of the bad-input suites (tests/robustness.rs, tests/robustness_round3.rs):
+//! Helpers of the bad-input suites (tests/robustness.rs, tests/robustness_round3.rs,
+//! tests/output_guard.rs):
 //! the input files every case may name, leftovers in a folder, and the runner
 //! of a table of bad inputs.
 #![allow(dead_code)]
@@ -83,6 +84,33 @@ pub fn leftovers(dir: &Path, before: &[String]) -> Vec<String> {
     v
 }
 
+/// What is wrong with a refusal `o` of `mmbm ARGS`: an exit code outside
+/// `codes`, or a word of `words` missing from stderr (empty when none).
+pub fn refusal_faults(o: &std::process::Output, codes: &[i32], words: &[&str]) -> Vec<String> {
+    let err = String::from_utf8_lossy(&o.stderr);
+    let mut why = Vec::new();
+    if !o.status.code().is_some_and(|c| codes.contains(&c)) {
+        why.push(format!("exit code {:?}", o.status.code()));
+    }
+    for w in words {
+        if !err.contains(w) {
+            why.push(format!("error does not say '{w}'"));
+        }
+    }
+    why
+}
+
+/// One line of a suite's failure list: the command, what is wrong, and
+/// (indented, at most 2000 characters) what it printed on stderr.
+pub fn failure(args: &str, why: &[String], o: &std::process::Output) -> String {
+    let err = String::from_utf8_lossy(&o.stderr);
+    format!(
+        "mmbm {args}: {}\n    {}",
+        why.join("; "),
+        err.chars().take(2000).collect::<String>().trim()
+    )
+}
+
 /// Runs every case of `table` in `dir` and returns how each one that is not
 /// a clear error leaving nothing behind fails (exit code, panic, words,
 /// stderr size, leftovers).
@@ -93,17 +121,9 @@ pub fn unclear_errors(dir: &Path, table: &[(&str, &[&str])]) -> Vec<String> {
         let argv: Vec<&str> = args.split_whitespace().collect();
         let o = mmbm_in(dir, &argv);
         let err = String::from_utf8_lossy(&o.stderr);
-        let mut why = Vec::new();
-        if !matches!(o.status.code(), Some(1 | 2)) {
-            why.push(format!("exit code {:?}", o.status.code()));
-        }
+        let mut why = refusal_faults(&o, &[1, 2], words);
         if !err.contains("error:") || err.contains("panicked") {
             why.push("no error line, or a panic".into());
-        }
-        for w in *words {
-            if !err.contains(w) {
-                why.push(format!("error does not say '{w}'"));
-            }
         }
         if err.len() > 2000 {
             why.push(format!(
@@ -120,11 +140,7 @@ pub fn unclear_errors(dir: &Path, table: &[(&str, &[&str])]) -> Vec<String> {
             }
         }
         if !why.is_empty() {
-            failures.push(format!(
-                "mmbm {args}: {}\n    {}",
-                why.join("; "),
-                err.chars().take(2000).collect::<String>().trim()
-            ));
+            failures.push(failure(args, &why, &o));
         }
     }
     failures
