@@ -9,7 +9,7 @@ use mmbm::io::atomic::all_or_nothing;
 use mmbm::io::guard::OutputGuard;
 use mmbm::io::images::{write_exr, write_png_linear_rgb};
 use mmbm::render::{
-    self, Backend, Integrator, Quality, RenderJob, RenderOutput, Target, Trajectory,
+    self, Backend, FrameMotion, Integrator, Quality, RenderJob, RenderOutput, Target,
 };
 use mmbm::Twist;
 use std::path::{Path, PathBuf};
@@ -196,19 +196,15 @@ pub fn run(args: RenderArgs) -> Result<()> {
         }
         None => None,
     };
-    // A rolling shutter exposes each line over its own window: the motion
-    // spans the readout plus the exposure.
-    let span = a.exposure + camera.shutter.readout_s;
-    let trajectory = match (&a.omega, &a.gyro, &log) {
-        (Some(w), None, _) => {
-            Trajectory::from_twist(Twist::new(*w, a.velocity.unwrap_or_default()), span)?
-        }
-        (None, Some(path), Some(log)) => {
-            let at =
-                a.at.ok_or_else(|| Error::invalid("--at", "required with --gyro"))?;
-            Trajectory::from_imu_log(log, at, span, a.use_velocity)
-                .map_err(|e| Error::invalid("--gyro", format!("{}: {e}", path.display())))?
-        }
+    let motion = match (&a.omega, &log) {
+        (Some(w), None) => FrameMotion::Twist(Twist::new(*w, a.velocity.unwrap_or_default())),
+        (None, Some(log)) => FrameMotion::Log {
+            log,
+            at_s: a
+                .at
+                .ok_or_else(|| Error::invalid("--at", "required with --gyro"))?,
+            use_velocity: a.use_velocity,
+        },
         _ => {
             return Err(Error::invalid(
                 "motion",
@@ -226,19 +222,22 @@ pub fn run(args: RenderArgs) -> Result<()> {
     if let Some(b) = a.background {
         target.background = [b.x as f32, b.y as f32, b.z as f32];
     }
+    // The exposure first (a non-positive one is the flag's fault, not the log's).
+    mmbm::check::positive("--exposure", a.exposure)?;
+    // The trajectory spans the camera's busy time (exposure plus readout).
+    let trajectory = motion
+        .trajectory(&camera, a.exposure)
+        .map_err(|e| match &a.gyro {
+            Some(path) => Error::invalid("--gyro", format!("{}: {e}", path.display())),
+            None => e,
+        })?;
     target.validate_for(&camera)?;
-    let backend = a.backend;
-    let job = RenderJob {
-        camera,
-        exposure_s: a.exposure,
-        trajectory,
-        target,
-        quality: a.quality,
-        backend,
-        seed: a.seed,
-        integrator: a.integrator,
-        with_maps: a.maps.is_some(),
-    };
+    let mut job = RenderJob::new(camera, a.exposure, trajectory, target);
+    job.quality = a.quality;
+    job.backend = a.backend;
+    job.seed = a.seed;
+    job.integrator = a.integrator;
+    job.with_maps = a.maps.is_some();
     let t0 = std::time::Instant::now();
     let out = render::render_frame(&job)?;
     let psf_img = match &psf {

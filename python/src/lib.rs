@@ -14,8 +14,9 @@ use mmbm::camera::Camera;
 use mmbm::gpu::Backend;
 use mmbm::io::gyro::{parse_rotation, GyroOptions, GyroSample};
 use mmbm::metric::{AnyMethod, Scene};
+use mmbm::model::log::ImuLog;
 use mmbm::model::motion::{Plane, Twist};
-use mmbm::render::{Integrator, Quality, RenderJob, Target, Trajectory};
+use mmbm::render::{FrameMotion, Integrator, Quality, RenderJob, Target};
 use mmbm::trigger::CameraTiming;
 use numpy::ndarray::{Array1, Array2, Array3};
 use numpy::{IntoPyArray, PyReadonlyArray1, PyReadonlyArray2};
@@ -405,43 +406,37 @@ fn render<'py>(
     sharp: bool,
 ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
     let camera = camera(&cam)?;
-    // A rolling shutter's lines are exposed one after another: the motion
-    // spans the readout plus the exposure (as in `mmbm render`).
-    let span = exposure + camera.shutter.readout_s;
-    let trajectory = match (omega, gyro) {
-        (Some(w), None) => {
-            Trajectory::from_twist(Twist::new(DVec3::from(w), DVec3::from(velocity)), span)
-                .map_err(err)?
-        }
-        (None, Some(g)) => {
-            let at = at.ok_or_else(|| PyValueError::new_err("at: required with gyro"))?;
-            let samples = dict_samples(&g)?;
-            Trajectory::from_log(&samples, at, span, use_velocity).map_err(err)?
-        }
-        _ => {
-            return Err(PyValueError::new_err(
-                "motion: give either omega or gyro (with at)",
-            ))
-        }
-    };
     let mut t = Target::parse(target, distance).map_err(err)?;
     t.tilt_deg = tilt;
     t.offset = offset;
     if let Some(b) = background {
         t.background = [b[0] as f32, b[1] as f32, b[2] as f32];
     }
-    t.validate_for(&camera).map_err(err)?;
-    let job = RenderJob {
-        camera,
-        exposure_s: exposure,
-        trajectory,
-        target: t,
-        quality: quality.parse::<Quality>().map_err(err)?,
-        backend: backend(backend_)?,
-        seed,
-        integrator: integrator.parse::<Integrator>().map_err(err)?,
-        with_maps: maps,
+    let log = match (&omega, &gyro) {
+        (None, Some(g)) => Some(ImuLog::new(dict_samples(g)?).map_err(err)?),
+        _ => None,
     };
+    let motion = match (omega, &log) {
+        (Some(w), None) => FrameMotion::Twist(Twist::new(DVec3::from(w), DVec3::from(velocity))),
+        (None, Some(log)) => FrameMotion::Log {
+            log,
+            at_s: at.ok_or_else(|| PyValueError::new_err("at: required with gyro"))?,
+            use_velocity,
+        },
+        _ => {
+            return Err(PyValueError::new_err(
+                "motion: give either omega or gyro (with at)",
+            ))
+        }
+    };
+    // The motion spans the camera's busy time (readout plus exposure), as in
+    // `mmbm render`.
+    let mut job = RenderJob::for_motion(camera, exposure, motion, t).map_err(err)?;
+    job.quality = quality.parse::<Quality>().map_err(err)?;
+    job.backend = backend(backend_)?;
+    job.seed = seed;
+    job.integrator = integrator.parse::<Integrator>().map_err(err)?;
+    job.with_maps = maps;
     let out = interruptible(py, err, || {
         if sharp {
             mmbm::render::render_sharp(&job)

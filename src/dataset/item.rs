@@ -12,7 +12,9 @@ use crate::io::input::{image_dimensions, is_regular_file};
 use crate::metric::{mmbm, Method, Scene};
 use crate::model::log::ImuLog;
 use crate::model::motion::{Plane, Twist};
-use crate::render::{self, Backend, Quality, RenderJob, RenderOutput, SharpAt, Target, Trajectory};
+use crate::render::{
+    self, Backend, FrameMotion, Quality, RenderJob, RenderOutput, SharpAt, Target,
+};
 use crate::sim::{simulate, GaitConfig};
 use glam::DVec3;
 use rand::{Rng, SeedableRng};
@@ -417,9 +419,13 @@ pub fn make(p: &ItemParams, src: &Sources, dir: &Path) -> Result<ItemMeasures> {
         }
     }
     let s = samples(p, cam.shutter.readout_s, src)?;
-    // The motion spans the readout (none for a global shutter) plus the exposure.
-    let span = cam.shutter.readout_s + p.exposure_s;
-    let traj = Trajectory::from_imu_log(&s, p.start_s, span, p.use_velocity)?;
+    // The motion spans the camera's busy time (readout plus exposure).
+    let traj = FrameMotion::Log {
+        log: &s,
+        at_s: p.start_s,
+        use_velocity: p.use_velocity,
+    }
+    .trajectory(&cam, p.exposure_s)?;
     crate::check::positive("texture_width_m", p.texture_width_m)?;
     let mut target =
         Target::from_texture(src.texture(&p.texture)?, p.texture_width_m, p.distance_m);

@@ -22,6 +22,7 @@ pub(crate) mod cpu;
 pub(crate) mod exact;
 pub(crate) mod gpu;
 pub(crate) mod homography;
+mod job;
 pub(crate) mod kernel;
 mod layout;
 pub mod maps;
@@ -34,13 +35,13 @@ pub mod texture;
 
 pub use crate::gpu::Backend;
 pub use crate::model::trajectory::{Pose, Trajectory};
+pub use job::{FrameMotion, RenderJob};
 pub use maps::{blur_maps, BlurMaps, BlurMeans};
 pub use poster::Background;
 pub use psf::{psf, Psf};
 pub use sharp::{render_sharp_at, SharpAt};
 pub use target::{project, Target, TargetKind, DEFAULT_BACKGROUND};
 
-use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::gpu::Resolved;
 use std::fmt;
@@ -51,27 +52,6 @@ pub use crate::limits::{MAX_PIXELS, MAX_PIXEL_SAMPLES};
 
 /// Most entries of a rolling-shutter homography table (lines x instants; 48 bytes each).
 pub const MAX_TABLE: u64 = 1 << 21;
-
-/// Checks the job's timing: a positive exposure, and a trajectory that spans
-/// the camera's readout plus the exposure (first line's exposure start to the
-/// last line's exposure end).
-fn check_timing(job: &RenderJob) -> Result<()> {
-    crate::check::positive("exposure", job.exposure_s)?;
-    let readout = job.camera.shutter.readout_s;
-    let span = readout + job.exposure_s;
-    let dur = job.trajectory.duration();
-    if (dur - span).abs() > 1e-9 * span.max(1.0) {
-        return Err(Error::invalid(
-            "trajectory",
-            format!(
-                "spans {dur} s, but an exposure of {} s with the camera's readout_s {readout} s \
-                 needs {span} s (readout + exposure)",
-                job.exposure_s
-            ),
-        ));
-    }
-    Ok(())
-}
 
 /// Largest sample count per pixel accepted (a longer blur is an error).
 pub const MAX_SAMPLES: u32 = 1 << 20;
@@ -229,51 +209,6 @@ impl fmt::Display for Integrator {
     }
 }
 
-/// One frame to render.
-#[derive(Debug, Clone)]
-pub struct RenderJob {
-    /// Camera intrinsics.
-    pub camera: Camera,
-    /// Exposure of each line, s (the whole frame's with a global shutter).
-    pub exposure_s: f64,
-    /// Camera motion from the first line's exposure start to the last line's
-    /// exposure end: [`Self::exposure_s`] plus the camera's rolling-shutter
-    /// readout when it has one (each line is exposed over its own window,
-    /// SPEC 9). Checked when the job renders.
-    pub trajectory: Trajectory,
-    /// The target.
-    pub target: Target,
-    /// Sampling quality.
-    pub quality: Quality,
-    /// GPU or CPU.
-    pub backend: Backend,
-    /// Seed of the per-pixel sample shifts.
-    pub seed: u32,
-    /// Also compute the per-pixel blur maps.
-    pub with_maps: bool,
-    /// Area integration.
-    pub integrator: Integrator,
-}
-
-impl RenderJob {
-    /// A frame exposed `exposure_s` seconds per line along `trajectory` (which
-    /// spans the camera's readout plus the exposure): default quality,
-    /// automatic backend, seed 0, with maps.
-    pub fn new(camera: Camera, exposure_s: f64, trajectory: Trajectory, target: Target) -> Self {
-        RenderJob {
-            camera,
-            exposure_s,
-            trajectory,
-            target,
-            quality: Quality::Default,
-            backend: Backend::Auto,
-            seed: 0,
-            with_maps: true,
-            integrator: Integrator::Auto,
-        }
-    }
-}
-
 /// A rendered frame.
 #[derive(Debug, Clone)]
 pub struct RenderOutput {
@@ -346,7 +281,7 @@ fn render_frame_stream(job: &RenderJob, stream: u64) -> Result<RenderOutput> {
             ),
         ));
     }
-    check_timing(job)?;
+    job.check_timing()?;
     let lmax = maps::max_path_px(cam, &job.target, &job.trajectory);
     let defocus = cam.lens.is_some();
     let analytic = match job.integrator {

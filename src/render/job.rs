@@ -1,0 +1,181 @@
+//! One frame to render ([`RenderJob`]), assembled once: the motion over the
+//! frame ([`FrameMotion`]: a constant twist or a window of a gyro log) is
+//! turned into a trajectory spanning the camera's busy time (exposure plus
+//! rolling-shutter readout, [`crate::camera::Shutter::busy_s`]), so callers
+//! (the CLI, Python, the dataset and experiment code) never derive the span
+//! themselves.
+
+use super::{Integrator, Quality, Target};
+use crate::camera::Camera;
+use crate::error::{Error, Result};
+use crate::gpu::Backend;
+use crate::model::log::ImuLog;
+use crate::model::motion::Twist;
+use crate::model::trajectory::Trajectory;
+
+/// Where the camera's motion over one frame comes from.
+#[derive(Debug, Clone, Copy)]
+pub enum FrameMotion<'a> {
+    /// A constant twist (angular velocity rad/s, linear velocity m/s).
+    Twist(Twist),
+    /// A gyro log, from `at_s` (s, the log's clock) on; linear velocity from
+    /// the log when `use_velocity` (it must have it).
+    Log {
+        /// The log (validated).
+        log: &'a ImuLog,
+        /// Start of the first line's exposure, s.
+        at_s: f64,
+        /// Also integrate the log's linear velocity.
+        use_velocity: bool,
+    },
+}
+
+impl FrameMotion<'_> {
+    /// The trajectory over a frame of `camera` exposed `exposure_s` s per line:
+    /// it spans `camera.shutter.busy_s(exposure_s)` (the first line's exposure
+    /// start to the last line's exposure end).
+    pub fn trajectory(&self, camera: &Camera, exposure_s: f64) -> Result<Trajectory> {
+        crate::check::positive("exposure", exposure_s)?;
+        let span = camera.shutter.busy_s(exposure_s);
+        match *self {
+            FrameMotion::Twist(tw) => Trajectory::from_twist(tw, span),
+            FrameMotion::Log {
+                log,
+                at_s,
+                use_velocity,
+            } => Trajectory::from_imu_log(log, at_s, span, use_velocity),
+        }
+    }
+}
+
+/// One frame to render.
+#[derive(Debug, Clone)]
+pub struct RenderJob {
+    /// Camera intrinsics.
+    pub camera: Camera,
+    /// Exposure of each line, s (the whole frame's with a global shutter).
+    pub exposure_s: f64,
+    /// Camera motion from the first line's exposure start to the last line's
+    /// exposure end: [`Self::exposure_s`] plus the camera's rolling-shutter
+    /// readout when it has one (each line is exposed over its own window,
+    /// SPEC 9). Checked when the job renders.
+    pub trajectory: Trajectory,
+    /// The target.
+    pub target: Target,
+    /// Sampling quality.
+    pub quality: Quality,
+    /// GPU or CPU.
+    pub backend: Backend,
+    /// Seed of the per-pixel sample shifts.
+    pub seed: u32,
+    /// Also compute the per-pixel blur maps.
+    pub with_maps: bool,
+    /// Area integration.
+    pub integrator: Integrator,
+}
+
+impl RenderJob {
+    /// A frame exposed `exposure_s` seconds per line along `trajectory` (which
+    /// spans the camera's readout plus the exposure): default quality,
+    /// automatic backend, seed 0, with maps.
+    pub fn new(camera: Camera, exposure_s: f64, trajectory: Trajectory, target: Target) -> Self {
+        RenderJob {
+            camera,
+            exposure_s,
+            trajectory,
+            target,
+            quality: Quality::Default,
+            backend: Backend::Auto,
+            seed: 0,
+            with_maps: true,
+            integrator: Integrator::Auto,
+        }
+    }
+
+    /// A frame exposed `exposure_s` seconds per line while the camera moves as
+    /// `motion` says: the trajectory spans the camera's busy time (exposure
+    /// plus readout). The target is checked against the camera. Defaults as
+    /// [`Self::new`].
+    pub fn for_motion(
+        camera: Camera,
+        exposure_s: f64,
+        motion: FrameMotion<'_>,
+        target: Target,
+    ) -> Result<Self> {
+        let trajectory = motion.trajectory(&camera, exposure_s)?;
+        target.validate_for(&camera)?;
+        Ok(Self::new(camera, exposure_s, trajectory, target))
+    }
+
+    /// Checks the job's timing: a positive exposure, and a trajectory that
+    /// spans the camera's readout plus the exposure (first line's exposure
+    /// start to the last line's exposure end).
+    pub(crate) fn check_timing(&self) -> Result<()> {
+        crate::check::positive("exposure", self.exposure_s)?;
+        let readout = self.camera.shutter.readout_s;
+        let span = self.camera.shutter.busy_s(self.exposure_s);
+        let dur = self.trajectory.duration();
+        if (dur - span).abs() > 1e-9 * span.max(1.0) {
+            return Err(Error::invalid(
+                "trajectory",
+                format!(
+                    "spans {dur} s, but an exposure of {} s with the camera's readout_s {readout} s \
+                     needs {span} s (readout + exposure)",
+                    self.exposure_s
+                ),
+            ));
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::DVec3;
+
+    fn rolling() -> Camera {
+        let mut cam = Camera::thesis();
+        cam.shutter.readout_s = 0.02;
+        cam
+    }
+
+    /// The trajectory spans exposure + readout (0.01 + 0.02 s), the job's
+    /// timing check accepts it, and a trajectory over the exposure alone
+    /// (what a caller that forgot the readout would build) is refused.
+    #[test]
+    fn a_job_spans_the_exposure_plus_the_readout() {
+        let tw = Twist::new(DVec3::new(0.1, 0.2, 0.3), DVec3::ZERO);
+        let target = Target::checker(0.05, 2.0);
+        let job =
+            RenderJob::for_motion(rolling(), 0.01, FrameMotion::Twist(tw), target.clone()).unwrap();
+        assert!((job.trajectory.duration() - 0.03).abs() < 1e-15);
+        job.check_timing().unwrap();
+        let short = Trajectory::from_twist(tw, 0.01).unwrap();
+        let bad = RenderJob::new(rolling(), 0.01, short, target);
+        let e = bad.check_timing().unwrap_err().to_string();
+        assert!(e.contains("readout"), "{e}");
+    }
+
+    /// A log window starts at `at_s` and spans the busy time too; a window
+    /// past the log's end is an error, not a panic.
+    #[test]
+    fn a_log_window_spans_the_busy_time() {
+        let s = |t| crate::model::log::GyroSample {
+            t,
+            omega: DVec3::new(0.0, 0.0, 1.0),
+            velocity: None,
+            depth: None,
+        };
+        let log = ImuLog::new((0..100).map(|k| s(k as f64 * 0.005)).collect()).unwrap();
+        let at = |at_s| FrameMotion::Log {
+            log: &log,
+            at_s,
+            use_velocity: false,
+        };
+        let traj = at(0.1).trajectory(&rolling(), 0.01).unwrap();
+        assert!((traj.duration() - 0.03).abs() < 1e-15);
+        assert!(at(0.48).trajectory(&rolling(), 0.01).is_err());
+        assert!(at(0.1).trajectory(&rolling(), 0.0).is_err());
+    }
+}
