@@ -10,7 +10,7 @@ use mmbm::camera::{CameraFile, CameraOverrides};
 use mmbm::Camera;
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
-use std::process::{Output, Stdio};
+use std::process::Output;
 use std::time::{Duration, Instant};
 
 /// A plain Gyroflow profile of a 1920 x 1080 video (fx = fy = 1000 px).
