@@ -260,10 +260,13 @@ pub fn estimate(
     let o_coarse = offsets[jbest];
     let refine = |r: f64| -> (f64, f64) {
         let m = (FINE_HALF_S / FINE_STEP_S).round() as i64;
+        // A later readout moves the lines' times by (r - r_mid) x the mean
+        // line fraction (about 1/2), and the best offset with them.
+        let centre_r = o_coarse + 0.5 * (r - r_mid);
         let pts: Vec<(f64, f64)> = (-m..=m)
             .into_par_iter()
             .map(|k| {
-                let o = o_coarse + k as f64 * FINE_STEP_S;
+                let o = centre_r + k as f64 * FINE_STEP_S;
                 let s = p.sums(o, r);
                 (
                     o,
