@@ -32,7 +32,7 @@ impl VideoInfo {
     /// The analysis size: at most [`SYNC_MAX_WIDTH_PX`] wide, the aspect
     /// kept, both sides even (at least 2), px.
     pub fn analysis_size(&self) -> (u32, u32) {
-        let w = self.width.min(SYNC_MAX_WIDTH_PX).max(2) & !1;
+        let w = self.width.clamp(2, SYNC_MAX_WIDTH_PX) & !1;
         let h = ((self.height as f64 * w as f64 / self.width as f64).round() as u32).max(2) & !1;
         (w, h)
     }

@@ -239,11 +239,12 @@ mod tests {
         for y in 0..h {
             for x in 0..w {
                 let (u, v) = (x as f64 - sx, y as f64 - sy);
+                // Periods of 40 to 140 px: no repeat within the search's reach.
                 let p = 128.0
-                    + 40.0 * (0.21 * u + 0.05 * v).sin()
-                    + 30.0 * (0.13 * v - 0.07 * u + 1.0).sin()
-                    + 25.0 * (0.31 * u + 0.27 * v + 2.0).sin()
-                    + 20.0 * (0.09 * u * 0.5 + 0.41 * v).cos();
+                    + 40.0 * (0.11 * u + 0.03 * v).sin()
+                    + 30.0 * (0.07 * v - 0.05 * u + 1.0).sin()
+                    + 25.0 * (0.13 * u + 0.09 * v + 2.0).sin()
+                    + 20.0 * (0.045 * u + 0.15 * v).cos();
                 px.push(p as f32);
             }
         }
