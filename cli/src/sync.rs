@@ -50,7 +50,7 @@ pub struct SyncArgs {
 
 pub fn run(a: SyncArgs) -> Result<()> {
     let exposure_s = match a.exposure {
-        Some(e) if !(e.is_finite() && e >= 0.0 && e <= 1.0) => {
+        Some(e) if !(0.0..=1.0).contains(&e) => {
             return Err(Error::invalid(
                 "--exposure",
                 format!("{e}: expected a finite exposure of 0 to 1 s"),
