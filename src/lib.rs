@@ -20,7 +20,7 @@
 //! | 1 | [`camera`], [`model`], [`io`], [`gpu`] | the camera (intrinsics, distortion, shutter, noise, lens); motion, flow; files; the wgpu device and compute plumbing |
 //! | 2 | [`metric`], [`board`], [`plot`], [`sim`], [`assess`] | MMBM rules; the thesis board, blobs, pose; figures; gait simulation; image blur metrics |
 //! | 3 | [`field`], [`tables`] | the flow-field kernel (GPU + CPU twin); thesis tables |
-//! | 4 | [`series`], [`render`] | MMBM of a log (CPU and GPU batch); the blur renderer |
+//! | 4 | [`series`], [`render`], [`sync`] | MMBM of a log (CPU and GPU batch); the blur renderer; the gyro-to-video offset from the video (ffmpeg) |
 //! | 5 | [`trigger`], [`augment`] | trigger policies; motion-blur augmentation of any image |
 //! | 6 | [`experiment`], [`dataset`] | the thesis experiment end to end; blur datasets at scale |
 //!
@@ -51,6 +51,7 @@ pub mod render;
 pub mod series;
 pub mod sim;
 pub mod stats;
+pub mod sync;
 pub mod tables;
 pub mod trigger;
 

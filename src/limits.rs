@@ -159,3 +159,20 @@ pub const MIN_SHARD_BYTES: u64 = 1 << 16;
 /// Largest WebDataset tar shard size `--shard-bytes` accepts, bytes (1 TiB:
 /// far past WebDataset's usual 1 GB; a tar shard is read as one stream).
 pub const MAX_SHARD_BYTES: u64 = 1 << 40;
+
+// == sync (video decoding) ==
+
+/// Most frames `mmbm sync` decodes from one video, frames: checked from
+/// ffprobe's duration x frame rate before decoding, and again while it
+/// decodes. Memory: about 0.4 KB of patch sums per frame (80 MB at the cap,
+/// 55 minutes at 60 fps).
+pub const SYNC_MAX_FRAMES: usize = 200_000;
+
+/// Widest analysis image of `mmbm sync`, px: ffmpeg scales every frame down
+/// to it (aspect kept) before mmbm sees it, so a frame held is at most
+/// 480 x 480 grey bytes whatever the video's size.
+pub const SYNC_MAX_WIDTH_PX: u32 = 480;
+
+/// Largest `mmbm sync --search` (half width of the offset search), s: the
+/// search's work grows with it (one score per 2 ms).
+pub const SYNC_MAX_SEARCH_S: f64 = 60.0;

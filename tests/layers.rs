@@ -33,6 +33,7 @@ const LAYERS: &[(&str, u32)] = &[
     ("tables", 3),
     ("series", 4),
     ("render", 4),
+    ("sync", 4),
     ("trigger", 5),
     ("experiment", 6),
     ("dataset", 6),

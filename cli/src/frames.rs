@@ -43,6 +43,10 @@ pub struct FramesArgs {
     /// Exposure of every frame, s, for a table of times only (ffprobe's).
     #[arg(long, value_name = "S")]
     pub exposure: Option<f64>,
+    /// The TOML `mmbm sync` wrote: its offset_s as --time-offset (not both), and its
+    /// readout_s unless --rolling-readout, the camera or the log gives one.
+    #[arg(long, value_name = "FILE", conflicts_with = "time_offset")]
+    pub sync: Option<PathBuf>,
     /// riemann[:NUxNV], gauss[:N] or exact[:TOL] (gpu is not available here).
     #[arg(long, default_value = "riemann:8x6")]
     pub method: AnyMethod,
@@ -83,6 +87,7 @@ pub fn run(a: FramesArgs) -> Result<()> {
         .input("--gyro", Some(&a.gyro))
         .input("--frames", Some(&a.frames))
         .input("--camera", a.camera.camera.as_deref())
+        .input("--sync", a.sync.as_deref())
         .check()?;
     let method = match a.method {
         AnyMethod::Cpu(m) => m,
@@ -100,8 +105,23 @@ pub fn run(a: FramesArgs) -> Result<()> {
     }
     let frames = read_frame_table(&a.frames, a.exposure)?;
     mmbm::series::select::check_frame_start(a.choice.frame_start, frames.len())?;
-    let samples = read_log(&a.gyro, a.gyro_opts.options()?)?;
+    let synced = a
+        .sync
+        .as_deref()
+        .map(super::sync::read_for_frames)
+        .transpose()?;
+    let mut gyro_opts = a.gyro_opts.options()?;
+    if let Some(s) = &synced {
+        gyro_opts.time_offset = s.offset_s;
+    }
+    let samples = read_log(&a.gyro, gyro_opts)?;
     let camera = super::args::with_log_readout(camera, samples.readout(), &a.gyro)?;
+    let camera = match (&synced, &a.sync) {
+        (Some(s), Some(path)) => {
+            super::sync::synced_readout(camera, s, path, a.camera.rolling_readout.is_some())
+        }
+        _ => camera,
+    };
     let opts = SeriesOptions {
         scene: Scene {
             camera,

@@ -19,6 +19,7 @@ mod live;
 mod render;
 mod series;
 mod simulate;
+mod sync;
 mod tables;
 mod trigger;
 
@@ -60,6 +61,8 @@ enum Command {
     Info,
     /// Per-pixel flow field at sensor resolution on the GPU (EXR, optional quiver PNG).
     Flow(flow::FlowArgs),
+    /// The gyro-to-video clock offset (and readout) from the video's motion (ffmpeg).
+    Sync(sync::SyncArgs),
     /// Render a ground-truth motion-blurred image of a planar target.
     Render(render::RenderArgs),
     /// Simulate a legged gait: a seeded gyro log.
@@ -124,6 +127,7 @@ fn run() -> i32 {
         Command::Info => info::run(),
         Command::Flow(a) => flow::run(a),
         Command::Render(a) => render::run(a),
+        Command::Sync(a) => sync::run(a),
         Command::Simulate(a) => simulate::run(a),
         Command::Trigger(a) => trigger::run(a),
         Command::Assess(a) => assess::run(a),

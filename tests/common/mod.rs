@@ -318,3 +318,21 @@ pub fn simulated_walk(dir: &Path) -> PathBuf {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     p
 }
+
+/// True when `ffmpeg` and `ffprobe` run (`mmbm sync` and the clip tests need
+/// them); else skipped, a failure under `MMBM_REQUIRE_FFMPEG=1` (as in CI).
+pub fn ffmpeg() -> bool {
+    let runs = |p: &str| {
+        Command::new(p)
+            .arg("-version")
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .status()
+            .is_ok_and(|s| s.success())
+    };
+    if runs("ffmpeg") && runs("ffprobe") {
+        return true;
+    }
+    missing("MMBM_REQUIRE_FFMPEG", "ffmpeg or ffprobe is not on PATH");
+    false
+}
