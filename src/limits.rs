@@ -159,3 +159,16 @@ pub const MIN_SHARD_BYTES: u64 = 1 << 16;
 /// Largest WebDataset tar shard size `--shard-bytes` accepts, bytes (1 TiB:
 /// far past WebDataset's usual 1 GB; a tar shard is read as one stream).
 pub const MAX_SHARD_BYTES: u64 = 1 << 40;
+
+// == video frames (frames --image-metric, --extract) ==
+
+/// Widest a decoded frame is scored at by `frames --image-metric`, px:
+/// ffmpeg scales each frame to at most this width (aspect kept) before the
+/// image metric, so one frame in memory is at most 640 x 640 x aspect bytes
+/// (grey), and the metric's time per frame is bounded.
+pub const SCORE_MAX_WIDTH: u32 = 640;
+
+/// Longest ffmpeg `select` expression `frames --extract` passes on
+/// ffmpeg's command line, bytes (Linux takes 128 KiB per argument); a
+/// longer choice is refused before ffmpeg runs.
+pub const MAX_SELECT_EXPR_BYTES: usize = 100_000;
