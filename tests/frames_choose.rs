@@ -106,12 +106,35 @@ fn per_window_and_per_seconds_pick_each_window_s_least_blur() {
     let d = folder("window");
     let b = blurs(60);
     clip(&d, &b, 0.0);
-    let err = ok(&d, &["--per-window", "10", "--image-list", "w.txt", "--out", "w.csv"]);
+    let err = ok(
+        &d,
+        &[
+            "--per-window",
+            "10",
+            "--image-list",
+            "w.txt",
+            "--out",
+            "w.csv",
+        ],
+    );
     let want: Vec<usize> = (0..6).map(|i| argmin(&b, i * 10..i * 10 + 10)).collect();
     assert_eq!(listed(&d.join("w.txt")), want, "{err}");
-    assert!(err.contains("chosen: 6 frames") && err.contains("largest hole"), "{err}");
+    assert!(
+        err.contains("chosen: 6 frames") && err.contains("largest hole"),
+        "{err}"
+    );
     // 0.1 s apart: windows of 0.5 s hold frames 0-4, 5-9, ... (0.5, 1.0, ... are exact in binary).
-    ok(&d, &["--per-seconds", "0.5", "--image-list", "s.txt", "--out", "s.csv"]);
+    ok(
+        &d,
+        &[
+            "--per-seconds",
+            "0.5",
+            "--image-list",
+            "s.txt",
+            "--out",
+            "s.csv",
+        ],
+    );
     let want: Vec<usize> = (0..12).map(|i| argmin(&b, i * 5..i * 5 + 5)).collect();
     assert_eq!(listed(&d.join("s.txt")), want);
     // The table holds the same rows.
@@ -130,14 +153,22 @@ fn count_covers_evenly_with_a_bounded_hole() {
     let d = folder("count");
     let b = blurs(60);
     clip(&d, &b, 0.0);
-    let err = ok(&d, &["--count", "7", "--image-list", "c.txt", "--out", "c.csv"]);
+    let err = ok(
+        &d,
+        &["--count", "7", "--image-list", "c.txt", "--out", "c.csv"],
+    );
     let got = listed(&d.join("c.txt"));
     // Window i: rows floor(60 i / 7) up to floor(60 (i+1) / 7).
-    let want: Vec<usize> = (0..7).map(|i| argmin(&b, i * 60 / 7..(i + 1) * 60 / 7)).collect();
+    let want: Vec<usize> = (0..7)
+        .map(|i| argmin(&b, i * 60 / 7..(i + 1) * 60 / 7))
+        .collect();
     assert_eq!(got, want, "{err}");
     // No two picks more than 2 ceil(60/7) - 1 = 17 frames apart.
     assert!(got.windows(2).all(|w| w[1] - w[0] <= 17), "{got:?}");
-    assert!(err.contains("chosen: 7 frames") && err.contains("largest hole"), "{err}");
+    assert!(
+        err.contains("chosen: 7 frames") && err.contains("largest hole"),
+        "{err}"
+    );
     let _ = std::fs::remove_dir_all(&d);
 }
 
@@ -147,12 +178,34 @@ fn budget_keeps_exactly_the_frames_under_it() {
     let b = blurs(40);
     clip(&d, &b, 0.0);
     // Budgets halfway between the blurs (0.1 px apart; the model's is b (1 + 1e-5)).
-    ok(&d, &["--max-blur", "4.55", "--image-list", "b.txt", "--out", "b.csv"]);
+    ok(
+        &d,
+        &[
+            "--max-blur",
+            "4.55",
+            "--image-list",
+            "b.txt",
+            "--out",
+            "b.csv",
+        ],
+    );
     let want: Vec<usize> = (0..40).filter(|&k| b[k] <= 4.55).collect();
     assert!(!want.is_empty() && want.len() < 40);
     assert_eq!(listed(&d.join("b.txt")), want);
     // A budget with windows: each window's pick within it, or none.
-    let err = ok(&d, &["--per-window", "5", "--max-blur", "2.05", "--image-list", "bw.txt", "--out", "bw.csv"]);
+    let err = ok(
+        &d,
+        &[
+            "--per-window",
+            "5",
+            "--max-blur",
+            "2.05",
+            "--image-list",
+            "bw.txt",
+            "--out",
+            "bw.csv",
+        ],
+    );
     let want: Vec<usize> = (0..8)
         .map(|i| argmin(&b, i * 5..i * 5 + 5))
         .filter(|&k| b[k] <= 2.05)
@@ -170,7 +223,10 @@ fn select_says_why_it_chose_fewer() {
     clip(&d, &blurs(40), 0.0);
     let err = ok(&d, &["--select", "30", "--gap", "0.25", "--out", "x.csv"]);
     assert!(err.contains("fewer than --select 30"), "{err}");
-    assert!(err.contains("within --gap 0.25 s of a sharper pick"), "{err}");
+    assert!(
+        err.contains("within --gap 0.25 s of a sharper pick"),
+        "{err}"
+    );
     let _ = std::fs::remove_dir_all(&d);
 }
 
@@ -184,10 +240,30 @@ fn modes_refuse_bad_values_by_flag() {
         (&["--per-seconds", "0"], "--per-seconds"),
         (&["--per-seconds", "NaN"], "--per-seconds"),
         (&["--count", "3", "--gap", "0.5"], "--gap"),
-        (&["--select", "3", "--image-metric", "laplacian", "--video", "frames.csv"], "--image-metric"),
+        (
+            &[
+                "--select",
+                "3",
+                "--image-metric",
+                "laplacian",
+                "--video",
+                "frames.csv",
+            ],
+            "--image-metric",
+        ),
         (&["--count", "3", "--per-window", "2"], "--per-window"),
         (&["--count", "3", "--extract", "x"], "--video"),
-        (&["--count", "3", "--image-metric", "sobel", "--video", "v.mp4"], "--image-metric"),
+        (
+            &[
+                "--count",
+                "3",
+                "--image-metric",
+                "sobel",
+                "--video",
+                "v.mp4",
+            ],
+            "--image-metric",
+        ),
         (&["--maps-format", "half"], "--maps"),
     ] {
         let o = run(&d, &[args, &["--out", "o.csv"]].concat());
@@ -209,20 +285,40 @@ fn no_frame_inside_the_log_is_refused_with_both_spans_and_an_offset() {
         f += &format!("{:.6},0.01\n", 100.0 + 0.1 * k as f64);
     }
     std::fs::write(d.join("frames.csv"), f).unwrap();
-    let o = run(&d, &["--count", "5", "--image-list", "l.txt", "--out", "o.csv"]);
+    let o = run(
+        &d,
+        &["--count", "5", "--image-list", "l.txt", "--out", "o.csv"],
+    );
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(!o.status.success(), "{err}");
     assert!(err.contains("no frame lies inside the gyro log"), "{err}");
-    assert!(err.contains("100.000 to 101.910 s") && err.contains("-0.100 to"), "{err}");
+    assert!(
+        err.contains("100.000 to 101.910 s") && err.contains("-0.100 to"),
+        "{err}"
+    );
     // The video (1.91 s) fits in the log (2.2 s): align the starts, +100.1 s.
     assert!(err.contains("--time-offset=100.100"), "{err}");
     assert!(!d.join("l.txt").exists() && !d.join("o.csv").exists());
     // With that offset the same run works.
-    ok(&d, &["--count", "5", "--image-list", "l.txt", "--out", "o.csv", "--time-offset=100.1"]);
+    ok(
+        &d,
+        &[
+            "--count",
+            "5",
+            "--image-list",
+            "l.txt",
+            "--out",
+            "o.csv",
+            "--time-offset=100.1",
+        ],
+    );
     assert_eq!(listed(&d.join("l.txt")).len(), 5);
     // Some frames outside: a warning naming the spans.
     let err = ok(&d, &["--time-offset=99.5", "--out", "p.csv"]);
-    assert!(err.contains("reach outside the gyro log") && err.contains("the frames span"), "{err}");
+    assert!(
+        err.contains("reach outside the gyro log") && err.contains("the frames span"),
+        "{err}"
+    );
     let _ = std::fs::remove_dir_all(&d);
 }
 
@@ -230,10 +326,24 @@ fn no_frame_inside_the_log_is_refused_with_both_spans_and_an_offset() {
 fn without_a_camera_the_default_is_named() {
     let d = folder("camera");
     clip(&d, &blurs(5), 0.0);
-    let o = mmbm_in(&d, &["frames", "--gyro", "gyro.csv", "--frames", "frames.csv", "--out", "o.csv"]);
+    let o = mmbm_in(
+        &d,
+        &[
+            "frames",
+            "--gyro",
+            "gyro.csv",
+            "--frames",
+            "frames.csv",
+            "--out",
+            "o.csv",
+        ],
+    );
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(o.status.success(), "{err}");
-    assert!(err.contains("no --camera") && err.contains("640x480") && err.contains("--camera FILE"), "{err}");
+    assert!(
+        err.contains("no --camera") && err.contains("640x480") && err.contains("--camera FILE"),
+        "{err}"
+    );
     let err = ok(&d, &["--out", "o.csv"]);
     assert!(!err.contains("no --camera"), "{err}");
     let _ = std::fs::remove_dir_all(&d);
@@ -247,8 +357,20 @@ fn maps_are_named_as_the_image_list_names_the_frames_half_and_chosen_channels() 
     let err = ok(
         &d,
         &[
-            "--per-window", "4", "--image-list", "l.txt", "--frame-name", "img_%03d.jpg",
-            "--frame-start", "0", "--maps", "m", "--backend", "cpu", "--out", "o.csv",
+            "--per-window",
+            "4",
+            "--image-list",
+            "l.txt",
+            "--frame-name",
+            "img_%03d.jpg",
+            "--frame-start",
+            "0",
+            "--maps",
+            "m",
+            "--backend",
+            "cpu",
+            "--out",
+            "o.csv",
         ],
     );
     let list = std::fs::read_to_string(d.join("l.txt")).unwrap();
@@ -267,14 +389,31 @@ fn maps_are_named_as_the_image_list_names_the_frames_half_and_chosen_channels() 
     // The path of a pixel is the blur, 100 w px = b px (to 1e-5), in half floats (3 digits).
     let path = &ch.iter().find(|c| c.0 == "path_px").unwrap().1;
     let want_b = b[argmin(&b, 0..4)];
-    assert!(path.iter().all(|&p| ((p as f64) - want_b).abs() < want_b * 2e-3), "{want_b}");
+    assert!(
+        path.iter()
+            .all(|&p| ((p as f64) - want_b).abs() < want_b * 2e-3),
+        "{want_b}"
+    );
     let half = std::fs::metadata(&first).unwrap().len();
     ok(
         &d,
         &[
-            "--per-window", "4", "--frame-name", "img_%03d.jpg", "--frame-start", "0",
-            "--maps", "f", "--maps-format", "float", "--maps-channels", "path_px,disp.u",
-            "--backend", "cpu", "--out", "o2.csv",
+            "--per-window",
+            "4",
+            "--frame-name",
+            "img_%03d.jpg",
+            "--frame-start",
+            "0",
+            "--maps",
+            "f",
+            "--maps-format",
+            "float",
+            "--maps-channels",
+            "path_px,disp.u",
+            "--backend",
+            "cpu",
+            "--out",
+            "o2.csv",
         ],
     );
     let (_, _, ch) = mmbm::io::images::read_exr(&d.join("f").join(&want[0])).unwrap();
@@ -282,9 +421,24 @@ fn maps_are_named_as_the_image_list_names_the_frames_half_and_chosen_channels() 
     got.sort();
     assert_eq!(got, ["disp.u", "path_px"]);
     assert!(half > 0);
-    let o = run(&d, &["--count", "2", "--maps", "g", "--maps-channels", "blur", "--out", "o3.csv"]);
+    let o = run(
+        &d,
+        &[
+            "--count",
+            "2",
+            "--maps",
+            "g",
+            "--maps-channels",
+            "blur",
+            "--out",
+            "o3.csv",
+        ],
+    );
     let err = String::from_utf8_lossy(&o.stderr);
-    assert!(!o.status.success() && err.contains("--maps-channels") && err.contains("flow.v"), "{err}");
+    assert!(
+        !o.status.success() && err.contains("--maps-channels") && err.contains("flow.v"),
+        "{err}"
+    );
     assert!(!d.join("g").exists() && !d.join("o3.csv").exists());
     let _ = std::fs::remove_dir_all(&d);
 }
@@ -309,7 +463,15 @@ fn ffmpeg() -> Option<()> {
 fn video(d: &Path, blurred: &str) {
     let vf = format!("boxblur=8:4:enable='{blurred}'");
     let o = Command::new("ffmpeg")
-        .args(["-v", "error", "-y", "-f", "lavfi", "-i", "testsrc=size=128x96:rate=10:duration=3"])
+        .args([
+            "-v",
+            "error",
+            "-y",
+            "-f",
+            "lavfi",
+            "-i",
+            "testsrc=size=128x96:rate=10:duration=3",
+        ])
         .args(["-vf", &vf, "-c:v", "ffv1", "v.mkv"])
         .current_dir(d)
         .output()
@@ -329,12 +491,26 @@ fn the_documented_ffmpeg_line_and_extract_give_the_listed_frames() {
     let err = ok(
         &d,
         &[
-            "--count", "4", "--image-list", "l.txt", "--ffmpeg-select", "s.select",
-            "--video", "v.mkv", "--extract", "x", "--out", "o.csv",
+            "--count",
+            "4",
+            "--image-list",
+            "l.txt",
+            "--ffmpeg-select",
+            "s.select",
+            "--video",
+            "v.mkv",
+            "--extract",
+            "x",
+            "--out",
+            "o.csv",
         ],
     );
     assert!(err.contains("extracted: 4"), "{err}");
-    let list: Vec<String> = std::fs::read_to_string(d.join("l.txt")).unwrap().lines().map(String::from).collect();
+    let list: Vec<String> = std::fs::read_to_string(d.join("l.txt"))
+        .unwrap()
+        .lines()
+        .map(String::from)
+        .collect();
     let mut got: Vec<String> = std::fs::read_dir(d.join("x"))
         .unwrap()
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
@@ -353,17 +529,37 @@ fn the_documented_ffmpeg_line_and_extract_give_the_listed_frames() {
         .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     for (i, name) in list.iter().enumerate() {
-        let a = image::open(d.join("sharp").join(format!("out_{:04}.png", i + 1))).unwrap().to_luma8();
+        let a = image::open(d.join("sharp").join(format!("out_{:04}.png", i + 1)))
+            .unwrap()
+            .to_luma8();
         let x = image::open(d.join("x").join(name)).unwrap().to_luma8();
         assert_eq!(a, x, "{name}");
     }
-    assert!(!d.join("sharp").join(format!("out_{:04}.png", list.len() + 1)).exists());
+    assert!(!d
+        .join("sharp")
+        .join(format!("out_{:04}.png", list.len() + 1))
+        .exists());
     // A video with another frame count than the table is refused, nothing written.
     let f = std::fs::read_to_string(d.join("frames.csv")).unwrap();
     std::fs::write(d.join("frames.csv"), format!("{f}3.0,0.01\n")).unwrap();
-    let o = run(&d, &["--count", "4", "--video", "v.mkv", "--extract", "y", "--out", "o4.csv"]);
+    let o = run(
+        &d,
+        &[
+            "--count",
+            "4",
+            "--video",
+            "v.mkv",
+            "--extract",
+            "y",
+            "--out",
+            "o4.csv",
+        ],
+    );
     let err = String::from_utf8_lossy(&o.stderr);
-    assert!(!o.status.success() && err.contains("30 frames") && err.contains("31 rows"), "{err}");
+    assert!(
+        !o.status.success() && err.contains("30 frames") && err.contains("31 rows"),
+        "{err}"
+    );
     assert!(!d.join("y").exists() && !d.join("o4.csv").exists());
     let _ = std::fs::remove_dir_all(&d);
 }
@@ -384,16 +580,31 @@ fn the_hybrid_overrides_a_defocused_gyro_pick() {
         let err = ok(
             &d,
             &[
-                "--per-window", "10", "--image-metric", metric, "--video", "v.mkv",
-                "--image-list", &l, "--out", "o.csv",
+                "--per-window",
+                "10",
+                "--image-metric",
+                metric,
+                "--video",
+                "v.mkv",
+                "--image-list",
+                &l,
+                "--out",
+                "o.csv",
             ],
         );
         let got = listed(&d.join(&l));
         let mut rest: Vec<usize> = (0..10).filter(|&k| k != g0).collect();
         rest.sort_by(|&x, &y| b[x].total_cmp(&b[y]));
         assert_eq!(got[0], rest[0], "{metric}: {err}");
-        assert_eq!(got[1..], [argmin(&b, 10..20), argmin(&b, 20..30)], "{metric}: {err}");
-        assert!(err.contains("overridden by") && err.contains("in 1 "), "{metric}: {err}");
+        assert_eq!(
+            got[1..],
+            [argmin(&b, 10..20), argmin(&b, 20..30)],
+            "{metric}: {err}"
+        );
+        assert!(
+            err.contains("overridden by") && err.contains("in 1 "),
+            "{metric}: {err}"
+        );
     }
     let _ = std::fs::remove_dir_all(&d);
 }
@@ -408,7 +619,16 @@ fn missing_ffmpeg_is_named_with_how_to_install_it() {
     let args: Vec<&str> = BASE
         .iter()
         .copied()
-        .chain(["--count", "3", "--image-metric", "laplacian", "--video", "v.mkv", "--out", "o.csv"])
+        .chain([
+            "--count",
+            "3",
+            "--image-metric",
+            "laplacian",
+            "--video",
+            "v.mkv",
+            "--out",
+            "o.csv",
+        ])
         .collect();
     let o = common::mmbm_cmd()
         .args(&args)
@@ -420,7 +640,10 @@ fn missing_ffmpeg_is_named_with_how_to_install_it() {
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(!o.status.success(), "{err}");
     assert!(err.contains("ffprobe") || err.contains("ffmpeg"), "{err}");
-    assert!(err.contains("install ffmpeg") && err.contains("apt install ffmpeg"), "{err}");
+    assert!(
+        err.contains("install ffmpeg") && err.contains("apt install ffmpeg"),
+        "{err}"
+    );
     assert!(!d.join("o.csv").exists());
     let _ = std::fs::remove_dir_all(&d);
 }

@@ -345,7 +345,15 @@ fn the_worked_example_runs() {
     let help = String::from_utf8(common::mmbm(&["frames", "--help"]).stdout).unwrap();
     // The video of the 50 frames, for the lines that decode it (ffmpeg's test pattern).
     let video = std::process::Command::new("ffmpeg")
-        .args(["-v", "error", "-y", "-f", "lavfi", "-i", "testsrc=size=160x120:rate=30"])
+        .args([
+            "-v",
+            "error",
+            "-y",
+            "-f",
+            "lavfi",
+            "-i",
+            "testsrc=size=160x120:rate=30",
+        ])
         .args(["-frames:v", "50", "-pix_fmt", "yuv420p", "video.mp4"])
         .current_dir(&d)
         .output()

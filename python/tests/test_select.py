@@ -23,8 +23,8 @@ def test_per_window_picks_each_window_s_minimum():
 
 def test_per_seconds_uses_the_times():
     b = blurs(20)
-    t = np.arange(20) * 0.1
-    got = mmbm.choose_frames(b, t, per_seconds=0.45)
+    t = np.arange(20) / 10  # windows of 0.5 s: frames 0-4, 5-9, ... (0.5, 1.0, 1.5 exact)
+    got = mmbm.choose_frames(b, t, per_seconds=0.5)
     want = [int(np.argmin(b[i : i + 5])) + i for i in range(0, 20, 5)]
     assert got.tolist() == want
     with pytest.raises(ValueError, match="times_s"):

@@ -221,7 +221,10 @@ pub fn stage_maps(
                     &root.join(&name),
                     out.format == MapsFormat::Half,
                     &out.channels,
-                )?;
+                )
+                // An interrupt may remove the staging folder under the write:
+                // the interrupt is the error, not the missing folder.
+                .map_err(|e| crate::cancel::check().err().unwrap_or(e))?;
                 staged.names.push(name);
                 let (mean, valid) = m.mean_path_px();
                 staged.written.written.push((k, mean, valid));

@@ -276,6 +276,41 @@ mod tests {
     }
 
     #[test]
+    fn coverage_counts_adjacent_pairs_and_the_largest_hole() {
+        // Frames 0.1 s apart, 1 and 8 without a value (the first and last
+        // with one: 0 and 9).
+        let b: Vec<Option<f64>> = (0..10).map(|k| (k != 1 && k != 8).then_some(1.0)).collect();
+        let t: Vec<f64> = (0..10).map(|k| k as f64 * 0.1).collect();
+        // Picks 2, 3, 7: one adjacent pair; holes 0.2 (0-2), 0.1, 0.4 (3-7), 0.2 (7-9).
+        let c = coverage(&[2, 3, 7], &b, &t).unwrap();
+        assert_eq!(c.adjacent_pairs, 1);
+        assert!((c.largest_hole_s - 0.4).abs() < 1e-12);
+        assert_eq!(c.hole, (3, 7));
+        assert!(coverage(&[], &b, &t).is_none());
+        // Why fewer: 2 without a value; with a 0.15 s gap the sharpest-first
+        // greedy keeps 0, 2, 4, 6, 9 (ties: the earlier) and refuses 3, 5, 7.
+        let (kept, r) = choose_series(
+            &b,
+            &t,
+            &Choice {
+                count: Some(9),
+                gap_s: 0.15,
+                max_blur_px: None,
+            },
+        )
+        .unwrap();
+        assert_eq!(kept, [0, 2, 4, 6, 9]);
+        assert_eq!(
+            r,
+            Refused {
+                without_value: 2,
+                over_budget: 0,
+                by_gap: 3
+            }
+        );
+    }
+
+    #[test]
     fn choose_keeps_the_sharpest_within_gap_and_budget() {
         let f = frames(&[Some(3.0), Some(1.0), Some(2.0), None, Some(0.5), Some(4.0)]);
         let all = |count, gap_s, max_blur_px| {
