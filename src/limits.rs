@@ -176,3 +176,16 @@ pub const SYNC_MAX_WIDTH_PX: u32 = 480;
 /// Largest `mmbm sync --search` (half width of the offset search), s: the
 /// search's work grows with it (one score per 2 ms).
 pub const SYNC_MAX_SEARCH_S: f64 = 60.0;
+
+// == video frames (frames --image-metric, --extract) ==
+
+/// Widest a decoded frame is scored at by `frames --image-metric`, px:
+/// ffmpeg scales each frame to at most this width (aspect kept) before the
+/// image metric, so one frame in memory is at most 640 x 640 x aspect bytes
+/// (grey), and the metric's time per frame is bounded.
+pub const SCORE_MAX_WIDTH: u32 = 640;
+
+/// Longest ffmpeg `select` expression `frames --extract` passes on
+/// ffmpeg's command line, bytes (Linux takes 128 KiB per argument); a
+/// longer choice is refused before ffmpeg runs.
+pub const MAX_SELECT_EXPR_BYTES: usize = 100_000;

@@ -347,8 +347,8 @@ fn cli_frames_maps() {
         v.sort();
         v
     };
-    assert_eq!(names, ["frame_000000.exr", "frame_000001.exr"]);
-    let (w, h, ch) = mmbm::io::images::read_exr(&dir.join("frame_000001.exr")).unwrap();
+    assert_eq!(names, ["frame_000001.exr", "frame_000002.exr"]);
+    let (w, h, ch) = mmbm::io::images::read_exr(&dir.join("frame_000002.exr")).unwrap();
     assert_eq!((w, h), (192, 108));
     let get = |n: &str| {
         ch.iter()

@@ -333,7 +333,7 @@ fn cli_frames_maps_backend() {
         "{err}"
     );
     for k in 0..2 {
-        let name = format!("frame_{k:06}.exr");
+        let name = format!("frame_{:06}.exr", k + 1);
         let (_, _, a) = mmbm::io::images::read_exr(&gpu.join(&name)).unwrap();
         let (_, _, b) = mmbm::io::images::read_exr(&cpu.join(&name)).unwrap();
         let get =
@@ -362,13 +362,13 @@ fn cli_frames_maps_backend() {
     let out = frames_maps(&gyro, &table, &cam, &gpu, &f, &["--backend", "gpu"]);
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(!out.status.success() && err.contains("poly3"), "{err}");
-    assert!(!gpu.join("frame_000000.exr").exists());
+    assert!(!gpu.join("frame_000001.exr").exists());
     let auto = tmp.path().join("poly3_auto");
     let out = frames_maps(&gyro, &table, &cam, &auto, &f, &["--backend", "auto"]);
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{err}");
     assert!(err.contains("poly3") && err.contains("on the CPU"), "{err}");
-    assert!(auto.join("frame_000000.exr").exists());
+    assert!(auto.join("frame_000001.exr").exists());
 }
 
 /// A `--backend` that is none of the four is refused by name, before any file is read.

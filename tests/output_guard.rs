@@ -322,9 +322,9 @@ fn failed_table_leaves_no_maps() {
     assert_eq!(
         left,
         [
-            "new/m/frame_000000.exr",
             "new/m/frame_000001.exr",
-            "new/m/frame_000002.exr"
+            "new/m/frame_000002.exr",
+            "new/m/frame_000003.exr"
         ],
         "{}",
         stderr(&o)

@@ -7,7 +7,8 @@ use mmbm::error::{Error, Result};
 use mmbm::io::frames::read_frame_table;
 use mmbm::io::gyro::read_log;
 use mmbm::series::frames::frame_mmbm;
-use mmbm::series::maps_write::{is_map_name, stage_maps};
+use mmbm::series::maps_write::{is_map_name, parse_channels, stage_maps, MapsFormat, MapsOutput};
+use mmbm::series::select::clock::{check_clock, Spans};
 use mmbm::series::SeriesOptions;
 use mmbm::{AnyMethod, Scene};
 use std::io::Write;
@@ -27,7 +28,13 @@ Examples:
   mmbm frames --gyro log.gcsv --frames frames.csv --camera lens_profile.json --scale-to 1920x1080 \\
       --select 20 --gap 0.5 --out sharpest.csv
   mmbm frames ... --select 200 --gap 0.2 --image-list sharp.txt --ffmpeg-select sharp.select \\
-      --worst --worst-list blurry.txt --worst-ffmpeg-select blurry.select"
+      --worst --worst-list blurry.txt --worst-ffmpeg-select blurry.select
+  mmbm frames ... --count 100 --image-list sharp.txt --video video.mp4 --extract sharp/
+  mmbm frames ... --per-window 10 --image-metric laplacian --video video.mp4 --image-list sharp.txt
+
+Without --camera the thesis's 640x480 camera is used (a note on stderr says so).
+If no frame lies inside the gyro log the command refuses, printing both time spans and a
+--time-offset to try."
 )]
 pub struct FramesArgs {
     /// Gyro log (CSV, Gyroflow .gcsv, ROS 2 .mcap, or a phone's IMU rows
@@ -55,13 +62,27 @@ pub struct FramesArgs {
     pub out: Option<PathBuf>,
     #[command(flatten)]
     pub choice: super::choose::ChoiceArgs,
-    /// Also write each frame's per-pixel blur fields to DIR/frame_NNNNNN.exr (float EXR: disp.u,
-    /// disp.v px, path_px, flow.u, flow.v px/s; NaN beyond the lens's radial limit), for the frames
-    /// written (all, or the --select ones) inside the log. The maps appear together with the table and
-    /// the lists, or not at all (staged in a hidden folder, removed on failure or interrupt); no other
-    /// output may lie in DIR.
+    /// Also write each frame's per-pixel blur fields to DIR, one EXR per frame named as
+    /// --image-list names the frame with the extension .exr (frame_000006.exr for
+    /// frame_000006.png), for the frames written (all, or the chosen ones) inside the log.
+    /// Channels: disp.u, disp.v (px), path_px (px), flow.u, flow.v (px/s); NaN beyond the
+    /// lens's radial limit. The maps appear together with the table and the lists, or not at
+    /// all (staged in a hidden folder, removed on failure or interrupt); no other output may
+    /// lie in DIR.
     #[arg(long, value_name = "DIR")]
     pub maps: Option<PathBuf>,
+    /// Samples of the --maps EXRs: half (f16, ZIP; about 3 significant digits) or float (f32, ZIP).
+    #[arg(
+        long,
+        value_name = "half|float",
+        default_value = "half",
+        requires = "maps"
+    )]
+    pub maps_format: MapsFormat,
+    /// Channels of the --maps EXRs, comma-separated, of disp.u, disp.v, path_px, flow.u,
+    /// flow.v (default: all five).
+    #[arg(long, value_name = "LIST", requires = "maps")]
+    pub maps_channels: Option<String>,
     /// Where --maps computes: cpu (f64, all cores), gpu (the maps kernel, or an error), auto
     /// (GPU if any adapter, else CPU) or bulk (a hardware GPU, else CPU). Lens models the
     /// kernel lacks run on the CPU (auto, bulk) or are an error (gpu).
@@ -98,7 +119,37 @@ pub fn run(a: FramesArgs) -> Result<()> {
             ))
         }
     };
+    let maps_out = MapsOutput {
+        name: a.choice.frame_name.with_extension("exr"),
+        start: a.choice.frame_start,
+        format: a.maps_format,
+        channels: match &a.maps_channels {
+            Some(list) => parse_channels(list)?,
+            None => MapsOutput::default().channels,
+        },
+    };
+    if a.maps.is_some() && a.choice.frame_name.has_folder() {
+        return Err(Error::invalid(
+            "--frame-name",
+            "--maps names the EXRs after it: give a name without a folder",
+        ));
+    }
     let camera = a.camera.camera()?;
+    if a.camera.camera.is_none() {
+        eprintln!(
+            "note: no --camera: using the thesis's camera ({}x{} px, focal {} mm, pitch {} mm{}); \
+             give yours with --camera FILE (TOML or a Gyroflow lens profile, docs/cameras.md)",
+            camera.width,
+            camera.height,
+            camera.focal_mm,
+            camera.pitch_x_mm,
+            if a.camera.focal.is_some() || a.camera.pitch.is_some() || a.camera.sensor.is_some() {
+                ", with the flags given"
+            } else {
+                ""
+            }
+        );
+    }
     if a.maps.is_some() {
         // The maps' size, before the log is read or anything allocated.
         mmbm::series::maps::check_size(&camera)?;
@@ -131,16 +182,30 @@ pub fn run(a: FramesArgs) -> Result<()> {
         use_velocity: a.use_velocity,
     };
     let (rows, outside) = frame_mmbm(&samples, &opts, &frames)?;
+    let log_t: Vec<f64> = samples.samples().iter().map(|s| s.t).collect();
+    let spans = Spans::of(&rows, &log_t);
+    let offset = a.gyro_opts.time_offset;
+    check_clock(spans, rows.len() - outside.len(), offset)?;
     if !outside.is_empty() {
         let list: Vec<String> = outside.iter().take(8).map(|k| k.to_string()).collect();
         eprintln!(
-            "warning: {} frame(s) reach outside the gyro log ({}{}): their values are empty",
+            "warning: {} frame(s) reach outside the gyro log ({}{}): their values are empty; {}",
             outside.len(),
             list.join(", "),
-            if outside.len() > 8 { ", ..." } else { "" }
+            if outside.len() > 8 { ", ..." } else { "" },
+            spans.map_or(String::new(), |s| s.describe(offset)),
         );
     }
-    let keep = a.choice.keep(&rows)?;
+    let sharpness = match (&a.choice.image_metric, &a.choice.video) {
+        (Some(m), Some(v)) => Some(mmbm::series::select::video::score_frames(
+            v,
+            *m,
+            rows.len(),
+        )?),
+        _ => None,
+    };
+    let kept = a.choice.keep(&rows, sharpness.as_deref())?;
+    let keep = &kept.rows;
     let write = |w: &mut dyn Write| -> Result<()> {
         let werr = |e: std::io::Error| mmbm::Error::io("<frames output>", e);
         writeln!(
@@ -150,7 +215,7 @@ pub fn run(a: FramesArgs) -> Result<()> {
         .map_err(werr)?;
         let opt =
             |x: Option<f64>| x.map_or(String::new(), |v| ryu::Buffer::new().format(v).to_string());
-        for &k in &keep {
+        for &k in keep {
             let r = &rows[k];
             writeln!(
                 w,
@@ -170,17 +235,41 @@ pub fn run(a: FramesArgs) -> Result<()> {
     // The maps go to a staging folder; they, the table and the lists appear
     // together once all were written, or none does.
     let staged = match &a.maps {
-        Some(dir) => Some(stage_maps(&samples, &opts, &frames, &keep, dir, a.backend)?),
+        Some(dir) => Some(stage_maps(
+            &samples, &opts, &frames, keep, dir, a.backend, &maps_out,
+        )?),
         None => None,
+    };
+    let extracted = match (&a.choice.extract, &a.choice.video) {
+        (Some(dir), Some(video)) => {
+            let mut staged = mmbm::series::maps_write::StagedMaps::empty(dir)?;
+            let names = mmbm::series::select::video::extract(
+                video,
+                keep,
+                &a.choice.frame_name,
+                a.choice.frame_start,
+                staged.root(),
+                rows.len(),
+            )?;
+            staged.add(names);
+            Some(staged)
+        }
+        _ => None,
     };
     let done = mmbm::io::atomic::all_or_nothing(|| {
         match &a.out {
             Some(p) => mmbm::io::atomic::write_atomic(p, |w| write(w))?,
             None => write(&mut std::io::stdout().lock())?,
         }
-        a.choice.write(&rows, &keep)?;
+        a.choice.write(&rows, &kept)?;
+        if let Some(x) = extracted {
+            x.publish()?;
+        }
         staged.map(|s| s.publish()).transpose()
     })?;
+    if let Some(dir) = &a.choice.extract {
+        eprintln!("extracted: {} frame(s) to {}", keep.len(), dir.display());
+    }
     if let (Some(dir), Some(done)) = (&a.maps, done) {
         let n = done.written.len();
         let mean = done.written.iter().map(|d| d.1).sum::<f64>() / n.max(1) as f64;

@@ -142,6 +142,9 @@ fn run() -> i32 {
     };
     match r {
         Ok(()) => 0,
+        // An error after Ctrl-C or SIGTERM (its removal of a staging folder
+        // under a write) is the interrupt: 130, as the handler exits.
+        Err(_) if control.is_stopped() => interrupted(),
         Err(e) => {
             eprintln!("error: {e}");
             1

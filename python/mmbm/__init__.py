@@ -38,6 +38,7 @@ __all__ = [
     "simulate",
     "trigger",
     "read_exr",
+    "choose_frames",
     "augment",
     "augment_batch",
     "BlurDataset",
@@ -394,6 +395,44 @@ def read_exr(src: Union[PathLike, bytes]) -> Dict[str, np.ndarray]:
     if isinstance(src, (bytes, bytearray, memoryview)):
         return _mmbm.read_exr(bytes(src))
     return _mmbm.read_exr(os.fspath(src))
+
+
+def choose_frames(
+    blur_px: ArrayLike,
+    times_s: Optional[ArrayLike] = None,
+    *,
+    per_window: Optional[int] = None,
+    per_seconds: Optional[float] = None,
+    count: Optional[int] = None,
+    select: Optional[int] = None,
+    gap: float = 0.0,
+    max_blur: Optional[float] = None,
+) -> np.ndarray:
+    """The chosen frames' indices (int64, in order) from each frame's blur,
+    px (NaN: no value, never chosen), as ``mmbm frames`` chooses them:
+    ``per_window=K`` the sharpest of every K frames, ``per_seconds=S`` of
+    every S s of ``times_s``, ``count=N`` of N windows of equal frame counts
+    (even coverage), ``select=N`` the N sharpest at least ``gap`` s apart;
+    ``max_blur`` alone every frame at most that blur, with a mode its picks
+    within it. ``times_s``: the frames' starts, s (default: the index)."""
+    b = np.ascontiguousarray(np.asarray(blur_px, dtype=np.float64).ravel())
+    t = None if times_s is None else np.ascontiguousarray(np.asarray(times_s, dtype=np.float64).ravel())
+    if t is not None and t.shape != b.shape:
+        raise ValueError(f"times_s has {t.size} values, blur_px {b.size}")
+    def opt_int(x: Any, name: str) -> Optional[int]:
+        if x is None:
+            return None
+        v = _int(x, name)
+        if v < 0:
+            raise ValueError(f"{name}: must be >= 0, got {v}")
+        return v
+
+    opt_f = lambda x: None if x is None else float(x)  # noqa: E731
+    got = _mmbm.choose_frames(
+        b, t, opt_int(per_window, "per_window"), opt_f(per_seconds), opt_int(count, "count"),
+        opt_int(select, "select"), float(gap), opt_f(max_blur),
+    )
+    return np.asarray(got, dtype=np.int64)
 
 
 _AUGMENT_DTYPES = (np.uint8, np.uint16, np.float32, np.float64)

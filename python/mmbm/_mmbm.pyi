@@ -65,6 +65,16 @@ def trigger(
     t: F64, mmbm_mm_s: F64, policies: List[str], exposure: float, delay: float, readout: float, min_interval: float, pitch_mm: float
 ) -> List[Dict[str, Any]]: ...
 def read_exr(src: Union[str, bytes]) -> Dict[str, F32]: ...
+def choose_frames(
+    blur_px: F64,
+    times_s: Optional[F64] = ...,
+    per_window: Optional[int] = ...,
+    per_seconds: Optional[float] = ...,
+    count: Optional[int] = ...,
+    select: Optional[int] = ...,
+    gap: float = ...,
+    max_blur: Optional[float] = ...,
+) -> List[int]: ...
 
 class DatasetMaker:
     def __init__(self, path: Optional[str] = ..., toml: Optional[str] = ...) -> None: ...

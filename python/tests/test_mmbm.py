@@ -217,12 +217,12 @@ def test_frame_maps_equal_cli(tmp_path):
     table.write_text("t_start,exposure_s\n5.258,0.0013\n99.0,0.001\n")
     d = tmp_path / "maps"
     cli("frames", "--gyro", str(g / "gyro.csv"), "--frames", str(table), "--camera", str(cam_file),
-        "--maps", str(d), "--out", str(tmp_path / "f.csv"))
+        "--maps", str(d), "--maps-format", "float", "--out", str(tmp_path / "f.csv"))
     log = mmbm.read_gyro(g / "gyro.csv")
     got = mmbm.frames(log["t"], log["omega"], [5.258, 99.0], [0.0013, 0.001],
                       camera=mmbm.Camera.from_file(cam_file), maps=True)
-    assert got["maps"][1] is None and not (d / "frame_000001.exr").exists()
-    e = mmbm.read_exr(d / "frame_000000.exr")
+    assert got["maps"][1] is None and not (d / "frame_000002.exr").exists()
+    e = mmbm.read_exr(d / "frame_000001.exr")
     assert sorted(got["maps"][0]) == sorted(e) == sorted(["disp.u", "disp.v", "path_px", "flow.u", "flow.v"])
     for name, a in got["maps"][0].items():
         assert a.shape == (108, 192) and a.dtype == np.float32

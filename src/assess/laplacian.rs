@@ -10,7 +10,7 @@ use crate::error::{Error, Result};
 use image::GrayImage;
 
 /// Index into `0..n` with a reflect-101 border (`n = 1` maps everything to 0).
-fn mirror(i: isize, n: usize) -> usize {
+pub(crate) fn mirror(i: isize, n: usize) -> usize {
     if n == 1 {
         return 0;
     }

@@ -19,6 +19,7 @@
 //! - [`blur_effect()`]: Crete et al. 2007 blur effect exactly as scikit-image's
 //!   `skimage.measure.blur_effect` (0 sharp .. 1 blurred).
 //! - [`laplacian_var()`]: variance of the 4-neighbour Laplacian (higher = sharper).
+//! - [`tenengrad()`]: mean squared Sobel gradient magnitude (higher = sharper).
 //!
 //! [`assess`] computes all six; JNBM is `None` when it is undefined (no edge
 //! block with a measured width, see [`jnbm()`]).
@@ -30,6 +31,7 @@ pub mod edges;
 pub(crate) mod jnbm;
 pub(crate) mod laplacian;
 pub mod matlab_edge;
+pub(crate) mod tenengrad;
 pub(crate) mod whole_image;
 
 use blocks::check_blocks;
@@ -38,6 +40,7 @@ pub use blur_effect::{blur_effect, blur_effect_axes};
 pub use cpbd::{cpbd, cpbd_2d};
 pub use jnbm::{jnbm, jnbm_2d, jnbm_2d_report, jnbm_report, JnbmReport};
 pub use laplacian::laplacian_var;
+pub use tenengrad::tenengrad;
 pub use whole_image::{cpbd_whole_image, jnbm_whole_image, jnbm_whole_image_report};
 
 use crate::error::{Error, Result};

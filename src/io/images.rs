@@ -14,6 +14,20 @@ pub fn write_exr(
     height: usize,
     channels: &[(&str, &[f32])],
 ) -> Result<()> {
+    write_exr_as(path, width, height, channels, false)
+}
+
+/// [`write_exr`] with the samples stored as half floats (f16: 11 bits of
+/// mantissa, about 3 significant digits, up to 65504; larger magnitudes
+/// become infinite) when `half`, else as f32; ZIP-compressed scan lines
+/// either way.
+pub fn write_exr_as(
+    path: &Path,
+    width: usize,
+    height: usize,
+    channels: &[(&str, &[f32])],
+    half: bool,
+) -> Result<()> {
     for (name, data) in channels {
         if data.len() != width * height {
             return Err(Error::invalid(
@@ -25,9 +39,20 @@ pub fn write_exr(
             ));
         }
     }
+    let samples = |data: &[f32]| {
+        if half {
+            FlatSamples::F16(
+                data.iter()
+                    .map(|&x| exr::prelude::f16::from_f32(x))
+                    .collect(),
+            )
+        } else {
+            FlatSamples::F32(data.to_vec())
+        }
+    };
     let list: Vec<AnyChannel<FlatSamples>> = channels
         .iter()
-        .map(|(name, data)| AnyChannel::new(*name, FlatSamples::F32(data.to_vec())))
+        .map(|(name, data)| AnyChannel::new(*name, samples(data)))
         .collect();
     let layer = Layer::new(
         (width, height),

@@ -85,6 +85,22 @@ impl FrameMaps {
         )
     }
 
+    /// Writes the channels `which` (indices into [`CHANNELS`], in that
+    /// order) as an EXR of half floats (`half`) or floats, ZIP-compressed
+    /// (atomically: temp file and rename).
+    pub fn write_exr_as(&self, path: &std::path::Path, half: bool, which: &[usize]) -> Result<()> {
+        let all = self.channels();
+        let chosen: Vec<(&str, &[f32])> =
+            which.iter().filter_map(|&i| all.get(i).copied()).collect();
+        crate::io::images::write_exr_as(
+            path,
+            self.width as usize,
+            self.height as usize,
+            &chosen,
+            half,
+        )
+    }
+
     /// Mean path length over the pixels that have one (px; the frame's
     /// exposure MMBM as a blur length) and their share of the pixels.
     pub fn mean_path_px(&self) -> (f64, f64) {

@@ -10,7 +10,8 @@
 //! of the command was written. A failure or an interrupt before then leaves
 //! DIR as it was.
 
-use super::maps::{frame_maps, MapRays, MapsJob};
+use super::maps::{frame_maps, MapRays, MapsJob, CHANNELS};
+use super::select::FrameName;
 use super::SeriesOptions;
 use crate::error::{Error, Result};
 use crate::io::atomic::PendingDir;
@@ -19,9 +20,86 @@ use crate::model::log::ImuLog;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
-/// The file name of frame `index`'s maps in a `--maps` directory.
+/// The file name of frame `index`'s maps in a `--maps` directory with the
+/// default [`MapsOutput`] (`frame_%06d.exr` numbered from 1, as the image
+/// list's default `frame_%06d.png`).
 pub fn file_name(index: usize) -> String {
-    format!("frame_{index:06}.exr")
+    MapsOutput::default().name(index)
+}
+
+/// How the maps are stored: the samples' type and the channels.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum MapsFormat {
+    /// Half floats (f16, about 3 significant digits; the default: half the
+    /// size, far finer than a blur map needs).
+    #[default]
+    Half,
+    /// 32-bit floats.
+    Float,
+}
+
+impl std::str::FromStr for MapsFormat {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self> {
+        match s {
+            "half" => Ok(Self::Half),
+            "float" => Ok(Self::Float),
+            _ => Err(Error::invalid(
+                "--maps-format",
+                format!("'{s}': expected half or float"),
+            )),
+        }
+    }
+}
+
+/// The channels to write: indices into [`CHANNELS`], from a list of their
+/// names (`path_px,disp.u`; written in [`CHANNELS`]' order, each once).
+pub fn parse_channels(s: &str) -> Result<Vec<usize>> {
+    let mut out = Vec::new();
+    for name in s.split(',').map(str::trim) {
+        let i = CHANNELS.iter().position(|&c| c == name).ok_or_else(|| {
+            Error::invalid(
+                "--maps-channels",
+                format!("'{name}': not a channel (they are {})", CHANNELS.join(", ")),
+            )
+        })?;
+        out.push(i);
+    }
+    out.sort_unstable();
+    out.dedup();
+    Ok(out)
+}
+
+/// How the maps are named and stored (see [`MapsFormat`], [`parse_channels`]).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct MapsOutput {
+    /// The file name, printf style (the image list's `--frame-name` with
+    /// the extension `.exr`).
+    pub name: FrameName,
+    /// The number of row 0 in the names (`--frame-start`).
+    pub start: u64,
+    /// Half or float samples.
+    pub format: MapsFormat,
+    /// Channels written, indices into [`CHANNELS`] in order.
+    pub channels: Vec<usize>,
+}
+
+impl Default for MapsOutput {
+    fn default() -> Self {
+        MapsOutput {
+            name: "frame_%06d.exr".parse().expect("a valid name"),
+            start: 1,
+            format: MapsFormat::Float,
+            channels: (0..CHANNELS.len()).collect(),
+        }
+    }
+}
+
+impl MapsOutput {
+    /// The file name of row `index`'s maps.
+    pub fn name(&self, index: usize) -> String {
+        self.name.name((index as u64).saturating_add(self.start))
+    }
 }
 
 /// What [`write_maps`] wrote.
@@ -50,16 +128,26 @@ pub fn write_maps(
     dir: &Path,
     backend: crate::gpu::Backend,
 ) -> Result<MapsWritten> {
-    stage_maps(log, opts, frames, which, dir, backend)?.publish()
+    stage_maps(
+        log,
+        opts,
+        frames,
+        which,
+        dir,
+        backend,
+        &MapsOutput::default(),
+    )?
+    .publish()
 }
 
-/// True for the name of a file [`write_maps`] writes in its folder
-/// (`frame_NNNNNN.exr`, six digits or more), relative to the folder.
+/// True for the name of a file [`write_maps`] may write in its folder
+/// (any `.exr` directly in it, whatever `--frame-name` names them),
+/// relative to the folder.
 pub fn is_map_name(rel: &Path) -> bool {
-    let s = rel.to_string_lossy();
-    s.strip_prefix("frame_")
-        .and_then(|r| r.strip_suffix(".exr"))
-        .is_some_and(|d| d.len() >= 6 && d.bytes().all(|b| b.is_ascii_digit()))
+    rel.components().count() == 1
+        && rel
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("exr"))
 }
 
 /// Maps computed and written into a staging folder, not yet in their
@@ -92,22 +180,17 @@ pub fn stage_maps(
     which: &[usize],
     dir: &Path,
     backend: crate::gpu::Backend,
+    out: &MapsOutput,
 ) -> Result<StagedMaps> {
+    if out.name.has_folder() {
+        return Err(Error::invalid(
+            "--frame-name",
+            "the maps are named after it: give a name without a folder with --maps",
+        ));
+    }
     super::maps::check_size(&opts.scene.camera)?;
-    let base = if dir.is_dir() {
-        dir.to_path_buf()
-    } else {
-        nearest_existing(dir)?
-    };
-    let stage = PendingDir::create(&base.join(stage_name()))?;
-    let mut staged = StagedMaps {
-        written: MapsWritten::default(),
-        names: Vec::new(),
-        dir: dir.to_path_buf(),
-        stage: None,
-    };
-    let root = stage.path().to_path_buf();
-    staged.stage = Some(stage);
+    let mut staged = StagedMaps::empty(dir)?;
+    let root = staged.root().to_path_buf();
     let rays = MapRays::new(&opts.scene.camera)?;
     let mut gpu = super::maps_gpu::resolve(backend, &opts.scene.camera)?;
     staged.written.adapter = gpu.as_ref().map(|g| g.adapter().to_string());
@@ -133,8 +216,15 @@ pub fn stage_maps(
         };
         match maps {
             Some(m) => {
-                let name = file_name(k);
-                m.write_exr(&root.join(&name))?;
+                let name = out.name(k);
+                m.write_exr_as(
+                    &root.join(&name),
+                    out.format == MapsFormat::Half,
+                    &out.channels,
+                )
+                // An interrupt may remove the staging folder under the write:
+                // the interrupt is the error, not the missing folder.
+                .map_err(|e| crate::cancel::check().err().unwrap_or(e))?;
                 staged.names.push(name);
                 let (mean, valid) = m.mean_path_px();
                 staged.written.written.push((k, mean, valid));
@@ -162,6 +252,34 @@ fn nearest_existing(dir: &Path) -> Result<PathBuf> {
 }
 
 impl StagedMaps {
+    /// An empty staging folder for `dir` (see the module docs), for files
+    /// written into [`Self::root`] and named with [`Self::add`] (the frames
+    /// `frames --extract` extracts).
+    pub fn empty(dir: &Path) -> Result<StagedMaps> {
+        let base = if dir.is_dir() {
+            dir.to_path_buf()
+        } else {
+            nearest_existing(dir)?
+        };
+        let stage = PendingDir::create(&base.join(stage_name()))?;
+        Ok(StagedMaps {
+            written: MapsWritten::default(),
+            names: Vec::new(),
+            dir: dir.to_path_buf(),
+            stage: Some(stage),
+        })
+    }
+
+    /// The staging folder.
+    pub fn root(&self) -> &Path {
+        self.stage.as_ref().map_or(Path::new(""), |s| s.path())
+    }
+
+    /// Files written into [`Self::root`], moved into the folder by [`Self::publish`].
+    pub fn add(&mut self, names: Vec<String>) {
+        self.names.extend(names);
+    }
+
     /// What was computed (the maps are not yet in their folder).
     pub fn written(&self) -> &MapsWritten {
         &self.written
@@ -212,10 +330,23 @@ mod tests {
     fn map_names() {
         assert!(is_map_name(Path::new("frame_000012.exr")));
         assert!(is_map_name(Path::new("frame_1234567.exr")));
-        assert!(!is_map_name(Path::new("frame_12.exr")));
+        assert!(is_map_name(Path::new("img12.exr")));
         assert!(!is_map_name(Path::new("t.csv")));
         assert!(!is_map_name(Path::new("sub/frame_000012.exr")));
-        assert_eq!(file_name(7), "frame_000007.exr");
+        // Named as the image list's default names the frame (numbered from 1).
+        assert_eq!(file_name(7), "frame_000008.exr");
+        let out = MapsOutput {
+            name: "img_%04d.png"
+                .parse::<FrameName>()
+                .unwrap()
+                .with_extension("exr"),
+            start: 0,
+            ..MapsOutput::default()
+        };
+        assert_eq!(out.name(5), "img_0005.exr");
+        assert_eq!(parse_channels("path_px, disp.u,path_px").unwrap(), [0, 2]);
+        let e = parse_channels("blur").unwrap_err().to_string();
+        assert!(e.contains("--maps-channels") && e.contains("flow.v"), "{e}");
         assert!(is_map_name(Path::new(&file_name(7))));
     }
 }

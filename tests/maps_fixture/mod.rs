@@ -42,7 +42,9 @@ pub fn running_phone_camera() -> PathBuf {
 }
 
 /// `mmbm frames --gyro GYRO --frames TABLE --camera CAMERA --scale-to
-/// 192x108 --maps DIR --out OUT` and `extra`.
+/// 192x108 --maps DIR --maps-format float --out OUT` and `extra` (float
+/// maps: the tests compare them to f32 rounding; the maps of row k are
+/// `frame_{k+1:06}.exr`, as the image list names the frame).
 pub fn frames_maps(
     gyro: &Path,
     table: &Path,
@@ -63,6 +65,8 @@ pub fn frames_maps(
         "192x108",
         "--maps",
         path(dir),
+        "--maps-format",
+        "float",
         "--out",
         path(out),
     ];
