@@ -243,10 +243,10 @@ mod tests {
         assert!((last.exposure_s() - 0.0093).abs() < 1e-12);
         assert!((last.gain - 0.0504 / 0.0093).abs() < 1e-6, "{}", last.gain);
         // Within budget (0.05 mm/s: 50.4 ms is 0.54 px): the auto-exposure's own.
-        let last = *run("ae-blur:5:1", 0.05).last().unwrap();
+        let last = run("ae-blur:5:1", 0.05).pop().unwrap();
         assert!((last.exposure_s() - 0.0504).abs() < 1e-6 && (last.gain - 1.0).abs() < 1e-9);
         // Still: the auto-exposure's.
-        let last = *run("ae-blur:5:1:cap=10ms", 0.0).last().unwrap();
+        let last = run("ae-blur:5:1:cap=10ms", 0.0).pop().unwrap();
         assert!((last.exposure_s() - 0.01).abs() < 1e-12 && (last.gain - 5.04).abs() < 1e-6);
     }
 
@@ -256,19 +256,19 @@ mod tests {
         // K = sqrt(107.53 * 0.0504 / 0.1) = 7.3616, T = 0.0504 / K = 6.846 ms.
         let v = 0.5 / 0.00465;
         let k = (v * 0.0504 / 0.1f64).sqrt();
-        let last = *run("ae-imu:5", 0.5).last().unwrap();
+        let last = run("ae-imu:5", 0.5).pop().unwrap();
         assert!((k - 7.3616).abs() < 1e-4);
         assert!((last.gain - k).abs() < 1e-5, "{} vs {k}", last.gain);
         assert!((last.exposure_s() - 0.0504 / k).abs() < 1e-8);
         // w0 adds to v c: w = 1, w0 = 10 -> K = sqrt(5.4194 + 10) = 3.9268.
         let k = (v * 0.0504 + 10.0f64).sqrt();
-        let last = *run("ae-imu:5:w=1:w0=10", 0.5).last().unwrap();
+        let last = run("ae-imu:5:w=1:w0=10", 0.5).pop().unwrap();
         assert!((last.gain - k).abs() < 1e-5, "{} vs {k}", last.gain);
         // Still: the auto-exposure (gain 1, 50.4 ms) ...
-        let last = *run("ae-imu:5", 0.0).last().unwrap();
+        let last = run("ae-imu:5", 0.0).pop().unwrap();
         assert!((last.exposure_s() - 0.0504).abs() < 1e-6 && (last.gain - 1.0).abs() < 1e-9);
         // ... and with its cap: K = c / cap = 5.04.
-        let last = *run("ae-imu:5:cap=10ms", 0.0).last().unwrap();
+        let last = run("ae-imu:5:cap=10ms", 0.0).pop().unwrap();
         assert!((last.exposure_s() - 0.01).abs() < 1e-9 && (last.gain - 5.04).abs() < 1e-6);
     }
 
