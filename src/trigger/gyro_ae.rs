@@ -167,6 +167,9 @@ impl Policy for ImuTradeAe {
     }
 }
 
+/// The variant's own `(key, value)` pairs and the auto-exposure's `key=value` arguments.
+type SplitKeys<'a> = (Vec<(&'a str, &'a str)>, Vec<&'a str>);
+
 /// Splits the `ae-*` keys into the variant's own (`own`, e.g. `w`, `w0`) and
 /// the auto-exposure's; refuses the auto-exposure keys in `refused` (keys
 /// the variant does not use), naming them.
@@ -175,7 +178,7 @@ pub(crate) fn split_keys<'a>(
     own: &[&str],
     refused: &[&str],
     spec: &str,
-) -> Result<(Vec<(&'a str, &'a str)>, Vec<&'a str>)> {
+) -> Result<SplitKeys<'a>> {
     let (mut mine, mut rest) = (Vec::new(), Vec::new());
     for kv in keys {
         match kv.split_once('=') {
