@@ -76,6 +76,18 @@ pub const AUGMENT_MAX_BLUR_PX: f64 = 2000.0;
 /// fills even that in 10 us: generous for any exposure, and finite.
 pub const MAX_LIGHT_E_PER_S: f64 = 1e12;
 
+/// Most illuminance `mmbm light` takes, lux (direct sun is about 1e5).
+pub const LIGHT_MAX_LUX: f64 = 1e7;
+
+/// Smallest f-number `mmbm light` takes (0.5: the limit of a lens in air).
+pub const LIGHT_MIN_F_NUMBER: f64 = 0.5;
+
+/// Largest f-number `mmbm light` takes.
+pub const LIGHT_MAX_F_NUMBER: f64 = 1000.0;
+
+/// Largest pixel pitch `mmbm light` takes, um.
+pub const LIGHT_MAX_PIXEL_UM: f64 = 1000.0;
+
 /// Largest mean (electrons) whose shot noise is drawn from the exact
 /// Poisson sampler; above it, from the normal approximation `N(mu, mu)`
 /// rounded and clamped at 0, which is bounded in time for every mean (the

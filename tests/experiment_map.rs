@@ -119,7 +119,7 @@ fn the_map_leads_the_report_and_holds_together() {
     }
     assert!(d.path().join("benefit_map.png").exists());
     assert!(md.contains("![benefit map](benefit_map.png)"));
-    // The terminal's answer: the ratios and where the report is.
+    // The terminal's answer: the three lines, the ratios and where the report is.
     let report = d.path().join("report.md");
     let answer = o.answer(&report);
     assert_eq!(answer, experiment::map_answer(m, &report).join("\n"));
@@ -127,7 +127,11 @@ fn the_map_leads_the_report_and_holds_together() {
         answer.ends_with(&format!("Report: {}", report.display())),
         "{answer}"
     );
-    assert_eq!(answer.lines().count(), 2 + m.cells.len());
+    // The three computed lines (pays, ties, loses), the summary, a line
+    // per cell and the report's place.
+    assert_eq!(answer.lines().count(), 5 + m.cells.len());
+    let three = experiment::three_lines(m);
+    assert!(answer.starts_with(&three.join("\n")), "{answer}");
     // frames.csv names every policy's family.
     let csv = std::fs::read_to_string(d.path().join("frames.csv")).unwrap();
     let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();

@@ -15,6 +15,7 @@ mod experiment;
 mod flow;
 mod frames;
 mod info;
+mod light;
 mod live;
 mod render;
 mod series;
@@ -69,6 +70,8 @@ enum Command {
     Simulate(simulate::SimulateArgs),
     /// Run a trigger policy on a gyro log.
     Trigger(trigger::TriggerArgs),
+    /// Electrons per second in a white pixel from lux, f-number, pixel pitch and QE.
+    Light(light::LightArgs),
     /// Image blur metrics (JNBM, CPBD, blur effect, Laplacian variance).
     Assess(assess::AssessArgs),
     /// Extract the 16 red blobs of the thesis target from an image.
@@ -130,6 +133,7 @@ fn run() -> i32 {
         Command::Sync(a) => sync::run(a),
         Command::Simulate(a) => simulate::run(a),
         Command::Trigger(a) => trigger::run(a),
+        Command::Light(a) => light::run(a),
         Command::Assess(a) => assess::run(a),
         Command::Blobs(a) => blobs::run(a),
         Command::Experiment(a) => experiment::run(a),

@@ -18,18 +18,28 @@ looks at the future, so not causal: `mmbm live` refuses it; FPS at most 1000):
   fixed:FPS[@PHASE]  threshold:X  adaptive[:X[:FPS]]  oracle:X[:H]  forecast:X[:H]  phase:X[:H]
   gate:X[:FPS[@PHASE]]  gate0:X[:FPS[@PHASE]]  deadline:FPS[:X]
   fixed:FPS[@PHASE]@Tms  ae:FPS[@PHASE][:cap=Tms][:target=F][:damp=F][:scene=F]
-  task:FPS:light=E[:read=E][:tmin=Tms]
+  ae-blur:FPS[@PHASE]:B[:ae keys]  ae-imu:FPS[@PHASE][:w=W][:w0=W0][:ae keys]
+  ae-grad:FPS[@PHASE][:white=F][:cap=Tms][:scene=F]  task:FPS:light=E[:read=E][:tmin=Tms]
   (gate keeps a fixed-rate frame when its exposure-averaged MMBM is <= X; gate0, the thesis's test, when
   the MMBM at the exposure start, i.e. of the decision sample, is; phase learns the gait's cycle from
   its touchdowns; fixed:FPS@Tms exposes every frame for T ms, gain raised by --exposure / T; ae is a
   motion-blind auto-exposure on the fixed schedule: exposure up to cap (default --exposure) first, then
   gain, toward a mean level target (default 0.18) with damping damp (0.5), the scene's mean radiance
-  scene (0.25); task picks each slot's instant and exposure for the highest predicted chance of a sharp
+  scene (0.25); ae-blur is that auto-exposure with each exposure capped where the gyro-predicted blur
+  passes B px, the gain making up the light (camera makers' gyro AE, e.g. FotoNation US 11,812,146 B2);
+  ae-imu splits the auto-exposure's exposure x gain c by K = sqrt((v c + w0) / w), T = c / K, v the
+  gyro's image speed px/s (after Begin & Hunter, Sensors 22(3):835, 2022; w default 0.1 px, w0 0);
+  ae-grad is a motion-blind gradient auto-exposure: each frame the product among x{1, 0.71, 1.41, 0.5, 2}
+  with the most predicted gradient after gamma 2.2 of a scene whose brightest radiance is white (1.0);
+  families: fixed, fixed-exposure, auto-exposure (ae, ae-grad), gyro-exposure (ae-blur, ae-imu,
+  fixed:FPS+exp), mmbm (trigger timing from the gyro), oracle; task picks each slot's instant and exposure for the highest predicted chance of a sharp
   frame at the stated light E e-/s (at most 1e12; read noise read e-, default 2.5; shortest exposure
   tmin, default 0.2ms))
 Exposure control: any policy followed by +exp:B[:TMIN] exposes each frame for
   clamp(B x pitch / MMBM, TMIN, --exposure) s (predicted blur within B px; TMIN default 0.001) and raises
   the gain by --exposure / that; the CSV's gain column says by how much.
+With --light E (e-/s; see mmbm light) the summary adds each policy's white-pixel SNR and the task model's
+  predicted sharp frames (the model of task:, fitted on the demo's board), so short exposures pay their noise.
 Output: the CSV goes to --out FILE, else to stdout; the summary goes to stderr, or to stdout with
   --summary when --out names a file (the CSV is never dropped).
 
@@ -40,6 +50,8 @@ Examples:
   mmbm trigger --gyro walk.csv --policy fixed:5+exp:2:0.02 --policy deadline:5+exp:3 --exposure 0.07 \\
       --out f.csv --summary
   mmbm trigger --gyro walk.csv --policy fixed:5@10ms --policy ae:5:cap=10ms --policy task:5:light=20000 \\
+      --exposure 0.07 --out frames.csv --summary
+  mmbm trigger --gyro walk.csv --policy ae-blur:5:1:cap=10ms --policy ae-imu:5:w=0.1 --policy ae-grad:5 \\
       --exposure 0.07 --out frames.csv --summary
   mmbm trigger --gyro ../shared/data/running_phone/gyro.csv --policy threshold:p20 --exposure 0.02 \\
       --out f.csv --summary"
@@ -120,6 +132,26 @@ fn summary_text(frames: &[Frame], spec: &str, duration: f64, pitch_mm: Option<f6
     )
 }
 
+/// The summary's line at `--light`: each kept frame's white-pixel SNR and
+/// the task model's predicted verdict (docs/trigger.md, `task:`): expected
+/// sharp frames, their share and rate over `duration` s.
+fn light_text(frames: &[Frame], light: f64, pitch_mm: f64, duration: f64) -> String {
+    let p = trigger::TaskModel::at_light(light).predict(frames, pitch_mm);
+    if p.kept == 0 {
+        return format!("  at {light} e-/s: no kept frame\n");
+    }
+    format!(
+        "  at {light} e-/s: white-pixel SNR mean {:.1} min {:.1}; predicted sharp (task model) {:.1} of {} kept \
+         frames ({:.0} %), {:.2} sharp frames/s\n",
+        p.mean_snr,
+        p.min_snr,
+        p.sharp,
+        p.kept,
+        100.0 * p.sharp / p.kept as f64,
+        p.sharp / duration
+    )
+}
+
 pub fn run(a: TriggerArgs) -> Result<()> {
     // The output's place, against every input, before any work.
     mmbm::io::guard::OutputGuard::new()
@@ -152,6 +184,14 @@ pub fn run(a: TriggerArgs) -> Result<()> {
                 .is_none()
                 .then_some(session.timing().pitch_mm),
         ));
+        if let Some(light) = a.camera.light {
+            text.push_str(&light_text(
+                frames,
+                light,
+                session.timing().pitch_mm,
+                run.duration_s,
+            ));
+        }
     }
     let all = run.frames;
     let write = |w: &mut dyn Write| -> Result<()> {

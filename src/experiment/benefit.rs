@@ -102,10 +102,24 @@ pub struct Headline {
     pub kept: usize,
 }
 
-/// Per block and policy: (sharp frames, blur sum, rendered frames); and the block's seconds.
+/// Per block and policy: (sharp frames, blur sum, rendered frames, kept
+/// frames); and the block's seconds.
 struct Block {
     seconds: f64,
-    per_policy: Vec<(f64, f64, f64)>,
+    per_policy: Vec<(f64, f64, f64, f64)>,
+}
+
+/// Sharp frames per second from `sharp` of `rendered` frames among `kept`
+/// kept frames over `seconds`: with every kept frame rendered, `sharp /
+/// seconds`; with a subsample (`max_frames_per_policy`), the subsample's
+/// sharp share times the kept frames per second, so the rate is computed on
+/// the frames that were judged, not read as if the others had failed.
+pub(crate) fn sharp_rate(sharp: f64, rendered: f64, kept: f64, seconds: f64) -> f64 {
+    if rendered > 0.0 && rendered < kept {
+        sharp / rendered * kept / seconds
+    } else {
+        sharp / seconds
+    }
 }
 
 /// The baseline policy: `fixed:5` if run, else the first `fixed:*`.
@@ -156,14 +170,11 @@ pub fn headlines(
             for &seconds in &wb.seconds {
                 blocks.push(Block {
                     seconds,
-                    per_policy: vec![(0.0, 0.0, 0.0); policies.len()],
+                    per_policy: vec![(0.0, 0.0, 0.0, 0.0); policies.len()],
                 });
             }
             for r in records.iter().filter(|r| r.walk == w.name) {
-                let (Some(pi), Some(m)) = (
-                    policies.iter().position(|p| p.as_str() == r.frame.policy),
-                    r.measure.as_ref(),
-                ) else {
+                let Some(pi) = policies.iter().position(|p| p.as_str() == r.frame.policy) else {
                     continue;
                 };
                 if !r.frame.kept {
@@ -171,21 +182,25 @@ pub fn headlines(
                 }
                 let b = wb.index(r.frame.trigger_t);
                 let c = &mut blocks[first + b].per_policy[pi];
-                c.0 += f64::from(u8::from(m.blobs_ok));
-                c.1 += m.blur_px;
-                c.2 += 1.0;
+                c.3 += 1.0;
+                if let Some(m) = r.measure.as_ref() {
+                    c.0 += f64::from(u8::from(m.blobs_ok));
+                    c.1 += m.blur_px;
+                    c.2 += 1.0;
+                }
             }
         }
         let stat = |idx: &[usize], pi: usize| {
-            let (mut ok, mut secs, mut blur, mut n) = (0.0, 0.0, 0.0, 0.0);
+            let (mut ok, mut secs, mut blur, mut n, mut kept) = (0.0, 0.0, 0.0, 0.0, 0.0);
             for &k in idx {
                 let c = blocks[k].per_policy[pi];
                 ok += c.0;
                 blur += c.1;
                 n += c.2;
+                kept += c.3;
                 secs += blocks[k].seconds;
             }
-            (ok / secs, blur / n)
+            (sharp_rate(ok, n, kept, secs), blur / n)
         };
         let all: Vec<usize> = (0..blocks.len()).collect();
         let samples = bootstrap_indices(blocks.len());
@@ -256,6 +271,16 @@ pub fn headline_md(hs: &[Headline], policies: &[PolicySpec]) -> String {
             None => "; no fixed-rate baseline was run, so no ratio".into(),
         }
     );
+    let (rendered, kept): (usize, usize) = hs
+        .iter()
+        .fold((0, 0), |(r, k), h| (r + h.rendered, k + h.kept));
+    if rendered < kept {
+        s += &format!(
+            "**A subsample was judged**: {rendered} of the {kept} kept frames were rendered \
+             (`max_frames_per_policy`); every rate and ratio below is the rendered frames' sharp share times \
+             the kept frames per second (docs/spec.md section 11).\n\n"
+        );
+    }
     s += "| walk | policy | family | sharp frames/s [95 % CI] | vs baseline [95 % CI] | mean blur px [95 % CI] | rendered / kept |\n";
     s += "|---|---|---|---|---|---|---|\n";
     for h in hs {
@@ -474,5 +499,34 @@ mod tests {
         let r = hs[1].ratio.unwrap();
         assert!(r.lo < r.value && r.value < r.hi, "{r:?}");
         assert!(r.value < 1.6 && r.hi > 1.5, "{r:?}");
+    }
+
+    #[test]
+    fn a_subsample_is_judged_on_its_own_frames() {
+        // The issue's case: 12 of fixed:5's 100 kept frames (20 s) rendered,
+        // 11 sharp. Not 11 / 20 s = 0.55 sharp frames/s ("11 % of its
+        // frames"), but 11/12 of its 5 frames/s = 4.58 /s.
+        let policies: Vec<PolicySpec> = vec!["fixed:5".parse().unwrap()];
+        let walks = vec![walk(1)];
+        let recs: Vec<FrameRecord> = (0..100)
+            .map(|k| {
+                let mut r = record(1, "fixed:5", k as f64 * 0.2, k != 0, 1.0);
+                if k % 8 != 0 || k >= 96 {
+                    r.measure = None;
+                }
+                r
+            })
+            .collect();
+        assert_eq!(recs.iter().filter(|r| r.measure.is_some()).count(), 12);
+        let hs = headlines(&walks, &recs, &policies);
+        assert_eq!((hs[0].rendered, hs[0].kept), (12, 100));
+        assert!((hs[0].sharp_fps.value - 11.0 / 12.0 * 100.0 / 20.0).abs() < 1e-9);
+        let md = headline_md(&hs, &policies);
+        assert!(
+            md.contains("12 of the 100 kept frames were rendered"),
+            "{md}"
+        );
+        // Every kept frame rendered: the plain count over the seconds.
+        assert!((sharp_rate(11.0, 12.0, 12.0, 20.0) - 0.55).abs() < 1e-15);
     }
 }

@@ -132,6 +132,9 @@ impl Default for MapSection {
                 "task:5:light=20000",
                 "ae:5:cap=10ms",
                 "ae:5:cap=3ms",
+                "ae-grad:5:cap=10ms",
+                "ae-blur:5:1",
+                "ae-imu:5",
             ]
             .map(String::from)
             .to_vec(),
@@ -157,8 +160,10 @@ impl MapSection {
 
     /// The reduced map of `mmbm demo`: the half board on the moderate walk,
     /// seeds 1-5, four lights, a coarser grid (3, 10, 20, 70 ms), five
-    /// gyro-driven candidates (trigger timing alone, and the predicted task
-    /// success at each light, stated) and one auto-exposure.
+    /// trigger-timing candidates (`deadline:5` with and without exposure
+    /// control, the predicted task success at three stated lights), the
+    /// blur-capped auto-exposure (`gyro-exposure`, the bar for timing) and
+    /// one motion-blind auto-exposure.
     pub fn reduced() -> Self {
         MapSection {
             lights_e_per_s: vec![1_000.0, 4_000.0, 20_000.0, 100_000.0],
@@ -167,10 +172,11 @@ impl MapSection {
             seeds: (1..=5).collect(),
             policies: [
                 "deadline:5",
+                "deadline:5+exp:3:0.02",
                 "task:5:light=1000",
                 "task:5:light=4000",
                 "task:5:light=20000",
-                "task:5:light=100000",
+                "ae-blur:5:1",
                 "ae:5:cap=10ms",
             ]
             .map(String::from)

@@ -220,7 +220,7 @@ mod tests {
              0.41040770904235263,73.92057289971574,15,64,52.500659,,11.599904771512902,\
              fast,3,0,,0.0000000001,-1.5,0,1,mmbm,2,0.375\n\
              fixed:5+exp:2:0.02,NaN,,,,,fast,1,inf,1000000000000000000000,-0,0,0,\
-             ,,,,,,,,,,,18446744073709551615,,,,,,2.5,mmbm,,\n"
+             ,,,,,,,,,,,18446744073709551615,,,,,,2.5,gyro-exposure,,\n"
         );
         assert_eq!(frames_csv(&records(), "fast").unwrap(), want);
         assert_eq!(
@@ -254,7 +254,7 @@ mod tests {
         assert_eq!(col(&rows[1], "rendered"), "0");
         assert_eq!(col(&rows[1], "seed"), "18446744073709551615");
         assert_eq!(col(&rows[1], "gain"), "2.5");
-        assert_eq!(col(&rows[1], "family"), "mmbm");
+        assert_eq!(col(&rows[1], "family"), "gyro-exposure");
         assert_eq!(col(&rows[0], "blobs_false"), "2");
         assert_eq!(col(&rows[0], "corner_repeatability"), "0.375");
         assert_eq!(col(&rows[1], "corner_repeatability"), "");

@@ -71,12 +71,17 @@ pub struct Cell {
     pub ae: Option<usize>,
     /// Index of the thesis's fixed rate.
     pub fixed: Option<usize>,
+    /// Index of the best `gyro-exposure` policy (fixed rate, exposure from the gyro).
+    pub gyro: Option<usize>,
     /// Best `mmbm` over the best fixed exposure in hindsight.
     pub vs_hindsight: Option<Estimate>,
     /// Best `mmbm` over auto-exposure.
     pub vs_ae: Option<Estimate>,
     /// Best `mmbm` over the fixed rate.
     pub vs_fixed: Option<Estimate>,
+    /// Does timing pay? Best `mmbm` (trigger timing from the gyro) over the
+    /// best `gyro-exposure` policy (SPEC section 11).
+    pub vs_gyro: Option<Estimate>,
     /// Index of the policy with the most sharp frames per second.
     pub winner: usize,
     /// Blocks resampled.
@@ -381,6 +386,7 @@ fn cell(
     let best_mmbm = best(&ps, fam(PolicyFamily::Mmbm));
     let hindsight = best(&ps, |p| in_grid(cfg, &p.policy));
     let ae = best(&ps, fam(PolicyFamily::AutoExposure));
+    let gyro = best(&ps, fam(PolicyFamily::GyroExposure));
     let fixed = ps.iter().position(|p| p.policy.is_baseline());
     let winner = best(&ps, |_| true).unwrap_or(0);
     let samples = bootstrap_indices(blocks.len());
@@ -406,11 +412,13 @@ fn cell(
         vs_hindsight: ratio(best_mmbm, hindsight),
         vs_ae: ratio(best_mmbm, ae),
         vs_fixed: ratio(best_mmbm, fixed),
+        vs_gyro: ratio(best_mmbm, gyro),
         policies: ps,
         best_mmbm,
         hindsight,
         ae,
         fixed,
+        gyro,
         winner,
         blocks: blocks.len(),
     }

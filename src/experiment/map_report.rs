@@ -51,6 +51,18 @@ pub fn lost(c: &Cell) -> bool {
         .any(|e| e.is_some_and(|e| e.hi < 1.0))
 }
 
+/// Does timing pay in cell `c`? `pays` when the best `mmbm` policy's ratio
+/// to the best `gyro-exposure` policy has its 95 % interval above 1, `loses`
+/// when below 1, `ties` when it reaches 1, `n/a` without both families.
+pub fn timing_verdict(c: &Cell) -> &'static str {
+    match c.vs_gyro {
+        Some(e) if e.lo > 1.0 => "pays",
+        Some(e) if e.hi < 1.0 => "loses",
+        Some(e) if e.lo.is_finite() && e.hi.is_finite() => "ties",
+        _ => "n/a",
+    }
+}
+
 /// The map's section of the report.
 pub fn map_md(m: &BenefitMap, figure: Option<&str>) -> String {
     let mut s =
@@ -59,7 +71,9 @@ pub fn map_md(m: &BenefitMap, figure: Option<&str>) -> String {
     s += &format!(
         "Sharp frames per second (kept, rendered, all 16 blobs at their true places) of the best causal gyro-driven \
          policy (family `mmbm`) over the best fixed exposure in hindsight (family `oracle`: the fixed exposure of the \
-         grid {:?} ms with the most sharp frames in the cell) and over auto-exposure (`auto-exposure`). Seeds {:?}, \
+         grid {:?} ms with the most sharp frames in the cell), over auto-exposure (`auto-exposure`) and, to ask whether \
+         the trigger's *timing* pays, over the best gyro-aware exposure at the fixed rate (`gyro-exposure`: \
+         `ae-blur`, `ae-imu`, `fixed:FPS+exp`; docs/spec.md section 11). Seeds {:?}, \
          {:.0}-s blocks ({} per cell), 95 % percentile bootstrap over {} resamplings of the blocks (bootstrap seed {}), \
          paired block by block; the best policies are chosen on all blocks, then held fixed. Light = electrons per \
          second in a white pixel; gain `K_ref = {} / (light x {:.0} ms)` (white fills the range at the reference \
@@ -101,10 +115,12 @@ pub fn map_md(m: &BenefitMap, figure: Option<&str>) -> String {
             };
             let w = &c.policies[c.winner];
             s += &format!(
-                " {}vs best fixed {}; vs AE {}; won: `{}`{} |",
+                " {}vs best fixed {}; vs AE {}; timing vs gyro-exposure {} ({}); won: `{}`{} |",
                 if lost(c) { "**lost** " } else { "" },
                 opt(&c.vs_hindsight),
                 opt(&c.vs_ae),
+                opt(&c.vs_gyro),
+                timing_verdict(c),
                 w.policy,
                 if c.hindsight == Some(c.winner) {
                     " (best fixed in hindsight)"
@@ -345,9 +361,10 @@ pub fn goals_md(m: &BenefitMap) -> String {
     s
 }
 
-/// The few lines the terminal ends with: the headline ratios and where the report is.
+/// The few lines the terminal ends with: the three lines of
+/// [`super::verdict::three_lines`], the map's ratios and where the report is.
 pub fn answer(m: &BenefitMap, report: &Path) -> Vec<String> {
-    let mut out = Vec::new();
+    let mut out: Vec<String> = super::verdict::three_lines(m).into();
     let won = m.cells.iter().filter(|c| !lost(c)).count();
     out.push(format!(
         "Benefit map ({} cells, seeds {:?}): gyro-driven capture is below neither the best fixed exposure in hindsight \
@@ -465,8 +482,9 @@ pub fn heat_map_png(path: &Path, m: &BenefitMap) -> Result<()> {
 
 /// The lines a heat-map cell is labelled with: the best `mmbm` policy over
 /// the best fixed exposure in hindsight with its 95 % interval (and `lost`
-/// where [`lost`]), over auto-exposure, and the policy with the most sharp
-/// frames per second with that rate.
+/// where [`lost`]), over auto-exposure, over the best `gyro-exposure` policy
+/// with [`timing_verdict`], and the policy with the most sharp frames per
+/// second with that rate.
 pub fn heat_labels(c: &Cell) -> Vec<String> {
     let short = |e: &Option<Estimate>| match e {
         Some(e) if e.value.is_finite() && e.lo.is_finite() => {
@@ -479,7 +497,15 @@ pub fn heat_labels(c: &Cell) -> Vec<String> {
     if lost(c) {
         first += " lost";
     }
-    let mut out = vec![first, format!("vs auto-exposure {}", short(&c.vs_ae))];
+    let mut out = vec![
+        first,
+        format!("vs auto-exposure {}", short(&c.vs_ae)),
+        format!(
+            "timing vs gyro-exposure {} {}",
+            short(&c.vs_gyro),
+            timing_verdict(c)
+        ),
+    ];
     if let Some(w) = c.policies.get(c.winner) {
         out.push(format!("won by {} ({:.2} /s)", w.policy, w.sharp_fps));
     }
@@ -514,6 +540,8 @@ mod tests {
             hindsight: Some(0),
             ae: None,
             fixed: Some(0),
+            gyro: None,
+            vs_gyro: None,
             vs_hindsight: Some(Estimate {
                 value: 1.25,
                 lo: 1.05,
@@ -529,6 +557,7 @@ mod tests {
             [
                 "vs hindsight 1.25x [1.05, 1.50]",
                 "vs auto-exposure n/a",
+                "timing vs gyro-exposure n/a n/a",
                 "won by deadline:5 (4.50 /s)"
             ]
         );
@@ -538,5 +567,16 @@ mod tests {
             hi: 0.6,
         });
         assert!(heat_labels(&c)[0].ends_with("0.50x [0.40, 0.60] lost"));
+        // Timing against the best gyro-exposure policy: an interval above 1
+        // pays, one below loses, one that reaches 1 ties.
+        for ((lo, hi), want) in [
+            ((1.1, 1.4), "pays"),
+            ((0.5, 0.9), "loses"),
+            ((0.9, 1.2), "ties"),
+        ] {
+            c.vs_gyro = Some(Estimate { value: 1.0, lo, hi });
+            assert_eq!(timing_verdict(&c), want);
+            assert!(heat_labels(&c)[2].ends_with(want));
+        }
     }
 }

@@ -27,10 +27,12 @@ pub(crate) mod report;
 pub(crate) mod run;
 pub(crate) mod sweep;
 pub(crate) mod truth;
+pub(crate) mod verdict;
 pub(crate) mod walk;
 
 pub use config::{ExperimentConfig, MapSection, WalkTimes, DEMO_POLICIES};
 pub use map::{BenefitMap, Cell, CellPolicy};
-pub use map_report::answer as map_answer;
+pub use map_report::{answer as map_answer, timing_verdict};
 pub use report::{table_6, Outcome};
 pub use run::{run, writes};
+pub use verdict::{cell_verdict, three_lines, Verdict};

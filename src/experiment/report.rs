@@ -415,6 +415,10 @@ pub fn report_md(
         .map(|w| w.runs.iter().map(|(p, _)| p.clone()).collect())
         .unwrap_or_default();
     if let Some(m) = &o.map {
+        for line in super::verdict::three_lines(m) {
+            s += &format!("- {line}\n");
+        }
+        s += "\n";
         s += &super::map_report::map_md(
             m,
             figs.iter()

@@ -113,8 +113,19 @@ impl AutoExposure {
         }
     }
 
+    /// The exposure-times-gain product the auto-exposure wants now,
+    /// relative to `T_ref` at the nominal gain (1 at the start).
+    pub(crate) fn product(&self) -> f64 {
+        self.log_p.exp()
+    }
+
+    /// The longest exposure it may choose under a camera exposure `t_ref` (s): `min(cap, t_ref)`.
+    pub(crate) fn longest(&self, t_ref: f64) -> f64 {
+        self.params.cap_s.unwrap_or(t_ref).min(t_ref)
+    }
+
     /// `(exposure s, relative gain)` for the current state.
-    fn setting(&self, t_ref: f64) -> (f64, f64) {
+    pub(crate) fn setting(&self, t_ref: f64) -> (f64, f64) {
         let p = self.log_p.exp();
         let te = (p * t_ref)
             .min(self.params.cap_s.unwrap_or(t_ref))
@@ -232,7 +243,7 @@ mod tests {
         assert_eq!(parse("ae:5").ae.unwrap().cap_s, None);
         for (s, fam) in [
             ("fixed:5", "fixed"),
-            ("fixed:5+exp:2", "mmbm"),
+            ("fixed:5+exp:2", "gyro-exposure"),
             ("threshold:0.4", "mmbm"),
             ("deadline:5+exp:3:0.02", "mmbm"),
             ("oracle:0.4", "oracle"),

@@ -36,6 +36,9 @@
 //! | `fixed:FPS[@PHASE]` | trigger at the first sample at or after `t_0 + PHASE + k / FPS` (slots the busy camera cannot take are skipped) |
 //! | `fixed:FPS[@PHASE]@Tms` | the same schedule, every frame exposed for `T` ms with the gain raised by the camera's exposure / `T` (see [`FixedExposure`]) |
 //! | `ae:FPS[@PHASE][:cap=Tms][:target=F][:damp=F][:scene=F]` | the same schedule with a motion-blind auto-exposure (see [`AutoExposure`]) |
+//! | `ae-blur:FPS[@PHASE]:B[:ae keys]` | the auto-exposure with its exposure capped where the gyro-predicted blur passes `B` px, the gain making up the light (family `gyro-exposure`; see [`BlurCappedAe`]) |
+//! | `ae-imu:FPS[@PHASE][:w=W][:w0=W0][:ae keys]` | the auto-exposure's product split into exposure and gain by the IMU trade `K = sqrt((v c + w0) / w)` (family `gyro-exposure`; see [`ImuTradeAe`]) |
+//! | `ae-grad:FPS[@PHASE][:white=F][:cap=Tms][:scene=F]` | motion-blind gradient auto-exposure (family `auto-exposure`; see [`GradientAe`]) |
 //! | `threshold:X` | thesis rule: camera free, minimum interval passed, the last three MMBM samples below `X` and strictly decreasing |
 //! | `adaptive[:X[:FPS]]` | thesis rule with an adaptive threshold (see [`Adaptive`]); `X` default 0.4, target `FPS` default 2.5 |
 //! | `oracle:X[:H]` | perfect future knowledge (see [`Oracle`]); `H` default 0.2 s |
@@ -63,6 +66,9 @@
 
 mod baselines;
 mod exposure;
+mod family;
+mod grad_ae;
+mod gyro_ae;
 mod latency;
 mod live;
 mod numbers;
@@ -81,6 +87,8 @@ mod timing;
 
 pub use baselines::{AeParams, AutoExposure, FixedExposure};
 pub use exposure::Exposure;
+pub use grad_ae::GradientAe;
+pub use gyro_ae::{AeVariant, BlurCappedAe, ImuTradeAe};
 pub use latency::Latency;
 pub use live::{Event, Live};
 pub use pace::check_speed;
@@ -99,5 +107,5 @@ pub use stats::{
     FRAME_HEADER,
 };
 pub use stream::{Stream, StreamControl, StreamEnd, StreamOptions, StreamOutcome, POLL};
-pub use task::{Task, TaskModel};
+pub use task::{Prediction, Task, TaskModel};
 pub use timing::{exposure_means, CameraTiming, Frame, Integral};

@@ -5,6 +5,8 @@
 
 use super::baselines::{parse_ae, split_exposure, AeParams, AutoExposure, FixedExposure};
 use super::exposure::Exposure;
+use super::grad_ae::{parse_white, GradientAe};
+use super::gyro_ae::{parse_imu, split_keys, AeVariant, BlurCappedAe, ImuTradeAe};
 use super::numbers::{parse_num, parse_pos};
 use super::phase::Phase;
 use super::policy::{Level, Policy};
@@ -12,6 +14,8 @@ use super::predict::{Forecast, Oracle};
 use super::rules::{Adaptive, Deadline, Fixed, Gate, Threshold};
 use super::task::{parse_task, Task, TaskModel};
 use crate::error::{Error, Result};
+
+pub use super::family::{Family, PolicyFamily};
 
 /// Highest frame rate a policy accepts, frames/s.
 pub const MAX_FPS: f64 = 1000.0;
@@ -63,7 +67,8 @@ fn parse_rate(s: &str, spec: &str) -> Result<(f64, f64)> {
     Ok((fps, p))
 }
 
-const GRAMMAR: &str = "fixed:FPS[@PHASE][@Tms], ae:FPS[@PHASE][:cap=Tms][:target=F][:damp=F][:scene=F], threshold:X, adaptive[:X[:FPS]], oracle:X[:H], \
+const GRAMMAR: &str = "fixed:FPS[@PHASE][@Tms], ae:FPS[@PHASE][:cap=Tms][:target=F][:damp=F][:scene=F], \
+ae-blur:FPS[@PHASE]:B[:ae keys], ae-imu:FPS[@PHASE][:w=W][:w0=W0][:ae keys], ae-grad:FPS[@PHASE][:white=F][:cap=Tms][:scene=F], threshold:X, adaptive[:X[:FPS]], oracle:X[:H], \
 forecast:X[:H], phase:X[:H], gate:X[:FPS[@PHASE]], gate0:X[:FPS[@PHASE]], deadline:FPS[:X] (X in mm/s or pNN) or task:FPS:light=E[:read=E][:tmin=Tms], \
 each optionally followed by +exp:B[:TMIN] (exposure control: blur budget B px, shortest exposure TMIN s)";
 
@@ -76,105 +81,6 @@ pub fn parse_policy(spec: &str) -> Result<Box<dyn Policy>> {
 /// The thesis's rule at its threshold (thesis ch. 6): three falling MMBM
 /// samples below 0.4 mm/s.
 pub const THESIS_POLICY: &str = "threshold:0.4";
-
-/// The family of a policy (its name before the first `:`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum Family {
-    /// `fixed:FPS[@PHASE]`.
-    Fixed,
-    /// `threshold:X`, the thesis rule.
-    Threshold,
-    /// `adaptive[:X[:FPS]]`.
-    Adaptive,
-    /// `oracle:X[:H]` (needs the future).
-    Oracle,
-    /// `forecast:X[:H]`.
-    Forecast,
-    /// `phase:X[:H]`.
-    Phase,
-    /// `gate:X[:FPS[@PHASE]]`.
-    Gate,
-    /// `gate0:X[:FPS[@PHASE]]`.
-    Gate0,
-    /// `deadline:FPS[:X]`.
-    Deadline,
-    /// `ae:FPS[...]`, motion-blind auto-exposure.
-    Ae,
-    /// `task:FPS:light=E[...]`, the predicted task success.
-    Task,
-}
-
-impl Family {
-    /// The family's name as written in a policy string.
-    pub fn name(self) -> &'static str {
-        match self {
-            Family::Fixed => "fixed",
-            Family::Threshold => "threshold",
-            Family::Adaptive => "adaptive",
-            Family::Oracle => "oracle",
-            Family::Forecast => "forecast",
-            Family::Phase => "phase",
-            Family::Gate => "gate",
-            Family::Gate0 => "gate0",
-            Family::Deadline => "deadline",
-            Family::Ae => "ae",
-            Family::Task => "task",
-        }
-    }
-
-    fn from_name(s: &str) -> Option<Self> {
-        [
-            Family::Fixed,
-            Family::Threshold,
-            Family::Adaptive,
-            Family::Oracle,
-            Family::Forecast,
-            Family::Phase,
-            Family::Gate,
-            Family::Gate0,
-            Family::Deadline,
-            Family::Ae,
-            Family::Task,
-        ]
-        .into_iter()
-        .find(|f| f.name() == s)
-    }
-}
-
-/// The family of SPEC section 10, by which the benefit map groups the
-/// policies (the `family` column of `frames.csv`). Not the rule ([`Family`]).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub enum PolicyFamily {
-    /// The thesis's fixed rate at the camera's exposure (`fixed:FPS[@PHASE]`).
-    Fixed,
-    /// A fixed rate at a fixed shorter exposure, gain raised (`fixed:FPS@Tms`).
-    FixedExposure,
-    /// Motion-blind auto-exposure (`ae:...`).
-    AutoExposure,
-    /// Every causal policy that reads the gyro (MMBM rules, gates, exposure control).
-    Mmbm,
-    /// Every non-causal one (the oracle; the best fixed exposure in hindsight).
-    Oracle,
-}
-
-impl PolicyFamily {
-    /// The family's name: `fixed`, `fixed-exposure`, `auto-exposure`, `mmbm`, `oracle`.
-    pub fn name(self) -> &'static str {
-        match self {
-            PolicyFamily::Fixed => "fixed",
-            PolicyFamily::FixedExposure => "fixed-exposure",
-            PolicyFamily::AutoExposure => "auto-exposure",
-            PolicyFamily::Mmbm => "mmbm",
-            PolicyFamily::Oracle => "oracle",
-        }
-    }
-}
-
-impl std::fmt::Display for PolicyFamily {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.name())
-    }
-}
 
 /// A frame rate with its phase.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -226,8 +132,10 @@ pub struct PolicySpec {
     pub exposure: Option<ExposureControl>,
     /// The fixed exposure of `fixed:FPS@Tms`, s.
     pub fixed_exposure_s: Option<f64>,
-    /// The auto-exposure of `ae:...`.
+    /// The auto-exposure of `ae:...` and `ae-*:...`.
     pub ae: Option<AeParams>,
+    /// What an `ae-*` policy adds to the auto-exposure (`None` for `ae:`).
+    pub ae_variant: Option<AeVariant>,
     /// The success model of `task:...` (with its stated light).
     pub task: Option<TaskModel>,
 }
@@ -303,6 +211,7 @@ impl PolicySpec {
             exposure: None,
             fixed_exposure_s: None,
             ae: None,
+            ae_variant: None,
             task: None,
         };
         match (family, args) {
@@ -315,6 +224,32 @@ impl PolicySpec {
                 unique_keys(keys, spec)?;
                 out.rate = Some(rate(r)?);
                 out.ae = Some(parse_ae(keys, spec)?);
+            }
+            (Family::AeBlur, [r, b, keys @ ..]) if !b.contains('=') => {
+                unique_keys(keys, spec)?;
+                out.rate = Some(rate(r)?);
+                out.ae = Some(parse_ae(keys, spec)?);
+                out.ae_variant = Some(AeVariant::BlurCap {
+                    budget_px: parse_pos(b, "blur budget (px)", spec)?,
+                });
+            }
+            (Family::AeBlur, _) => return Err(bad("ae-blur needs its blur budget: ae-blur:FPS:B")),
+            (Family::AeImu, [r, keys @ ..]) => {
+                unique_keys(keys, spec)?;
+                out.rate = Some(rate(r)?);
+                let (own, rest) = split_keys(keys, &["w", "w0"], &[], spec)?;
+                out.ae = Some(parse_ae(&rest, spec)?);
+                out.ae_variant = Some(parse_imu(&own, spec)?);
+            }
+            (Family::AeGrad, [r, keys @ ..]) => {
+                unique_keys(keys, spec)?;
+                out.rate = Some(rate(r)?);
+                let (own, rest) = split_keys(keys, &["white"], &["target", "damp"], spec)?;
+                let ae = parse_ae(&rest, spec)?;
+                out.ae_variant = Some(AeVariant::Gradient {
+                    white: parse_white(&own, ae.scene_mean, spec)?,
+                });
+                out.ae = Some(ae);
             }
             (Family::Task, [f, keys @ ..]) => {
                 unique_keys(keys, spec)?;
@@ -369,12 +304,17 @@ impl PolicySpec {
     pub fn policy_family(&self) -> PolicyFamily {
         if !self.is_causal() {
             PolicyFamily::Oracle
+        } else if self.ae_variant.is_some_and(|v| v.reads_gyro()) {
+            PolicyFamily::GyroExposure
         } else if self.ae.is_some() {
             PolicyFamily::AutoExposure
         } else if self.fixed_exposure_s.is_some() {
             PolicyFamily::FixedExposure
         } else if self.is_baseline() {
             PolicyFamily::Fixed
+        } else if self.family == Family::Fixed {
+            // The fixed rate with `+exp`: exposure from the gyro, no timing.
+            PolicyFamily::GyroExposure
         } else {
             PolicyFamily::Mmbm
         }
@@ -436,6 +376,23 @@ impl PolicySpec {
                 rate.phase,
                 self.ae.unwrap_or_default(),
             )),
+            Family::AeBlur | Family::AeImu | Family::AeGrad => {
+                let ae = self.ae.unwrap_or_default();
+                let (fps, phase) = (rate.fps, rate.phase);
+                match self.ae_variant {
+                    Some(AeVariant::BlurCap { budget_px }) => {
+                        Box::new(BlurCappedAe::new(spec, fps, phase, ae, budget_px))
+                    }
+                    Some(AeVariant::ImuTrade {
+                        weight_px,
+                        offset_px,
+                    }) => Box::new(ImuTradeAe::new(spec, fps, phase, ae, weight_px, offset_px)),
+                    Some(AeVariant::Gradient { white }) => {
+                        Box::new(GradientAe::new(spec, fps, phase, ae, white))
+                    }
+                    None => Box::new(AutoExposure::new(spec, fps, phase, ae)),
+                }
+            }
             Family::Threshold => Box::new(Threshold::new(spec, level)),
             Family::Adaptive => Box::new(Adaptive::new(spec, level, rate.fps)),
             Family::Oracle => Box::new(Oracle::new(spec, level, h)),
@@ -536,6 +493,9 @@ mod tests {
             "deadline:5+exp:3:0.02",
             "fixed:5@3ms",
             "ae:5:cap=10ms",
+            "ae-blur:5@0.1:1:cap=10ms",
+            "ae-imu:5:w=0.5:w0=1:damp=0.25",
+            "ae-grad:5:white=0.9",
         ] {
             let p = spec(s);
             let b = p.build();
@@ -569,6 +529,14 @@ mod tests {
             "ae:5:speed=1",
             "ae:5:10ms",
             "ae:5+exp:2",
+            "ae-blur:5",
+            "ae-blur:5:cap=10ms",
+            "ae-blur:5:-1",
+            "ae-imu:5:w=x",
+            "ae-imu:5:speed=1",
+            "ae-grad:5:target=0.2",
+            "ae-grad:5:white=0.1",
+            "ae-grad:5+exp:1",
         ] {
             assert!(PolicySpec::parse(s).is_err(), "{s}");
         }

@@ -100,6 +100,52 @@ impl TaskModel {
         }
         out
     }
+
+    /// What the model predicts for a run's kept `frames` on pixels of
+    /// `pitch_mm` (mm): each frame's white-pixel SNR from its exposure
+    /// ([`Self::snr`]; the gain does not add photons) and its probability of
+    /// being sharp from its blur over the exposure (exposure MMBM / pitch x
+    /// exposure, px) and that SNR ([`Self::p_sharp`]). The camera's gain cap
+    /// is not modelled (where it binds, frames are darker than predicted).
+    pub fn predict(&self, frames: &[super::timing::Frame], pitch_mm: f64) -> Prediction {
+        let mut p = Prediction {
+            kept: 0,
+            mean_snr: f64::NAN,
+            min_snr: f64::NAN,
+            sharp: 0.0,
+        };
+        let mut snr_sum = 0.0;
+        for f in frames.iter().filter(|f| f.kept) {
+            let te = f.exposure_s();
+            let snr = self.snr(te);
+            let blur = crate::camera::blur_px(f.mmbm_exposure_mm_s, te, pitch_mm);
+            p.kept += 1;
+            snr_sum += snr;
+            p.min_snr = if p.min_snr.is_nan() {
+                snr
+            } else {
+                p.min_snr.min(snr)
+            };
+            p.sharp += self.p_sharp(blur, te);
+        }
+        if p.kept > 0 {
+            p.mean_snr = snr_sum / p.kept as f64;
+        }
+        p
+    }
+}
+
+/// [`TaskModel::predict`]'s answer for one run.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Prediction {
+    /// Kept frames.
+    pub kept: usize,
+    /// Mean white-pixel SNR over the kept frames (NaN without frames).
+    pub mean_snr: f64,
+    /// Lowest white-pixel SNR (NaN without frames).
+    pub min_snr: f64,
+    /// Expected sharp frames: the sum of the kept frames' probabilities.
+    pub sharp: f64,
 }
 
 /// `task:FPS:light=E[:read=E][:tmin=Tms]`: one frame per slot of the fixed
