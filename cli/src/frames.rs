@@ -5,7 +5,6 @@ use super::series::GyroArgs;
 use clap::Args;
 use mmbm::error::{Error, Result};
 use mmbm::io::frames::read_frame_table;
-use mmbm::io::gyro::read_log;
 use mmbm::series::frames::frame_mmbm;
 use mmbm::series::maps_write::{is_map_name, stage_maps};
 use mmbm::series::SeriesOptions;
@@ -31,7 +30,8 @@ Examples:
 )]
 pub struct FramesArgs {
     /// Gyro log (CSV, Gyroflow .gcsv, ROS 2 .mcap, or a phone's IMU rows
-    /// timestamp_ns,type,x,y,z), on the clock of FRAMES (else --time-offset).
+    /// timestamp_ns,type,x,y,z), on the clock of FRAMES (else --time-offset);
+    /// or a camera's own file: GoPro MP4, Gyroflow project, Sensor Logger or phyphox CSV.
     #[arg(long, value_name = "FILE")]
     pub gyro: PathBuf,
     /// Frame table: CSV with t_start (first line's exposure start, s), exposure_s
@@ -100,7 +100,7 @@ pub fn run(a: FramesArgs) -> Result<()> {
     }
     let frames = read_frame_table(&a.frames, a.exposure)?;
     mmbm::series::select::check_frame_start(a.choice.frame_start, frames.len())?;
-    let samples = read_log(&a.gyro, a.gyro_opts.options()?)?;
+    let samples = mmbm::telemetry::read_gyro(&a.gyro, &a.gyro_opts.telemetry()?)?;
     let camera = super::args::with_log_readout(camera, samples.readout(), &a.gyro)?;
     let opts = SeriesOptions {
         scene: Scene {
