@@ -7,6 +7,7 @@
 mod augment;
 mod camera;
 mod dataset;
+mod telemetry;
 
 use camera::{camera, camera_json};
 use glam::DVec3;
@@ -607,6 +608,7 @@ fn _mmbm(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(simulate, m)?)?;
     m.add_function(wrap_pyfunction!(trigger, m)?)?;
     m.add_function(wrap_pyfunction!(read_exr, m)?)?;
+    m.add_function(wrap_pyfunction!(telemetry::read_camera, m)?)?;
     m.add_class::<dataset::DatasetMaker>()?;
     m.add_function(wrap_pyfunction!(augment::augment, m)?)?;
     // The camera timing's defaults, from their one place in the library.

@@ -355,3 +355,43 @@ fn gyro_stream(
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn orin_names_the_axis_of_each_channel() {
+        // ZXY: channel 0 is Z, 1 is X, 2 is Y; lowercase negates.
+        let m = orin_matrix("ZXY").unwrap();
+        assert_eq!(m * DVec3::new(1.0, 2.0, 3.0), DVec3::new(2.0, 3.0, 1.0));
+        let m = orin_matrix("yXz").unwrap();
+        assert_eq!(m * DVec3::new(1.0, 2.0, 3.0), DVec3::new(2.0, -1.0, -3.0));
+        assert!(orin_matrix("ZZY").unwrap_err().contains("twice"));
+        assert!(orin_matrix("ZX").unwrap_err().contains("3 axis letters"));
+        assert!(orin_matrix("ZXW").unwrap_err().contains("'W'"));
+    }
+
+    #[test]
+    fn klv_lengths_are_checked_and_zero_padding_ends_a_payload() {
+        let p = Path::new("x.mp4");
+        // GYRO 's' 6 x 2 = 12 bytes, then zero padding.
+        let mut d = b"GYROs\x06\x00\x02".to_vec();
+        d.extend_from_slice(&[0u8; 12]);
+        d.extend_from_slice(&[0u8; 6]);
+        let e = entries(p, "payload", 0, &d).unwrap();
+        assert_eq!(e.len(), 1);
+        assert_eq!((e[0].size, e[0].repeat, e[0].data.len()), (6, 2, 12));
+        // 3 repeats need 18 (20 padded) bytes: 18 are there.
+        let mut d = b"GYROs\x06\x00\x03".to_vec();
+        d.extend_from_slice(&[1u8; 18]);
+        let err = entries(p, "payload", 100, &d).unwrap_err().to_string();
+        assert!(
+            err.contains("GYRO at byte 100") && err.contains("run past"),
+            "{err}"
+        );
+        // A truncated header that is not padding.
+        let err = entries(p, "payload", 0, b"GYR").unwrap_err().to_string();
+        assert!(err.contains("truncated KLV header"), "{err}");
+    }
+}

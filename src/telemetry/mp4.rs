@@ -457,3 +457,46 @@ fn sample_table<'a>(
     }
     Ok(out)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn box_lengths_must_fit_their_parent() {
+        let p = Path::new("x.mp4");
+        let mut d = 16u32.to_be_bytes().to_vec();
+        d.extend_from_slice(b"free");
+        d.extend_from_slice(&[0u8; 8]);
+        assert_eq!(boxes(p, "moov", 0, &d).unwrap().len(), 1);
+        d[3] = 17;
+        let e = boxes(p, "moov", 40, &d).unwrap_err().to_string();
+        assert!(
+            e.contains("moov/free at byte 40") && e.contains("does not fit"),
+            "{e}"
+        );
+        d[3] = 4; // shorter than its own header
+        assert!(boxes(p, "moov", 0, &d).is_err());
+        assert!(boxes(p, "moov", 0, &d[..5])
+            .unwrap_err()
+            .to_string()
+            .contains("truncated"));
+    }
+
+    #[test]
+    fn a_table_count_must_fit_its_box() {
+        let p = Path::new("x.mp4");
+        let data = [0u8, 0, 0, 0, 0x40, 0, 0, 0, 1, 2, 3, 4];
+        let mut c = Cursor {
+            path: p,
+            place: "stco".into(),
+            data: &data,
+            at: 4,
+        };
+        let e = c.count(4).unwrap_err().to_string();
+        assert!(
+            e.contains("1073741824 entries of 4 bytes do not fit in the 4 bytes left"),
+            "{e}"
+        );
+    }
+}

@@ -144,12 +144,8 @@ mod tests {
     }
 
     #[test]
-    fn back_camera_looks_along_minus_z_and_turning_right_pans_the_image() {
-        // A phone in portrait turning to the user's right (about device +y,
-        // negative: right-handed +y turns x towards -z... so turning right
-        // is -y): the camera pans right, i.e. rotates about camera +y (down)
-        // positively? Check by the forward axis instead: the camera's
-        // forward is the device's -z in every back preset.
+    fn each_preset_sends_the_named_device_axes_where_the_docs_say() {
+        // The back camera's forward is the device's -z in every back preset.
         for o in [
             Orientation::PhoneBackPortrait,
             Orientation::PhoneBackLandscape,

@@ -339,3 +339,33 @@ pub fn video_time(offsets: &[(f64, f64)], t: f64) -> f64 {
     let first = t + offset_at(offsets, t);
     t + offset_at(offsets, first)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn offsets_interpolate_clamp_and_invert_as_gyroflow_reads_them() {
+        assert_eq!(offset_at(&[], 3.0), 0.0);
+        assert_eq!(offset_at(&[(5.0, 0.02)], -1.0), 0.02);
+        let o = [(0.0, 0.01), (10.0, 0.03)];
+        assert_eq!(offset_at(&o, -1.0), 0.01);
+        assert_eq!(offset_at(&o, 11.0), 0.03);
+        assert!((offset_at(&o, 5.0) - 0.02).abs() < 1e-15);
+        // tv - off(tv) = t: with off = 0.01 + 0.002 tv, tv = (t + 0.01) / 0.998.
+        for t in [0.0, 1.0, 4.5, 9.0] {
+            let tv = video_time(&o, t);
+            assert!((tv - offset_at(&o, tv) - t).abs() < 1e-7, "{t}: {tv}");
+        }
+        // One offset: exact.
+        assert_eq!(video_time(&[(0.0, -0.005)], 2.0), 1.995);
+    }
+
+    #[test]
+    fn a_project_is_known_by_its_title_or_gyro_source() {
+        assert!(looks_like_project(b"  {\"title\": \"Gyroflow data file\""));
+        assert!(looks_like_project(b"{\"gyro_source\": {}}"));
+        assert!(!looks_like_project(b"{\"fisheye_params\": {}}"));
+        assert!(!looks_like_project(b"t,wx,wy,wz"));
+    }
+}
