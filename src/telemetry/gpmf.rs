@@ -35,6 +35,7 @@ use std::path::Path;
 pub const DEFAULT_ORIN: &str = "ZXY";
 
 /// One KLV entry of a payload.
+#[derive(Debug)]
 struct Klv<'a> {
     key: [u8; 4],
     kind: u8,
@@ -185,6 +186,19 @@ pub struct Gpmf {
 /// Reads the gyro of every payload of the `gpmd` track `payloads` of `path`.
 pub fn read(path: &Path, payloads: &[Sample]) -> Result<Gpmf> {
     let mut file = crate::bounded::open_file(path)?;
+    // Payloads do not overlap: more bytes in all than the file holds is a
+    // table pointing many samples at the same bytes (time, not memory).
+    let len = file.metadata().map_err(|e| Error::io(path, e))?.len();
+    let total: u64 = payloads.iter().map(|s| s.size).sum();
+    if total > len {
+        return Err(bad(
+            path,
+            "gpmd track",
+            format!(
+                "its payloads add up to {total} bytes, more than the file's {len}: they overlap"
+            ),
+        ));
+    }
     let mut out = Gpmf::default();
     let mut buf = Vec::new();
     let mut orin_seen: Option<String> = None;

@@ -64,6 +64,7 @@ pub fn looks_like_mp4(head: &[u8]) -> bool {
 }
 
 /// A box's header: type, payload range within the parent's bytes.
+#[derive(Debug)]
 struct Header {
     kind: [u8; 4],
     body: std::ops::Range<usize>,
@@ -415,12 +416,13 @@ fn sample_table<'a>(
     let mut k = 0usize;
     let mut clock = 0u64;
     let place = format!("{t} track");
+    // The run of each chunk, walked once (runs are in increasing order).
+    let mut run = 0usize;
     for (ci, &chunk_at) in offsets.iter().enumerate() {
-        let per = runs
-            .iter()
-            .rev()
-            .find(|&&(f, _)| f <= ci + 1)
-            .map_or(0, |&(_, p)| p);
+        while run + 1 < runs.len() && runs[run + 1].0 <= ci + 1 {
+            run += 1;
+        }
+        let per = runs.get(run).filter(|r| r.0 <= ci + 1).map_or(0, |r| r.1);
         let mut at = chunk_at;
         for _ in 0..per {
             if k >= sizes.len() {
