@@ -110,10 +110,7 @@ impl GyroArgs {
 /// (`mmbm::telemetry`) read whole.
 fn source(gyro: &std::path::Path, g: &GyroArgs) -> Result<series::Samples> {
     if mmbm::telemetry::sniff(gyro)? == mmbm::telemetry::Format::Log && g.orientation.is_none() {
-        return Ok(series::Samples::Reader(GyroReader::open(
-            gyro,
-            g.options()?,
-        )?));
+        return Ok(GyroReader::open(gyro, g.options()?)?.into());
     }
     let log = mmbm::telemetry::read_gyro(gyro, &g.telemetry()?)?;
     Ok(series::Samples::Read(log.into_samples().into_iter()))

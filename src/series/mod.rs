@@ -208,14 +208,14 @@ pub fn px_of(opts: &SeriesOptions<AnyMethod>) -> Result<Box<PxFn>> {
 /// already read (a camera file, `crate::telemetry`).
 pub enum Samples {
     /// A streaming log reader (its warnings printed when it is done).
-    Reader(GyroReader),
+    Reader(Box<GyroReader>),
     /// Samples in memory.
     Read(std::vec::IntoIter<GyroSample>),
 }
 
 impl From<GyroReader> for Samples {
     fn from(r: GyroReader) -> Self {
-        Samples::Reader(r)
+        Samples::Reader(Box::new(r))
     }
 }
 
