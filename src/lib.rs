@@ -18,7 +18,7 @@
 //! |---|---|---|
 //! | 0 | [`error`], [`check`], [`limits`], [`bounded`], [`stats`], [`diagnostics`], [`cancel`] | the error enum; value checks (finite, positive) that name the value; every cap on inputs; bounded whole-file reading (file kinds, the text cap); mean and percentile; where the library's warnings go (the `log` facade); stopping long calls from outside |
 //! | 1 | [`camera`], [`model`], [`io`], [`gpu`] | the camera (intrinsics, distortion, shutter, noise, lens); motion, flow; files; the wgpu device and compute plumbing |
-//! | 2 | [`metric`], [`board`], [`plot`], [`sim`], [`assess`] | MMBM rules; the thesis board, blobs, pose; figures; gait simulation; image blur metrics |
+//! | 2 | [`metric`], [`board`], [`plot`], [`sim`], [`assess`], [`telemetry`] | MMBM rules; the thesis board, blobs, pose; figures; gait simulation; image blur metrics; the gyro from a camera's own files (GoPro MP4, Gyroflow projects, phone apps) |
 //! | 3 | [`field`], [`tables`] | the flow-field kernel (GPU + CPU twin); thesis tables |
 //! | 4 | [`series`], [`render`], [`sync`] | MMBM of a log (CPU and GPU batch); the blur renderer; the gyro-to-video offset from the video (ffmpeg) |
 //! | 5 | [`trigger`], [`augment`] | trigger policies; motion-blur augmentation of any image |
@@ -53,6 +53,7 @@ pub mod sim;
 pub mod stats;
 pub mod sync;
 pub mod tables;
+pub mod telemetry;
 pub mod trigger;
 
 pub use camera::Camera;

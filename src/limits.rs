@@ -201,3 +201,31 @@ pub const SCORE_MAX_WIDTH: u32 = 640;
 /// ffmpeg's command line, bytes (Linux takes 128 KiB per argument); a
 /// longer choice is refused before ffmpeg runs.
 pub const MAX_SELECT_EXPR_BYTES: usize = 100_000;
+
+// == camera files (telemetry) ==
+
+/// Largest `moov` box of an MP4 read for its gyro track (`mmbm::telemetry`),
+/// bytes: the box is read whole (the sample tables); an hour of 4K GoPro
+/// video has a `moov` of a few MB. The video itself (`mdat`) is never read,
+/// only the telemetry payloads it points at.
+pub const MAX_MP4_MOOV_BYTES: u64 = 64 << 20;
+
+/// Most boxes walked at the top level of an MP4 and inside its `moov`,
+/// boxes (time: each is a seek or a slice).
+pub const MAX_MP4_BOXES: usize = 1 << 16;
+
+/// Largest single GPMF payload (one `gpmd` sample) read, bytes; GoPro's are
+/// a few kB (one second of telemetry).
+pub const MAX_GPMF_PAYLOAD_BYTES: u64 = 16 << 20;
+
+/// Deepest nesting of GPMF KLV containers followed, levels (GoPro uses 2:
+/// DEVC > STRM).
+pub const MAX_GPMF_DEPTH: usize = 8;
+
+/// Most gyro samples read from one camera file or app CSV, samples: about
+/// 80 bytes each in memory (670 MB at the cap), 44 minutes at 3200 Hz.
+pub const MAX_TELEMETRY_SAMPLES: usize = 1 << 23;
+
+/// Most entries of a Gyroflow project's `offsets` map (sync points),
+/// entries.
+pub const MAX_PROJECT_OFFSETS: usize = 100_000;

@@ -29,6 +29,7 @@ const LAYERS: &[(&str, u32)] = &[
     ("plot", 2),
     ("sim", 2),
     ("assess", 2),
+    ("telemetry", 2),
     ("field", 3),
     ("tables", 3),
     ("series", 4),

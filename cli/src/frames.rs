@@ -5,7 +5,6 @@ use super::series::GyroArgs;
 use clap::Args;
 use mmbm::error::{Error, Result};
 use mmbm::io::frames::read_frame_table;
-use mmbm::io::gyro::read_log;
 use mmbm::series::frames::frame_mmbm;
 use mmbm::series::maps_write::{is_map_name, parse_channels, stage_maps, MapsFormat, MapsOutput};
 use mmbm::series::select::clock::{check_clock, Spans};
@@ -38,7 +37,8 @@ If no frame lies inside the gyro log the command refuses, printing both time spa
 )]
 pub struct FramesArgs {
     /// Gyro log (CSV, Gyroflow .gcsv, ROS 2 .mcap, or a phone's IMU rows
-    /// timestamp_ns,type,x,y,z), on the clock of FRAMES (else --time-offset).
+    /// timestamp_ns,type,x,y,z), on the clock of FRAMES (else --time-offset);
+    /// or a camera's own file: GoPro MP4, Gyroflow project, Sensor Logger or phyphox CSV.
     #[arg(long, value_name = "FILE")]
     pub gyro: PathBuf,
     /// Frame table: CSV with t_start (first line's exposure start, s), exposure_s
@@ -161,11 +161,11 @@ pub fn run(a: FramesArgs) -> Result<()> {
         .as_deref()
         .map(super::sync::read_for_frames)
         .transpose()?;
-    let mut gyro_opts = a.gyro_opts.options()?;
+    let mut telemetry = a.gyro_opts.telemetry()?;
     if let Some(s) = &synced {
-        gyro_opts.time_offset = s.offset_s;
+        telemetry.gyro.time_offset = s.offset_s;
     }
-    let samples = read_log(&a.gyro, gyro_opts)?;
+    let samples = mmbm::telemetry::read_gyro(&a.gyro, &telemetry)?;
     let camera = super::args::with_log_readout(camera, samples.readout(), &a.gyro)?;
     let camera = match (&synced, &a.sync) {
         (Some(s), Some(path)) => {

@@ -190,7 +190,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
     let mut camera = a.camera.camera()?;
     let log = match &a.gyro {
         Some(g) => {
-            let log = mmbm::io::gyro::read_log(g, a.gyro_opts.options()?)?;
+            let log = mmbm::telemetry::read_gyro(g, &a.gyro_opts.telemetry()?)?;
             camera = super::args::with_log_readout(camera, log.readout(), g)?;
             Some(log)
         }

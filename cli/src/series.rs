@@ -41,6 +41,13 @@ pub struct GyroArgs {
     /// IMU-to-camera frame is --imu-rotation (/tf is not read).
     #[arg(long, value_name = "TOPIC")]
     pub topic: Option<String>,
+    /// The device-to-camera rotation by name (before --imu-rotation):
+    /// phone-back-portrait, phone-back-landscape (the phone's top to the
+    /// left), phone-back-landscape-right, phone-front-portrait, action-cam
+    /// (GoPro's IMU axes; a GoPro MP4's default) or camera (the identity).
+    /// Matrices: docs/frames.md, "Gyro from the camera's own files".
+    #[arg(long, value_name = "PRESET")]
+    pub orientation: Option<mmbm::telemetry::Orientation>,
 }
 
 /// `--imu-rotation`: 9 numbers, a rotation matrix (clap reports a bad one, exit 2).
@@ -64,7 +71,22 @@ fn angles(s: &str) -> std::result::Result<[f64; 3], String> {
 }
 
 impl GyroArgs {
+    /// The options of a streamed log (`--orientation` is refused here: it
+    /// applies where the log is read whole, `mmbm::telemetry`).
     pub fn options(&self) -> Result<GyroOptions> {
+        if let Some(o) = self.orientation {
+            return Err(mmbm::Error::invalid(
+                "--orientation",
+                format!(
+                    "'{}' is not available for this command's streamed log; give the same rotation as --imu-rotation",
+                    o.name()
+                ),
+            ));
+        }
+        self.log_options()
+    }
+
+    fn log_options(&self) -> Result<GyroOptions> {
         Ok(GyroOptions {
             time_unit: self.time_unit,
             angle_unit: self.angle_unit,
@@ -74,6 +96,24 @@ impl GyroArgs {
             topic: self.topic.clone(),
         })
     }
+
+    /// The options of `mmbm::telemetry::read_gyro` (camera files and every log).
+    pub fn telemetry(&self) -> Result<mmbm::telemetry::TelemetryOptions> {
+        Ok(mmbm::telemetry::TelemetryOptions {
+            gyro: self.log_options()?,
+            orientation: self.orientation,
+        })
+    }
+}
+
+/// The samples of `gyro`: a log streamed by its reader, a camera file
+/// (`mmbm::telemetry`) read whole.
+fn source(gyro: &std::path::Path, g: &GyroArgs) -> Result<series::Samples> {
+    if mmbm::telemetry::sniff(gyro)? == mmbm::telemetry::Format::Log && g.orientation.is_none() {
+        return Ok(GyroReader::open(gyro, g.options()?)?.into());
+    }
+    let log = mmbm::telemetry::read_gyro(gyro, &g.telemetry()?)?;
+    Ok(series::Samples::Read(log.into_samples().into_iter()))
 }
 
 /// MMBM for every gyro sample: CSV `t,mmbm_mm_s,mmbm_px_s`.
@@ -84,7 +124,9 @@ impl GyroArgs {
   mmbm series --gyro log.csv --use-velocity --depth 3 --method gpu:64x48")]
 pub struct SeriesArgs {
     /// Gyro log: CSV t,wx,wy,wz[,vx,vy,vz][,depth]; also a ROS 2 .mcap or a
-    /// Gyroflow .gcsv IMU log (t*tscale s, g*gscale rad/s, its orientation).
+    /// Gyroflow .gcsv IMU log (t*tscale s, g*gscale rad/s, its orientation),
+    /// or a camera's own file: a GoPro MP4 (GPMF), a Gyroflow project
+    /// (.gyroflow), Sensor Logger's or phyphox's gyroscope CSV.
     #[arg(long, value_name = "FILE")]
     pub gyro: PathBuf,
     /// riemann[:NUxNV], gauss[:N], exact[:TOL] or gpu[:WxH].
@@ -128,7 +170,7 @@ pub fn run(a: SeriesArgs) -> Result<()> {
     if let Some(p) = &opts.scene.plane {
         p.validate_for(&opts.scene.camera)?;
     }
-    let reader = GyroReader::open(&a.gyro, a.gyro_opts.options()?)?;
+    let reader = source(&a.gyro, &a.gyro_opts)?;
     let mut eval = series::evaluator(opts)?;
     let px = series::px_of(&opts)?;
     if let Some(te) = a.exposure {

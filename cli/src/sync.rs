@@ -4,7 +4,6 @@ use super::args::CameraArgs;
 use super::series::GyroArgs;
 use clap::Args;
 use mmbm::error::{Error, Result};
-use mmbm::io::gyro::read_log;
 use mmbm::limits::SYNC_MAX_SEARCH_S;
 use mmbm::sync::{sync, SyncFile, SyncOptions};
 use std::path::PathBuf;
@@ -87,10 +86,10 @@ pub fn run(a: SyncArgs) -> Result<()> {
         );
     }
     let camera = a.camera.camera()?;
-    let mut gyro_opts = a.gyro_opts.options()?;
-    let centre_s = gyro_opts.time_offset;
-    gyro_opts.time_offset = 0.0;
-    let log = read_log(&a.gyro, gyro_opts)?;
+    let mut telemetry = a.gyro_opts.telemetry()?;
+    let centre_s = telemetry.gyro.time_offset;
+    telemetry.gyro.time_offset = 0.0;
+    let log = mmbm::telemetry::read_gyro(&a.gyro, &telemetry)?;
     let camera = super::args::with_log_readout(camera, log.readout(), &a.gyro)?;
     let opts = SyncOptions {
         exposure_s,

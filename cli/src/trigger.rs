@@ -4,7 +4,6 @@ use super::args::{CameraArgs, SceneArgs, TimingArgs};
 use super::series::GyroArgs;
 use clap::Args;
 use mmbm::error::{Error, Result};
-use mmbm::io::gyro::read_log;
 use mmbm::trigger::{self, Frame, PolicySpec, Session, SessionConfig};
 use mmbm::Method;
 use std::io::Write;
@@ -160,7 +159,7 @@ pub fn run(a: TriggerArgs) -> Result<()> {
         .input("--camera", a.camera.camera.as_deref())
         .check()?;
     let camera = a.camera.camera()?;
-    let samples = read_log(&a.gyro, a.gyro_opts.options()?)?;
+    let samples = mmbm::telemetry::read_gyro(&a.gyro, &a.gyro_opts.telemetry()?)?;
     let session = Session::new(
         SessionConfig {
             camera,

@@ -263,12 +263,20 @@ def read_gyro(
     imu_rotation: Optional[Sequence[float]] = None,
     time_offset: float = 0.0,
     topic: Optional[str] = None,
-) -> Dict[str, np.ndarray]:
-    """Reads a gyro log (CSV ``t,wx,wy,wz[,vx,vy,vz][,depth]`` or a ROS 2
-    MCAP file with ``topic``): ``{"t": (N,) s, "omega": (N, 3) rad/s[,
-    "velocity": (N, 3) m/s][, "depth": (N,) m]}``, in the camera frame."""
+    orientation: Optional[str] = None,
+) -> Dict[str, Any]:
+    """Reads a gyro log (CSV ``t,wx,wy,wz[,vx,vy,vz][,depth]``, a Gyroflow
+    ``.gcsv``, a ROS 2 MCAP file with ``topic``, a phone's IMU rows) or a
+    camera's own file (a GoPro MP4, a Gyroflow ``.gyroflow`` project,
+    Sensor Logger's or phyphox's gyroscope CSV): ``{"t": (N,) s, "omega":
+    (N, 3) rad/s[, "velocity": (N, 3) m/s][, "depth": (N,) m]}`` in the
+    camera frame, with ``"format"`` and what the file says (``readout_s``,
+    ``fps``, ``offsets``, ``lens_profile`` as JSON text, ``device``,
+    ``orientation``). ``orientation``: a device-to-camera preset
+    (``phone-back-portrait``, ``phone-back-landscape``, ``action-cam``, ...;
+    docs/frames.md), applied before ``imu_rotation``."""
     rot = None if imu_rotation is None else ",".join(repr(float(x)) for x in np.ravel(imu_rotation))
-    return _mmbm.read_gyro(os.fspath(path), time_unit, angle_unit, rot, float(time_offset), topic)
+    return _mmbm.read_camera(os.fspath(path), time_unit, angle_unit, rot, float(time_offset), topic, orientation)
 
 
 def flow_field(

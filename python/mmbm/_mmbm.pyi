@@ -37,6 +37,15 @@ def read_gyro(
     time_offset: float,
     topic: Optional[str],
 ) -> Dict[str, F64]: ...
+def read_camera(
+    path: str,
+    time_unit: str,
+    angle_unit: str,
+    imu_rotation: Optional[str],
+    time_offset: float,
+    topic: Optional[str],
+    orientation: Optional[str],
+) -> Dict[str, Any]: ...
 def flow_field(
     cam: CamSpec, omega: Sequence[float], velocity: Sequence[float], plane_: Optional[F64], backend_: str
 ) -> F32: ...

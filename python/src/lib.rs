@@ -8,6 +8,7 @@ mod augment;
 mod camera;
 mod dataset;
 mod select;
+mod telemetry;
 
 use camera::{camera, camera_json};
 use glam::DVec3;
@@ -604,6 +605,7 @@ fn _mmbm(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(trigger, m)?)?;
     m.add_function(wrap_pyfunction!(read_exr, m)?)?;
     m.add_function(wrap_pyfunction!(select::choose_frames, m)?)?;
+    m.add_function(wrap_pyfunction!(telemetry::read_camera, m)?)?;
     m.add_class::<dataset::DatasetMaker>()?;
     m.add_function(wrap_pyfunction!(augment::augment, m)?)?;
     // The camera timing's defaults, from their one place in the library.

@@ -204,17 +204,51 @@ pub fn px_of(opts: &SeriesOptions<AnyMethod>) -> Result<Box<PxFn>> {
     }))
 }
 
+/// What [`run`] reads: a log streamed by its [`GyroReader`], or samples
+/// already read (a camera file, `crate::telemetry`).
+pub enum Samples {
+    /// A streaming log reader (its warnings printed when it is done).
+    Reader(Box<GyroReader>),
+    /// Samples in memory.
+    Read(std::vec::IntoIter<GyroSample>),
+}
+
+impl From<GyroReader> for Samples {
+    fn from(r: GyroReader) -> Self {
+        Samples::Reader(Box::new(r))
+    }
+}
+
+impl Samples {
+    fn print_warnings(&self) {
+        if let Samples::Reader(r) = self {
+            r.print_warnings();
+        }
+    }
+}
+
+impl Iterator for Samples {
+    type Item = Result<GyroSample>;
+    fn next(&mut self) -> Option<Self::Item> {
+        match self {
+            Samples::Reader(r) => r.next(),
+            Samples::Read(s) => s.next().map(Ok),
+        }
+    }
+}
+
 /// Streams `reader` through `eval` in batches of [`BATCH`] and writes the CSV.
 /// Parsing runs on a second thread, overlapped with evaluation and
 /// formatting (shortest round-trip floats, [`push_f64`]). Returns the number of samples.
 /// `px` gives each sample's px/s ([`px_of`]); `blur_px` is px/s times the exposure.
 pub fn run<W: Write>(
-    reader: GyroReader,
+    reader: impl Into<Samples>,
     eval: &mut BatchFn,
     px: &PxFn,
     exposure_s: Option<f64>,
     out: W,
 ) -> Result<u64> {
+    let reader: Samples = reader.into();
     // Rows come formatted in blocks of FORMAT_CHUNK (about 100 KB): a
     // buffer smaller than a block passes them straight to `out`, uncopied.
     let mut out = std::io::BufWriter::with_capacity(1 << 16, out);
