@@ -399,7 +399,7 @@ pub fn augment_image(img: &Image, a: &Augment) -> Result<AugmentedImage> {
         );
         frame_to_image(&cam, &target, tex, &traj.pose_at(t))
     };
-    let lmax = bound::longest_path_px(w, h, mode, &at)?;
+    let lmax = bound::longest_path_px(w, h, mode, at)?;
     let n = match (a.integrator, a.warps) {
         (Integrator::Render, _) => 1,
         (_, Some(n)) => n.max(1),
