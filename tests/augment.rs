@@ -52,7 +52,8 @@ fn motion() -> Motion {
 #[test]
 fn homographies_carry_a_point_to_its_streak() {
     let img = dot(40, 30);
-    let a = Augment::new(motion(), 0.03);
+    let mut a = Augment::new(motion(), 0.03);
+    a.maps = true;
     let out = augment(W, H, &img, &a).unwrap();
     // At exposure start the image fills the view: the identity.
     let (x0, y0) = apply(&out.homographies[0], 40.0, 30.0);
@@ -73,7 +74,7 @@ fn homographies_carry_a_point_to_its_streak() {
     );
     // The maps' path length at the dot is the streak's length.
     let k = (30 * W + 40) as usize;
-    let path = out.maps.path_px[k] as f64;
+    let path = out.maps.expect("maps asked for").path_px[k] as f64;
     assert!((path - len).abs() < 0.05 * len, "path {path} vs {len}");
 }
 

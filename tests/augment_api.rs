@@ -94,10 +94,11 @@ fn zero_motion_returns_the_input_bit_for_bit() {
                 a.integrator = integrator;
                 a.border = Border::Constant;
                 a.fields = true;
+                a.maps = true;
                 let out = augment_image(&img, &a).unwrap();
                 assert_eq!(out.pixels, pixels.to_buf(), "{integrator:?}, {c} channels");
                 assert_eq!(out.samples, 0);
-                assert!(out.maps.path_px.iter().all(|&p| p == 0.0));
+                assert!(out.maps.unwrap().path_px.iter().all(|&p| p == 0.0));
                 assert!(out.fields.unwrap().iter().all(|&d| d.abs() < 1e-4));
             }
         }
@@ -210,8 +211,9 @@ fn blur_px_is_the_mean_path_of_the_maps() {
         let mut a = Augment::new(motion, 0.02);
         a.blur_px = Some(target);
         a.sharp = mmbm::render::SharpAt::Mid;
+        a.maps = true;
         let out = augment_image(&f32_image(w, h, 3, &img), &a).unwrap();
-        let p = &out.maps.path_px;
+        let p = &out.maps.unwrap().path_px;
         let mean = p.iter().map(|&x| x as f64).sum::<f64>() / p.len() as f64;
         assert!(
             (mean / target - 1.0).abs() < 0.03,

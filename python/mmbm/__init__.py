@@ -502,6 +502,7 @@ def _augment_nhwc(
     border: str,
     blur_px: Optional[float],
     return_fields: bool,
+    return_maps: bool = False,
 ) -> Dict[str, Any]:
     """The images of ``x`` ((N, H, W, C), any supported dtype, a view is
     fine), image ``k`` applied with probability ``p`` under ``seeds[k]``."""
@@ -517,13 +518,14 @@ def _augment_nhwc(
     idx = [k for k in range(n) if applied[k]]
     out = {
         "image": np.array(x, copy=True) if idx else x,
-        "maps": {k: np.zeros((n, h, w), np.float32) for k in ("path_px", "disp_px", "speed_px_s")},
         "homographies": np.tile(np.eye(3), (n, 3, 1, 1)),
         "motion": ["none"] * n,
         "seed": list(seeds),
         "applied": applied,
         "samples": [0] * n,
     }
+    if return_maps:
+        out["maps"] = {k: np.zeros((n, h, w), np.float32) for k in ("path_px", "disp_px", "speed_px_s")}
     if return_fields:
         out["fields"] = np.zeros((n, 3, h, w, 2), np.float32)
     if not idx:
@@ -552,10 +554,12 @@ def _augment_nhwc(
         border,
         None if blur_px is None else float(blur_px),
         bool(return_fields),
+        bool(return_maps),
     )
     out["image"][idx] = img.astype(dtype, copy=False)
-    for key in out["maps"]:
-        out["maps"][key][idx] = maps[key]
+    if return_maps:
+        for key in out["maps"]:
+            out["maps"][key][idx] = maps[key]
     out["homographies"][idx] = hs
     if return_fields:
         out["fields"][idx] = fields
@@ -586,6 +590,7 @@ def augment(
     blur_px: Optional[float] = None,
     return_fields: bool = False,
     sharp: Optional[str] = None,
+    return_maps: bool = False,
 ) -> Dict[str, Any]:
     """Motion blur of ``image`` along a real or simulated camera motion.
 
@@ -608,27 +613,29 @@ def augment(
     ``"seed"``); a given seed reproduces the call. ``p``: the probability
     of applying (drawn from the seed); when not applied the input itself is
     returned. ``blur_px``: the motion scaled so that the mean path over the
-    frame (the mean of ``maps["path_px"]``) is that many px. ``border``:
+    frame (the mean of ``return_maps``' ``path_px``) is that many px. ``border``:
     ``"reflect"`` (mirrored about the edge pixels, OpenCV's REFLECT_101),
     ``"replicate"`` or ``"constant"`` (``background``, linear RGB;
     transparent with alpha). ``integrator``: ``"fast"`` (warp samples at
-    most 0.5 px apart: within 0.5/255 mean, 3/255 p99 of the exact time
-    integral), ``"exact"`` (1/32 px apart) or ``"render"`` (the renderer's
-    pixel-area integral, ``quality``; border ``"constant"`` only).
+    most 1 px apart at the peak speed, at least 8: within 0.5/255 mean,
+    3/255 p99 of the exact time integral; 2 px apart would not be),
+    ``"exact"`` (1/32 px apart) or ``"render"`` (the renderer's pixel-area
+    integral, ``quality``; border ``"constant"`` only).
     Without motion the input comes back bit for bit.
 
     ``image``: (H, W) or (H, W, C) with C 1, 3 or 4 (straight alpha, blurred
     with the colour premultiplied); uint8 or uint16 (sRGB, ``srgb`` default
     True) or float (linear, ``srgb`` ignored). Returns ``{"image"`` (same
-    shape and dtype), ``"maps"`` (``path_px``, ``disp_px``, ``speed_px_s``,
-    (H, W) float32), ``"homographies"`` ((3, 3, 3) float64: image pixel
+    shape and dtype), ``"homographies"`` ((3, 3, 3) float64: image pixel
     coordinates to the blurred frame's at exposure start, middle and end;
     (0, 0) the top-left corner), ``"motion"`` (what was drawn, e.g.
     ``sim:moderate@2.7141s``; ``"none"`` when not applied), ``"seed"``,
     ``"applied"``, ``"samples"`` (warp instants; 0: returned as given) and
     with ``return_fields`` ``"fields"`` ((3, H, W, 2) float32: for each
     pixel the displacement (x, y) px to the image point it sees at its
-    exposure's start, middle and end)``}``.
+    exposure's start, middle and end), with ``return_maps`` ``"maps"``
+    (``path_px``, ``disp_px``, ``speed_px_s``, (H, W) float32: computed only
+    when asked, as they cost more than the fast blur)``}``.
 
     >>> out = augment(np.zeros((24, 32, 3), np.uint8), motion="sim:fast", exposure=0.02)
     >>> out["image"].shape, out["homographies"].shape
@@ -642,11 +649,10 @@ def augment(
     s = _draw_seed() if seed is None else int(seed)
     out = _augment_nhwc(
         x, [s], p, motion, exposure, camera, _sharp(sharp, centre), zoom, distance, at, srgb, quality, background,
-        use_velocity, integrator, border, blur_px, return_fields,
+        use_velocity, integrator, border, blur_px, return_fields, return_maps,
     )
     res = {
         "image": a if not out["applied"][0] else out["image"][0].reshape(a.shape),
-        "maps": {k: v[0] for k, v in out["maps"].items()},
         "homographies": out["homographies"][0],
         "motion": out["motion"][0],
         "seed": s,
@@ -655,6 +661,8 @@ def augment(
     }
     if return_fields:
         res["fields"] = out["fields"][0]
+    if return_maps:
+        res["maps"] = {k: v[0] for k, v in out["maps"].items()}
     return res
 
 
@@ -702,7 +710,7 @@ def augment_batch(
     defaults = dict(
         motion="shake", exposure=0.03, camera=None, centre=None, sharp=None, zoom=1.0, distance=2.0, at=None, srgb=None,
         quality="default", background=(0.0, 0.0, 0.0), use_velocity=True, integrator="fast", border="reflect",
-        blur_px=None, return_fields=False,
+        blur_px=None, return_fields=False, return_maps=False,
     )
     p = kwargs.pop("p", 1.0)
     unknown = set(kwargs) - set(defaults)

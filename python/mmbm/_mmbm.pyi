@@ -113,6 +113,7 @@ def augment(
     border: str,
     blur_px: Optional[float],
     fields: bool,
-) -> Tuple[Any, Dict[str, F32], F64, Optional[F32], List[str], List[int]]: ...
+    maps: bool,
+) -> Tuple[Any, Optional[Dict[str, F32]], F64, Optional[F32], List[str], List[int]]: ...
 
 AUGMENT_MAX_PIXELS: int

@@ -8,7 +8,7 @@ use crate::err;
 use crate::interrupt::interruptible;
 use glam::DVec3;
 use mmbm::augment::{augment_batch, Augment, AugmentedImage, Image, Motion, PixelBuf, Pixels};
-use mmbm::render::Quality;
+use mmbm::render::{BlurMaps, Quality};
 use mmbm::Twist;
 use numpy::ndarray::{Array, Array3, Array4, Array5};
 use numpy::{Element, IntoPyArray, PyArray4, PyArrayMethods, PyUntypedArrayMethods};
@@ -20,7 +20,7 @@ use pyo3::types::PyDict;
 /// the warp instants per image.
 type Out<'py> = (
     Bound<'py, PyAny>,
-    Bound<'py, PyDict>,
+    Option<Bound<'py, PyDict>>,
     Bound<'py, PyAny>,
     Option<Bound<'py, PyAny>>,
     Vec<String>,
@@ -101,12 +101,13 @@ fn run<'py, T: Element + Copy + Send + Sync>(
 /// Blurs `images` ((N, H, W, C) uint8, uint16, float32 or float64,
 /// C-contiguous; C 1, 3 or 4), image `k` with seed `seeds[k]`. `motion`:
 /// `shake`, `sim:GAIT`, `twist` (with `omega`, `velocity`) or `log` (with
-/// `gyro`, `at`). Returns (images, maps (N, H, W) each, homographies
+/// `gyro`, `at`). Returns (images, maps (N, H, W) each or None without
+/// `maps`, homographies
 /// (N, 3, 3, 3), fields (N, 3, H, W, 2) or None, motions drawn, warp
 /// instants per image).
 #[pyfunction]
 #[pyo3(signature = (images, seeds, motion, omega, velocity, gyro, at, exposure, cam, distance, zoom,
-    sharp, quality, background, use_velocity, srgb, integrator, border, blur_px, fields))]
+    sharp, quality, background, use_velocity, srgb, integrator, border, blur_px, fields, maps))]
 #[allow(clippy::too_many_arguments)]
 pub fn augment<'py>(
     py: Python<'py>,
@@ -130,6 +131,7 @@ pub fn augment<'py>(
     border: &str,
     blur_px: Option<f64>,
     fields: bool,
+    maps: bool,
 ) -> PyResult<Out<'py>> {
     let mut job = Augment::new(self::motion(motion, omega, velocity, gyro, at)?, exposure);
     job.camera = cam.map(|c| camera(&c)).transpose()?;
@@ -143,6 +145,7 @@ pub fn augment<'py>(
     job.border = border.parse().map_err(err)?;
     job.blur_px = blur_px;
     job.fields = fields;
+    job.maps = maps;
     let jobs: Vec<Augment> = seeds
         .iter()
         .map(|&s| Augment {
@@ -226,19 +229,27 @@ pub fn augment<'py>(
             "images: uint8, uint16, float32 or float64 expected",
         ));
     };
-    let maps = PyDict::new(py);
-    for (k, get) in [
-        (
-            "path_px",
-            (|o: &AugmentedImage| &o.maps.path_px) as fn(&AugmentedImage) -> &Vec<f32>,
-        ),
-        ("disp_px", |o| &o.maps.disp_px),
-        ("speed_px_s", |o| &o.maps.speed_px_s),
-    ] {
-        let v: Vec<f32> = outs.iter().flat_map(|o| get(o).iter().copied()).collect();
-        let a = Array3::from_shape_vec((n, h, w), v).map_err(shape_err)?;
-        maps.set_item(k, a.into_pyarray(py))?;
-    }
+    let maps = if maps {
+        let d = PyDict::new(py);
+        for (k, get) in [
+            (
+                "path_px",
+                (|m: &BlurMaps| &m.path_px) as fn(&BlurMaps) -> &Vec<f32>,
+            ),
+            ("disp_px", |m| &m.disp_px),
+            ("speed_px_s", |m| &m.speed_px_s),
+        ] {
+            let v: Vec<f32> = outs
+                .iter()
+                .flat_map(|o| o.maps.iter().flat_map(|m| get(m).iter().copied()))
+                .collect();
+            let a = Array3::from_shape_vec((n, h, w), v).map_err(shape_err)?;
+            d.set_item(k, a.into_pyarray(py))?;
+        }
+        Some(d)
+    } else {
+        None
+    };
     let hs: Vec<f64> = outs
         .iter()
         .flat_map(|o| o.homographies.iter().flatten().copied())

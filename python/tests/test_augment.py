@@ -27,7 +27,7 @@ def centroid(img):
 
 @pytest.mark.parametrize("centre", [False, True])
 def test_homographies_follow_the_dot(centre):
-    out = mmbm.augment(dot(), motion={"omega": [0.0, 0.9, 0.2]}, exposure=0.03, centre=centre)
+    out = mmbm.augment(dot(), motion={"omega": [0.0, 0.9, 0.2]}, exposure=0.03, centre=centre, return_maps=True)
     hs = out["homographies"]
     assert hs.shape == (3, 3, 3)
     start, mid, end = (apply(hs[k], 30.0, 20.0) for k in range(3))

@@ -26,7 +26,7 @@ def noise(shape, dtype, seed=0):
     return rng.random(shape).astype(dtype)
 
 
-@pytest.mark.parametrize("dtype", [np.uint8, np.uint16, np.float32, np.float64])
+@pytest.mark.parametrize("dtype", [np.uint8, np.uint16, np.float16, np.float32, np.float64])
 @pytest.mark.parametrize("shape", [(120, 160), (120, 160, 1), (120, 160, 3), (120, 160, 4)])
 def test_zero_motion_returns_the_input_bit_for_bit(dtype, shape):
     img = noise(shape, dtype)
@@ -59,7 +59,7 @@ def test_p_zero_returns_the_input_and_p_is_drawn_per_seed():
         mmbm.augment(img, p=1.5)
 
 
-@pytest.mark.parametrize("dtype", [np.uint8, np.uint16, np.float32])
+@pytest.mark.parametrize("dtype", [np.uint8, np.uint16, np.float16, np.float32, np.float64])
 @pytest.mark.parametrize("shape", [(48, 64), (48, 64, 1), (48, 64, 3), (48, 64, 4)])
 def test_every_shape_and_dtype_is_blurred_in_kind(dtype, shape):
     img = noise(shape, dtype)
@@ -105,7 +105,7 @@ def test_batches_in_either_layout_are_the_images_one_by_one(layout):
 def test_blur_px_is_the_mean_path():
     img = noise((96, 128, 3), np.float32)
     for target in (5.0, 20.0):
-        out = mmbm.augment(img, motion="shake", seed=3, blur_px=target, centre=True)
+        out = mmbm.augment(img, motion="shake", seed=3, blur_px=target, centre=True, return_maps=True)
         assert abs(out["maps"]["path_px"].mean() / target - 1.0) < 0.03
 
 
@@ -179,3 +179,18 @@ def test_blur_dataset_applies_the_transform():
     assert got[0][0].shape == (24, 32, 3)
     np.testing.assert_array_equal(ds[1][0], ds.item(1)["sharp"])
     assert "sharp" in ds.item(0)
+
+
+def test_maps_only_when_asked_for():
+    """The blur maps cost more than the fast blur: returned (and computed)
+    only with ``return_maps``; the image is the same either way."""
+    img = noise((48, 64, 3), np.float32)
+    plain = mmbm.augment(img, motion=YAW, seed=2)
+    assert "maps" not in plain
+    with_maps = mmbm.augment(img, motion=YAW, seed=2, return_maps=True)
+    np.testing.assert_array_equal(plain["image"], with_maps["image"])
+    assert with_maps["maps"]["path_px"].shape == (48, 64)
+    assert with_maps["maps"]["path_px"].mean() > 5.0
+    b = mmbm.augment_batch(np.stack([img, img]), seed=2, motion=YAW, return_maps=True)
+    assert b["maps"]["path_px"].shape == (2, 48, 64)
+    assert "maps" not in mmbm.augment_batch(np.stack([img, img]), seed=2, motion=YAW)

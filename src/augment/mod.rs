@@ -16,12 +16,15 @@
 //!
 //! Integrators ([`Integrator`]): `fast` (default) and `exact` average the
 //! image's bilinear interpolant at each pixel centre's path over instants
-//! spaced at most 0.5 px (fast: within the image contract, mean 0.5/255 and
-//! p99 3/255 against the exact time integral) or 1/32 px (exact: within
-//! 0.02/255) apart ([`warp`]); `render` is the renderer (each pixel the
+//! spaced at most 1 px (fast: within the image contract, mean 0.5/255 and
+//! p99 3/255 against the exact time integral; 2 px is not) or 1/32 px
+//! (exact: within 0.02/255) apart along the longest path ([`bound`],
+//! [`warp`]); `render` is the renderer (each pixel the
 //! exact integral of the interpolant over its area and the exposure, so a
 //! still image is the (1/8, 3/4, 1/8) filter of the input). Without motion
-//! every integrator returns the input bit for bit.
+//! every integrator returns the input bit for bit. The blur maps are
+//! computed only when asked for ([`Augment::maps`]): they cost more than
+//! the fast blur itself.
 //!
 //! Homographies: `H(t)` maps image pixel coordinates (fractional, `(0, 0)`
 //! the top-left corner, as [`crate::render::project`]'s) to the frame's
@@ -29,6 +32,7 @@
 //! start, middle and end (exact for a camera without lens distortion, and
 //! refused with one since the map is not a homography then).
 
+pub mod bound;
 pub mod motion;
 pub mod pixels;
 pub mod warp;
@@ -74,7 +78,8 @@ pub enum Motion {
 /// How the exposure is integrated.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Integrator {
-    /// Warp samples at most 0.5 px apart along the longest path.
+    /// Warp samples at most 1 px apart along the longest path (within the
+    /// image contract; 2 px apart is not: `tests/augment_speed.rs`).
     #[default]
     Fast,
     /// Warp samples at most 1/32 px apart (the reference of `fast`).
@@ -87,11 +92,29 @@ impl Integrator {
     /// Largest distance (px) between neighbouring warp samples.
     pub fn spacing_px(self) -> f64 {
         match self {
-            Integrator::Fast => 0.5,
+            Integrator::Fast => 1.0,
             _ => 1.0 / 32.0,
         }
     }
+
+    /// Warp instants for a longest path of `path_px` px (peak speed,
+    /// [`bound`]): the path over the spacing; `fast` takes at least
+    /// [`FAST_MIN_SAMPLES`] instants (or 0.5 px apart if fewer suffice),
+    /// since with a few instants the bilinear interpolant's errors at
+    /// each no longer average out (a 3.6 px shake at 4 instants is at
+    /// 0.52/255 mean). `render`: 1.
+    pub fn samples(self, path_px: f64) -> usize {
+        let n = |s: f64| (path_px / s).ceil().max(1.0) as usize;
+        match self {
+            Integrator::Render => 1,
+            Integrator::Fast => n(1.0).max(n(0.5).min(FAST_MIN_SAMPLES)),
+            Integrator::Exact => n(self.spacing_px()),
+        }
+    }
 }
+
+/// Fewest warp instants of `fast` for a path of 4 px or more ([`Integrator::samples`]).
+pub const FAST_MIN_SAMPLES: usize = 8;
 
 impl FromStr for Integrator {
     type Err = Error;
@@ -142,12 +165,18 @@ pub struct Augment {
     pub blur_px: Option<f64>,
     /// Also return the displacement fields.
     pub fields: bool,
+    /// Also compute the blur maps ([`AugmentedImage::maps`]).
+    pub maps: bool,
+    /// Warp instants per pixel; `None` (default): from the longest path and
+    /// the integrator's spacing ([`Integrator::spacing_px`]).
+    pub warps: Option<usize>,
 }
 
 impl Augment {
     /// Defaults: `exposure_s` of the given motion, thesis camera, 2 m, zoom
     /// 1, exposure start as reference, seed 0, `fast` integrator, reflected
-    /// border, black background, translation used, no blur target, no fields.
+    /// border, black background, translation used, no blur target, no
+    /// fields, no maps, warp instants from the path.
     pub fn new(motion: Motion, exposure_s: f64) -> Self {
         Augment {
             motion,
@@ -164,6 +193,8 @@ impl Augment {
             border: Border::Reflect,
             blur_px: None,
             fields: false,
+            maps: false,
+            warps: None,
         }
     }
 }
@@ -177,8 +208,9 @@ pub struct Augmented {
     pub height: u32,
     /// Linear RGB, interleaved, row-major.
     pub rgb: Vec<f32>,
-    /// Per-pixel blur maps (path length, displacement, speed).
-    pub maps: BlurMaps,
+    /// Per-pixel blur maps (path length, displacement, speed), when asked
+    /// for ([`Augment::maps`]).
+    pub maps: Option<BlurMaps>,
     /// Image px to frame px at exposure start, middle and end (row-major 3x3).
     pub homographies: [[f64; 9]; 3],
     /// What the motion was (e.g. `sim:moderate@3.217s`, `twist`).
@@ -190,8 +222,9 @@ pub struct Augmented {
 pub struct AugmentedImage {
     /// The blurred image: the input's size, channels and dtype.
     pub pixels: PixelBuf,
-    /// Per-pixel blur maps (path length, displacement, speed).
-    pub maps: BlurMaps,
+    /// Per-pixel blur maps (path length, displacement, speed), when asked
+    /// for ([`Augment::maps`]).
+    pub maps: Option<BlurMaps>,
     /// Image px to frame px at exposure start, middle and end (row-major 3x3).
     pub homographies: [[f64; 9]; 3],
     /// With `fields`: for each frame pixel, the displacement (px; x, y) from
@@ -352,21 +385,6 @@ pub fn augment_image(img: &Image, a: &Augment) -> Result<AugmentedImage> {
     });
     let [h0, h1, h2] = homographies;
     let homographies = [h0?, h1?, h2?];
-    let lmax = render::maps::max_path_px(&cam, &target, &traj);
-    let n = match a.integrator {
-        Integrator::Render => 1,
-        i => ((lmax / i.spacing_px()).ceil() as usize).max(1),
-    };
-    let pixels = w as u64 * h as u64;
-    if n > AUGMENT_MAX_WARP_SAMPLES || pixels * n as u64 > AUGMENT_MAX_PIXEL_SAMPLES {
-        return Err(Error::invalid(
-            "augment",
-            format!(
-                "{w} x {h} px x {n} warp samples ({lmax:.0} px of blur): at most \
-                 {AUGMENT_MAX_WARP_SAMPLES} samples and {AUGMENT_MAX_PIXEL_SAMPLES} pixel-samples"
-            ),
-        ));
-    }
     // The frame-to-image map of each line at each instant.
     let mode = render::homography::line_mode(&cam);
     let lines = render::homography::table_lines(&cam) as usize;
@@ -381,6 +399,22 @@ pub fn augment_image(img: &Image, a: &Augment) -> Result<AugmentedImage> {
         );
         frame_to_image(&cam, &target, tex, &traj.pose_at(t))
     };
+    let lmax = bound::longest_path_px(w, h, mode, at)?;
+    let n = match (a.integrator, a.warps) {
+        (Integrator::Render, _) => 1,
+        (_, Some(n)) => n.max(1),
+        (i, None) => i.samples(lmax),
+    };
+    let pixels = w as u64 * h as u64;
+    if n > AUGMENT_MAX_WARP_SAMPLES || pixels * n as u64 > AUGMENT_MAX_PIXEL_SAMPLES {
+        return Err(Error::invalid(
+            "augment",
+            format!(
+                "{w} x {h} px x {n} warp samples ({lmax:.0} px of blur): at most \
+                 {AUGMENT_MAX_WARP_SAMPLES} samples and {AUGMENT_MAX_PIXEL_SAMPLES} pixel-samples"
+            ),
+        ));
+    }
     let mats: Vec<DMat3> = (0..lines * n)
         .map(|k| at(k / n, k % n, n))
         .collect::<Result<_>>()?;
@@ -411,9 +445,11 @@ pub fn augment_image(img: &Image, a: &Augment) -> Result<AugmentedImage> {
             Ok::<_, Error>(warp::fields(w as usize, h as usize, mode, &[p0?, p1?, p2?]))
         })
         .transpose()?;
-    let maps = if still {
+    let maps = if !a.maps {
+        None
+    } else if still {
         let zero = vec![0.0f32; (w * h) as usize];
-        BlurMaps {
+        Some(BlurMaps {
             width: w,
             height: h,
             duration: traj.duration(),
@@ -421,11 +457,18 @@ pub fn augment_image(img: &Image, a: &Augment) -> Result<AugmentedImage> {
             disp_px: zero.clone(),
             speed_px_s: zero.clone(),
             speed_mm_s: zero,
-        }
+        })
     } else {
         // Chords of about 2 px (the maps are a measure, not the image).
+        let lmax = render::maps::max_path_px(&cam, &target, &traj);
         let steps = ((0.5 * lmax).ceil() as usize).clamp(8, 4096);
-        render::maps::blur_maps(&cam, &target, &traj, a.exposure_s, steps)
+        Some(render::maps::blur_maps(
+            &cam,
+            &target,
+            &traj,
+            a.exposure_s,
+            steps,
+        ))
     };
     crate::cancel::check()?;
     let (pixels, samples) = if still {

@@ -170,33 +170,31 @@ impl Image<'_> {
     /// Linear f32 values, colour premultiplied by alpha with 4 channels.
     pub fn to_linear(&self) -> Vec<f32> {
         let c = self.channels as usize;
-        let alpha = |k: usize| c == 4 && k % 4 == 3;
+        // Integer codes: the sRGB table (colour) or the scale (alpha, linear).
+        fn decode<T: Copy + Into<u32>>(
+            v: &[T],
+            table: &[f32],
+            max: f32,
+            srgb: bool,
+            c: usize,
+        ) -> Vec<f32> {
+            v.iter()
+                .enumerate()
+                .map(|(k, &x)| {
+                    let x: u32 = x.into();
+                    if srgb && !(c == 4 && k % 4 == 3) {
+                        table[x as usize]
+                    } else {
+                        x as f32 / max
+                    }
+                })
+                .collect()
+        }
         let mut out: Vec<f32> = match self.pixels {
-            Pixels::U8(v) => {
-                let t = decode_u8();
-                v.iter()
-                    .enumerate()
-                    .map(|(k, &x)| {
-                        if self.srgb && !alpha(k) {
-                            t[x as usize]
-                        } else {
-                            x as f32 / 255.0
-                        }
-                    })
-                    .collect()
-            }
+            Pixels::U8(v) => decode(v, decode_u8(), 255.0, self.srgb, c),
             Pixels::U16(v) => {
                 let t = if self.srgb { decode_u16() } else { &[] };
-                v.iter()
-                    .enumerate()
-                    .map(|(k, &x)| {
-                        if self.srgb && !alpha(k) {
-                            t[x as usize]
-                        } else {
-                            x as f32 / 65535.0
-                        }
-                    })
-                    .collect()
+                decode(v, t, 65535.0, self.srgb, c)
             }
             Pixels::F32(v) => v.to_vec(),
             Pixels::F64(v) => v.iter().map(|&x| x as f32).collect(),

@@ -171,6 +171,57 @@ pub fn integrate(src: &Src, maps: &Maps) -> Vec<f32> {
     }
 }
 
+/// A map `g` (row-major) along the row of pixel centres at height `y`, as
+/// affine functions of the column `i`: `(u, v, z)` numerators at pixel
+/// `i` are `(k[0] + k[1] i, k[2] + k[3] i, k[4] + k[5] i)` (the centre at
+/// `i + 0.5`), so a pixel costs no matrix product.
+#[inline]
+fn along_row(g: &[f32; 9], y: f32) -> [f32; 6] {
+    [
+        g[0] * 0.5 + g[1] * y + g[2],
+        g[0],
+        g[3] * 0.5 + g[4] * y + g[5],
+        g[3],
+        g[6] * 0.5 + g[7] * y + g[8],
+        g[6],
+    ]
+}
+
+/// Adds the interpolant at column `i` under the row map `k` to `acc`.
+#[inline(always)]
+fn sample<const C: usize>(src: &Src, k: &[f32; 6], fi: f32, acc: &mut [f32; C]) {
+    let z = k[4] + k[5] * fi;
+    if z <= 0.0 {
+        for (a, f) in acc.iter_mut().zip(src.fill) {
+            *a += f;
+        }
+        return;
+    }
+    let r = 1.0 / z;
+    let u = (k[0] + k[1] * fi) * r - 0.5;
+    let v = (k[2] + k[3] * fi) * r - 0.5;
+    let (x0, y0) = (u.floor(), v.floor());
+    let (xi, yi) = (x0 as i64, y0 as i64);
+    if xi >= 0 && yi >= 0 && xi + 1 < src.w as i64 && yi + 1 < src.h as i64 {
+        // Inside: two lerps along x, one along y, per channel.
+        let (fx, fy) = (u - x0, v - y0);
+        let i = (yi as usize * src.w + xi as usize) * C;
+        let r = src.w * C;
+        let t = &src.v[i..i + C * 2];
+        let b = &src.v[i + r..i + r + C * 2];
+        for c in 0..C {
+            let top = t[c] + fx * (t[c + C] - t[c]);
+            let bot = b[c] + fx * (b[c + C] - b[c]);
+            acc[c] += top + fy * (bot - top);
+        }
+    } else {
+        src.add(u, v, acc);
+    }
+}
+
+/// Pixel by pixel, each pixel's instants summed in registers; the maps of
+/// a row precomputed once per row (per pixel only with a column-wise
+/// rolling shutter, `mode` 2), rows in parallel.
 fn integrate_c<const C: usize>(src: &Src, maps: &Maps) -> Vec<f32> {
     let (w, h) = (src.w, src.h);
     let n = maps.n;
@@ -178,31 +229,27 @@ fn integrate_c<const C: usize>(src: &Src, maps: &Maps) -> Vec<f32> {
     let mut out = vec![0.0f32; w * h * C];
     out.par_chunks_mut(w * C).enumerate().for_each(|(j, row)| {
         let y = j as f32 + 0.5;
-        for m in 0..n {
-            for (i, px) in row.chunks_exact_mut(C).enumerate() {
-                let line = match maps.mode {
-                    0 => 0,
-                    1 => j,
-                    _ => i,
-                };
-                let g = &maps.m[line * n + m];
-                let x = i as f32 + 0.5;
-                let z = g[6] * x + g[7] * y + g[8];
-                let mut acc = [0.0f32; C];
-                if z <= 0.0 {
-                    acc.copy_from_slice(&src.fill[..C]);
-                } else {
-                    let r = 1.0 / z;
-                    let u = (g[0] * x + g[1] * y + g[2]) * r - 0.5;
-                    let v = (g[3] * x + g[4] * y + g[5]) * r - 0.5;
-                    src.add(u, v, &mut acc);
+        let line = if maps.mode == 1 { j } else { 0 };
+        let ks: Vec<[f32; 6]> = maps.m[line * n..(line + 1) * n]
+            .iter()
+            .map(|g| along_row(g, y))
+            .collect();
+        for (i, px) in row.chunks_exact_mut(C).enumerate() {
+            let fi = i as f32;
+            let mut acc = [0.0f32; C];
+            if maps.mode == 2 {
+                for g in &maps.m[i * n..(i + 1) * n] {
+                    sample::<C>(src, &along_row(g, y), fi, &mut acc);
                 }
-                for k in 0..C {
-                    px[k] += acc[k];
+            } else {
+                for k in &ks {
+                    sample::<C>(src, k, fi, &mut acc);
                 }
             }
+            for (p, a) in px.iter_mut().zip(acc) {
+                *p = a * scale;
+            }
         }
-        row.iter_mut().for_each(|x| *x *= scale);
     });
     out
 }
