@@ -65,7 +65,8 @@ pub fn set_progress(p: Box<dyn Progress>) -> bool {
 
 /// Starts a job's progress: reported to the installed [`Progress`] when
 /// `show` is true and one is installed, else nowhere.
-pub(crate) fn progress(show: bool, what: &str, total: u64) -> Box<dyn ProgressTask> {
+#[doc(hidden)]
+pub fn progress(show: bool, what: &str, total: u64) -> Box<dyn ProgressTask> {
     match PROGRESS.get() {
         Some(p) if show => p.start(what, total),
         _ => Box::new(Nowhere),

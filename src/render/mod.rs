@@ -1,4 +1,4 @@
-//! Ground-truth motion-blur renderer (SPEC section 4).
+//! Ground-truth motion-blur renderer (docs/spec.md section 4).
 //!
 //! A textured planar [`Target`] seen by a [`Camera`] moving along a
 //! [`Trajectory`] during one exposure (box shutter). Each pixel is the mean
@@ -29,7 +29,8 @@ pub mod poster;
 pub(crate) mod psf;
 mod sampling;
 pub mod sharp;
-pub(crate) mod target;
+#[doc(hidden)]
+pub mod target;
 pub mod texture;
 
 pub use crate::gpu::Backend;
@@ -239,7 +240,7 @@ pub struct RenderJob {
     /// Camera motion from the first line's exposure start to the last line's
     /// exposure end: [`Self::exposure_s`] plus the camera's rolling-shutter
     /// readout when it has one (each line is exposed over its own window,
-    /// SPEC 9). Checked when the job renders.
+    /// docs/spec.md section 9). Checked when the job renders.
     pub trajectory: Trajectory,
     /// The target.
     pub target: Target,

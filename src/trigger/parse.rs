@@ -141,7 +141,7 @@ impl Family {
     }
 }
 
-/// The family of SPEC section 10, by which the benefit map groups the
+/// The family of docs/spec.md section 10, by which the benefit map groups the
 /// policies (the `family` column of `frames.csv`). Not the rule ([`Family`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum PolicyFamily {
@@ -365,7 +365,7 @@ impl PolicySpec {
         &self.text
     }
 
-    /// The family of SPEC section 10 (the benefit map's grouping).
+    /// The family of docs/spec.md section 10 (the benefit map's grouping).
     pub fn policy_family(&self) -> PolicyFamily {
         if !self.is_causal() {
             PolicyFamily::Oracle

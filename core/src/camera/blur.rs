@@ -9,7 +9,7 @@ use crate::error::{Error, Result};
 ///
 /// ```
 /// // 0.4 mm/s for 70 ms on 4.65 um pixels: about 6 px.
-/// let b = mmbm::camera::blur_px(0.4, 0.07, 0.00465);
+/// let b = mmbm_core::camera::blur_px(0.4, 0.07, 0.00465);
 /// assert!((b - 6.0215).abs() < 1e-3);
 /// ```
 pub fn blur_px(mmbm_mm_s: f64, exposure_s: f64, pitch_mm: f64) -> f64 {
@@ -21,8 +21,8 @@ pub fn blur_px(mmbm_mm_s: f64, exposure_s: f64, pitch_mm: f64) -> f64 {
 /// door that prints or stores a blur in px uses this one.
 ///
 /// ```
-/// assert!(mmbm::camera::checked_blur_px(0.4, 1e308, 0.00465).is_err());
-/// assert!(mmbm::camera::checked_blur_px(0.4, 0.07, 0.00465).is_ok());
+/// assert!(mmbm_core::camera::checked_blur_px(0.4, 1e308, 0.00465).is_err());
+/// assert!(mmbm_core::camera::checked_blur_px(0.4, 0.07, 0.00465).is_ok());
 /// ```
 pub fn checked_blur_px(mmbm_mm_s: f64, exposure_s: f64, pitch_mm: f64) -> Result<f64> {
     finite_blur(blur_px(mmbm_mm_s, exposure_s, pitch_mm), || {

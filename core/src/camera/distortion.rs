@@ -1,4 +1,4 @@
-//! Lens distortion (SPEC section 9): the two models users have calibrations
+//! Lens distortion (docs/spec.md section 9): the two models users have calibrations
 //! for, as maps of normalised pinhole coordinates `(x, y) = (X/Z, Y/Z)` to
 //! distorted normalised coordinates `(x_d, y_d)`; pixels are then
 //! `K [x_d, y_d, 1]`.

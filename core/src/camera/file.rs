@@ -2,7 +2,7 @@
 //! profiles (JSON with `fisheye_params`), so that the public collection of
 //! Gyroflow profiles works as it is.
 //!
-//! Own format (every key of SPEC 1 and 9; pitch may be given once for square pixels):
+//! Own format (every key of docs/spec.md section 1 and 9; pitch may be given once for square pixels):
 //!
 //! ```toml
 //! focal_mm = 4.2548
@@ -54,7 +54,7 @@ pub use super::gyroflow::Choice;
 /// array took 5.7 s and 530 MB to refuse.
 pub const MAX_CAMERA_BYTES: u64 = 1 << 20;
 
-/// The camera file's keys (SPEC sections 1 and 9), every one optional: on
+/// The camera file's keys (docs/spec.md sections 1 and 9), every one optional: on
 /// its own ([`CameraFile::camera`]) a file needs `focal_mm`, a pitch
 /// (`pitch_mm`, or `pitch_x_mm` and `pitch_y_mm`), `width` and `height`;
 /// over a base camera ([`CameraFile::over`]) each key given replaces the

@@ -1,7 +1,7 @@
 //! Camera intrinsics: focal length (mm), pixel pitch (mm), resolution,
-//! principal point and skew (pixels), and the real-camera parts of SPEC
+//! principal point and skew (pixels), and the real-camera parts of docs/spec.md
 //! section 9 (distortion, rolling shutter, noise, lens). Coordinates follow
-//! SPEC section 1: x right, y down, z forward; sensor coordinates `(u, v)` in
+//! docs/spec.md section 1: x right, y down, z forward; sensor coordinates `(u, v)` in
 //! mm, which are `f` times the normalised coordinates `(x, y)`.
 
 use super::distortion::{Distortion, Jac};

@@ -1,4 +1,4 @@
-//! Thin-lens defocus (SPEC section 9): aperture diameter `A = f / N`; a point
+//! Thin-lens defocus (docs/spec.md section 9): aperture diameter `A = f / N`; a point
 //! at depth `z` focused at `s` spreads over a disc of diameter
 //! `c = A f / (s - f) |z - s| / z` on the sensor.
 

@@ -1,4 +1,4 @@
-//! The camera (SPEC sections 1 and 9): pinhole intrinsics (`intrinsics`),
+//! The camera (docs/spec.md sections 1 and 9): pinhole intrinsics (`intrinsics`),
 //! lens distortion (`distortion`), rolling shutter (`shutter`), sensor
 //! noise (`noise`), thin-lens defocus (`lens`), blur in px of an MMBM over
 //! an exposure (`blur`) and the files that describe
@@ -9,7 +9,8 @@
 
 pub(crate) mod blur;
 pub(crate) mod digital;
-pub(crate) mod distortion;
+#[doc(hidden)]
+pub mod distortion;
 pub(crate) mod file;
 pub(crate) mod fisheye;
 pub(crate) mod gyroflow;

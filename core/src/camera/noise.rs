@@ -1,4 +1,4 @@
-//! Sensor noise, the EMVA 1288 linear photon-transfer model (SPEC section 9).
+//! Sensor noise, the EMVA 1288 linear photon-transfer model (docs/spec.md section 9).
 //!
 //! A pixel of linear radiance `L` (0..1) collects `mu_e = phi * t_e * L`
 //! electrons on average in an exposure of `t_e` seconds (`phi`: the electrons

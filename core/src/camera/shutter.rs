@@ -1,4 +1,4 @@
-//! Rolling shutter (SPEC section 9): the exposure of line `j` of `n` starts
+//! Rolling shutter (docs/spec.md section 9): the exposure of line `j` of `n` starts
 //! `readout_s * j / n` after the first line's. The readout direction is named
 //! as Gyroflow names it; `../shared/data` and this crate stamp a frame at the
 //! exposure start of its first line (Gyroflow stamps the middle of the readout:

@@ -1,4 +1,4 @@
-//! Gyro logs (SPEC section 5): a plain CSV with a header row, columns `t`
+//! Gyro logs (docs/spec.md section 5): a plain CSV with a header row, columns `t`
 //! (seconds by default), `wx, wy, wz` (rad/s by default), optional `vx, vy, vz`
 //! (m/s) and `depth` (m). Lines starting with `#` are comments. A ROS 2 MCAP
 //! file (`mcap`) or a Gyroflow `.gcsv` log ([`super::gcsv`]) is read

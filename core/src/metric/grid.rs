@@ -56,7 +56,7 @@ pub fn gauss_legendre(n: usize) -> (Vec<f64>, Vec<f64>) {
 /// With lens distortion ([`GridRule::distorted`]) the nodes stay where they
 /// are on the (distorted) sensor, the monomials are those of their undistorted
 /// points and the distortion's Jacobian at each is kept: the speed at a node is
-/// `|J flow(u, v)|` (SPEC section 9).
+/// `|J flow(u, v)|` (docs/spec.md section 9).
 #[derive(Debug, Clone)]
 pub struct GridRule {
     m: [Vec<f64>; 5],

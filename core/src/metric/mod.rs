@@ -284,13 +284,13 @@ impl Scene {
 /// is `crate::field::mmbm_gpu`.)
 ///
 /// ```
-/// use mmbm::{mmbm, Camera, Method, Scene, Twist};
+/// use mmbm_core::{mmbm, Camera, Method, Scene, Twist};
 /// let scene = Scene { camera: Camera::thesis(), plane: None };
 /// // Pitching at 1 rad/s: every point moves at least f = 4.2548 mm/s on the sensor.
 /// let m = mmbm(&scene, &Twist::rotation(1.0, 0.0, 0.0), Method::Exact { tol: 1e-9 })?;
 /// assert!(m.mm_s > 4.2548 && m.mm_s < 5.0);
 /// assert!(m.error_estimate.unwrap() < 1e-6);
-/// # Ok::<(), mmbm::Error>(())
+/// # Ok::<(), mmbm_core::Error>(())
 /// ```
 pub fn mmbm(scene: &Scene, tw: &Twist, method: Method) -> Result<Mmbm> {
     scene.validate_for(tw)?;
@@ -300,7 +300,7 @@ pub fn mmbm(scene: &Scene, tw: &Twist, method: Method) -> Result<Mmbm> {
 
 /// MMBM of a pre-expanded flow polynomial (no validation; the hot path).
 /// Through lens distortion the rules average `|J flow|` at the undistorted
-/// points of their nodes on the (distorted) sensor rectangle (SPEC 9).
+/// points of their nodes on the (distorted) sensor rectangle (docs/spec.md section 9).
 pub fn mmbm_poly(cam: &Camera, poly: &FlowPoly, method: Method) -> Result<Mmbm> {
     let rect = cam.sensor_rect();
     let pinhole = cam.distortion.is_none();

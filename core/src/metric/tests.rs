@@ -1,4 +1,4 @@
-//! Metric tests: thesis tables (values typed from the thesis), SPEC reference
+//! Metric tests: thesis tables (values typed from the thesis), docs/spec.md reference
 //! values, the roll closed form and properties.
 
 use super::*;

@@ -1,4 +1,4 @@
-//! The instantaneous image-plane flow of SPEC section 2 (thesis eq. 3.20).
+//! The instantaneous image-plane flow of docs/spec.md section 2 (thesis eq. 3.20).
 //!
 //! For sensor point `(u, v)` mm, focal length `f` mm, twist `w` rad/s, `t` m/s
 //! and scene depth `z` m:
@@ -39,7 +39,7 @@ pub fn flow_at(f: f64, u: f64, v: f64, tw: &Twist, plane: Option<&Plane>) -> (f6
 }
 
 /// Flow (mm/s on the distorted sensor) seen at the distorted sensor point
-/// `(ud, vd)` mm (SPEC section 9): the pinhole flow of its undistorted point
+/// `(ud, vd)` mm (docs/spec.md section 9): the pinhole flow of its undistorted point
 /// pushed through the distortion's Jacobian. Without distortion this is
 /// exactly [`flow_at`]. `None` where undistortion does not converge.
 #[inline]

@@ -1,4 +1,4 @@
-//! The IMU log (SPEC section 5), validated once: its samples in the camera
+//! The IMU log (docs/spec.md section 5), validated once: its samples in the camera
 //! frame ([`GyroSample`]), strictly increasing finite times, the gap rule
 //! (an interval over [`GAP_FACTOR`] x the median is a gap), the log's own
 //! rolling-shutter readout where the file carries one (a Gyroflow `.gcsv`),
@@ -202,12 +202,12 @@ impl ImuLog {
     ///
     /// ```
     /// use glam::DVec3;
-    /// use mmbm::model::log::{GyroSample, ImuLog};
+    /// use mmbm_core::model::log::{GyroSample, ImuLog};
     /// let s = |t| GyroSample { t, omega: DVec3::new(0.1, 0.0, 0.0), velocity: None, depth: None };
     /// let log = ImuLog::new(vec![s(0.0), s(0.005), s(0.01)])?;
     /// assert_eq!(log.median_interval(), Some(0.005));
     /// assert!(ImuLog::new(vec![s(0.0), s(0.0)]).is_err()); // time must increase
-    /// # Ok::<(), mmbm::Error>(())
+    /// # Ok::<(), mmbm_core::Error>(())
     /// ```
     pub fn new(samples: Vec<GyroSample>) -> Result<Self> {
         if samples.is_empty() {

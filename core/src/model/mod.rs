@@ -1,4 +1,4 @@
-//! The physical model (SPEC sections 1-2): the camera (its own layer-1 folder,
+//! The physical model (docs/spec.md sections 1-2): the camera (its own layer-1 folder,
 //! [`crate::camera`]), its motion and the scene plane ([`motion`]), and the
 //! instantaneous image-plane flow they produce ([`flow`]), and the IMU log that
 //! measures the motion ([`log`]), and the camera's pose over an exposure

@@ -1,4 +1,4 @@
-//! Camera pose trajectories over one exposure (SPEC section 4).
+//! Camera pose trajectories over one exposure (docs/spec.md section 4).
 //!
 //! Convention: the world frame is the camera frame at exposure start, so
 //! `pose_at(0) = (identity, 0)`. A pose `(q, c)` maps camera-frame vectors to

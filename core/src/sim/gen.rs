@@ -236,7 +236,7 @@ impl Iterator for Samples {
 
 impl ExactSizeIterator for Samples {}
 
-/// Writes samples as a gyro CSV (SPEC section 5) atomically: header
+/// Writes samples as a gyro CSV (docs/spec.md section 5) atomically: header
 /// `t,wx,wy,wz` plus `,vx,vy,vz` when every sample has a velocity and
 /// `,depth` when every sample has a depth (a mix of samples with and without
 /// is an error). Floats use Rust's shortest round-trip formatting, so reading

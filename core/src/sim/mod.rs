@@ -1,5 +1,5 @@
 //! Seeded simulation of a hexapod's (SensoRHex-like) straight walk: a gyro log
-//! in the camera frame (x right, y down, z forward), SPEC section 7.
+//! in the camera frame (x right, y down, z forward), docs/spec.md section 7.
 //!
 //! # Model
 //!

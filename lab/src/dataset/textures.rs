@@ -20,28 +20,28 @@ pub const BUILTIN: &str = "builtin:";
 pub const BUILTIN_FILES: [(&str, &[u8]); 5] = [
     (
         "brick.png",
-        include_bytes!("../../assets/textures/brick.png"),
+        include_bytes!("../../../assets/textures/brick.png"),
     ),
     (
         "chelsea.png",
-        include_bytes!("../../assets/textures/chelsea.png"),
+        include_bytes!("../../../assets/textures/chelsea.png"),
     ),
     (
         "coffee.png",
-        include_bytes!("../../assets/textures/coffee.png"),
+        include_bytes!("../../../assets/textures/coffee.png"),
     ),
     (
         "gravel.png",
-        include_bytes!("../../assets/textures/gravel.png"),
+        include_bytes!("../../../assets/textures/gravel.png"),
     ),
     (
         "rocket.jpg",
-        include_bytes!("../../assets/textures/rocket.jpg"),
+        include_bytes!("../../../assets/textures/rocket.jpg"),
     ),
 ];
 
 /// The built-in textures' origin and licences (`assets/textures/LICENSE.md`).
-pub const LICENSE: &str = include_str!("../../assets/textures/LICENSE.md");
+pub const LICENSE: &str = include_str!("../../../assets/textures/LICENSE.md");
 
 /// True when `textures` names the built-in set.
 pub fn is_builtin(textures: &Path) -> bool {

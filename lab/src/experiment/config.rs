@@ -29,7 +29,7 @@ pub struct ExperimentConfig {
     /// Several simulation seeds (each walk simulated once per seed; the
     /// headline pools them). Empty: `seed` alone.
     pub seeds: Vec<u64>,
-    /// A real gyro log (CSV of SPEC section 5) instead of the simulation.
+    /// A real gyro log (CSV of docs/spec.md section 5) instead of the simulation.
     pub gyro: Option<PathBuf>,
     /// Forward speed (m/s) used for the target distance when the log has no velocity.
     pub speed_m_s: f64,
@@ -68,11 +68,11 @@ pub struct ExperimentConfig {
     pub sweep_frames: usize,
     /// The `[camera]` section: any of the camera file's keys
     /// ([`CameraFile`]) over the thesis camera at `resolution`, e.g. the
-    /// real camera of SPEC section 9 (`readout_s`, `readout_direction`,
+    /// real camera of docs/spec.md section 9 (`readout_s`, `readout_direction`,
     /// `[camera.distortion]`, `[camera.noise]`, `[camera.lens]`; all off by
     /// default: the thesis's ideal global-shutter pinhole).
     pub camera: CameraFile,
-    /// The benefit map of SPEC section 10 (off unless `lights_e_per_s` is set).
+    /// The benefit map of docs/spec.md section 10 (off unless `lights_e_per_s` is set).
     pub map: MapSection,
 }
 
@@ -394,7 +394,7 @@ impl ExperimentConfig {
             // The map's fixed-exposure grid replaces the exposure sweep.
             sweep_exposures_s: Vec::new(),
             // Clutter for blob extraction and corners for the second task
-            // metric (SPEC 10): the poster behind the board.
+            // metric (docs/spec.md section 10): the poster behind the board.
             background: "poster".into(),
             ..d
         }

@@ -72,7 +72,7 @@ struct FrameRow<'a> {
     jnbm_2d: Measured,
     cpbd_2d: Measured,
     gain: Shown,
-    /// SPEC section 10's family of the policy (`fixed`, `fixed-exposure`,
+    /// docs/spec.md section 10's family of the policy (`fixed`, `fixed-exposure`,
     /// `auto-exposure`, `mmbm`, `oracle`).
     family: &'static str,
     /// Blobs found away from every board place (false alarms).

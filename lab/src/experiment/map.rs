@@ -1,4 +1,4 @@
-//! The benefit map (SPEC section 10): when does gyro-driven capture beat
+//! The benefit map (docs/spec.md section 10): when does gyro-driven capture beat
 //! what camera users do instead? Cells are light x gait x board; in each,
 //! the sharp frames per second of every policy (kept, rendered, all 16 blobs
 //! at their true places), the best causal gyro-driven policy (`mmbm`) against

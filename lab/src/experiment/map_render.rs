@@ -1,6 +1,6 @@
 //! The benefit map's renders: each frame rendered once without noise, then
 //! judged (blob extraction) at every light level with the sensor noise of
-//! that light and the gain a camera would set there (SPEC section 10).
+//! that light and the gain a camera would set there (docs/spec.md section 10).
 
 use super::corners;
 use super::measure::{blob_metrics, bulk_job, frame_motion};
@@ -14,7 +14,7 @@ use crate::trigger::Frame;
 /// The window judged at each light: the blob grid padded by this many blob pitches.
 pub const WINDOW_PITCHES: f64 = 3.0;
 
-/// The camera's gain at one light level (SPEC section 10).
+/// The camera's gain at one light level (docs/spec.md section 10).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Light {
     /// The sensor at this light (its `gain_dn_per_e` is the reference gain `K_ref`).

@@ -10,7 +10,7 @@ use plotters::prelude::*;
 use std::path::Path;
 use std::sync::OnceLock;
 
-static FONT: &[u8] = include_bytes!("../../assets/DejaVuSans.ttf");
+static FONT: &[u8] = include_bytes!("../../../assets/DejaVuSans.ttf");
 
 /// Registers the bundled font as plotters' `sans-serif` (once per process).
 pub fn ensure_font() -> Result<()> {
