@@ -5,7 +5,7 @@
 //! `(thesis - predictor) / (thesis - oracle)` per walk, with the predictor's
 //! kept frames against the oracle's.
 //!
-//! `cargo run --release --example phase_share -- [SEEDS] [POLICIES...]`
+//! `cargo run --release -p mmbm-lab --example phase_share -- [SEEDS] [POLICIES...]`
 //! (SEEDS e.g. `1-5` or `1,3,7`; default 1-5 and `phase:0.4`).
 
 use mmbm::series::mmbm_series;
