@@ -1,6 +1,6 @@
 //! The real camera's cost (`cargo bench --bench camera`; printed, never
 //! asserted): the metric per sample through lens distortion, and the
-//! renderer's ms per 640x480 frame with each effect of SPEC 9 alone (the
+//! renderer's ms per 640x480 frame with each effect of docs/spec.md section 9 alone (the
 //! render goal's checker at 1 m, 20 px of blur, `default` preset), GPU and
 //! CPU twin.
 

@@ -1,4 +1,4 @@
-// Per-pixel image-plane flow (SPEC section 2, thesis eq. 3.20) and its mean
+// Per-pixel image-plane flow (docs/spec.md section 2, thesis eq. 3.20) and its mean
 // over the sensor (MMBM, thesis eq. 3.11). The CPU twin of every function and
 // entry point is in src/field/cpu.rs; the host structs in src/field/kernel.rs
 // and src/field/table.rs.
@@ -84,7 +84,7 @@ fn flow_mm(p: vec2<f32>, tw: Twist) -> vec2<f32> {
     return vec2<f32>(du, dv);
 }
 
-// Lens distortion (SPEC section 9) in normalised coordinates q = (x, y):
+// Lens distortion (docs/spec.md section 9) in normalised coordinates q = (x, y):
 // the Jacobian of the distortion map at q, and its inverse by Newton's method
 // (a fixed UNDISTORT_STEPS steps from the distorted point). Twins:
 // distort/jacobian/undistort in src/field/cpu.rs. The fisheye model needs

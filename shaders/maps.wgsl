@@ -1,4 +1,4 @@
-// Per-pixel blur fields of a video frame (`mmbm frames --maps`, SPEC section
+// Per-pixel blur fields of a video frame (`mmbm frames --maps`, docs/spec.md section
 // 9): each pixel's image track over its own line's exposure (rolling
 // shutter), its displacement, path length and start flow. The CPU twin of
 // every function is in src/series/maps_kernel.rs, the f64 reference in
@@ -63,7 +63,7 @@ struct Step {
 
 const WG: u32 = 64u;
 
-// Lens distortion (SPEC section 9) in normalised coordinates: copied from
+// Lens distortion (docs/spec.md section 9) in normalised coordinates: copied from
 // shaders/field.wgsl (a test keeps the copies equal); twins in src/field/cpu.rs.
 // atan(x) for x >= 0.
 fn atan_poly(x: f32) -> f32 {

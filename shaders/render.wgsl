@@ -150,7 +150,7 @@ fn shade(h: Homography, px: f32, py: f32) -> vec3<f32> {
     return trilinear(u, v, lod);
 }
 
-// Lens distortion (SPEC 9): entry lattice.z + (j w + i) of the table is pixel
+// Lens distortion (docs/spec.md section 9): entry lattice.z + (j w + i) of the table is pixel
 // (i, j)'s map: h0 = (x', y', L00, L01), h1 = (L10, L11, _, _), with (x', y')
 // the pinhole pixel coordinates of the ray through the pixel centre and L the
 // Jacobian of undistortion there (host f64). A sample at (sx, sy) in the
@@ -161,7 +161,7 @@ fn pixel_point(m: Homography, sx: f32, sy: f32) -> vec2<f32> {
     return vec2<f32>(m.h0.x + m.h0.z * dx + m.h0.w * dy, m.h0.y + m.h1.x * dx + m.h1.y * dy);
 }
 
-// Defocus (SPEC 9, thin lens): a uniform point of the unit disc from a point
+// Defocus (docs/spec.md section 9, thin lens): a uniform point of the unit disc from a point
 // of the unit square (Shirley-Chiu concentric map; sine and cosine as
 // polynomials on [-pi/4, pi/4], like the twin's).
 fn sin_p(x: f32) -> f32 {
@@ -204,7 +204,7 @@ fn lens_sample(e: u32, l: vec2<f32>, q: vec2<f32>) -> vec3<f32> {
     return shade(hl, p.x, p.y);
 }
 
-// Rolling shutter (SPEC 9): the first table entry of pixel (i, j)'s line.
+// Rolling shutter (docs/spec.md section 9): the first table entry of pixel (i, j)'s line.
 // Line mode range2.z: 0 one set of N instants for every pixel, 1 one set per
 // row, 2 one per column (each line's own exposure window).
 fn line_base(i: u32, j: u32) -> u32 {

@@ -6,7 +6,7 @@
 mod common;
 
 use mmbm::camera::{CameraFile, Noise};
-use mmbm::experiment::{self, ExperimentConfig, MapSection};
+use mmbm_lab::experiment::{self, ExperimentConfig, MapSection};
 use mmbm::trigger::{run, CameraTiming, Frame, PolicyFamily, PolicySpec};
 
 /// 20 s at 600 Hz of an MMBM that swings between 0 and 2 mm/s (a gait-like
@@ -196,7 +196,7 @@ fn each_cell_says_whether_timing_pays() {
         assert!(fps(g) >= fps(2).max(fps(3)));
         let r = c.vs_gyro.expect("both families present");
         assert!((r.value - fps(1) / fps(g)).abs() < 1e-12 || !r.value.is_finite());
-        let verdict = mmbm::experiment::timing_verdict(c);
+        let verdict = mmbm_lab::experiment::timing_verdict(c);
         let want = if !(r.lo.is_finite() && r.hi.is_finite()) {
             "n/a"
         } else if r.lo > 1.0 {
@@ -217,18 +217,18 @@ fn each_cell_says_whether_timing_pays() {
     }
     // The report and the terminal open with the three computed lines, each
     // cell in the line of its verdict.
-    let lines = mmbm::experiment::three_lines(m);
+    let lines = mmbm_lab::experiment::three_lines(m);
     let map_at = md.find("## Benefit map").unwrap();
     for l in &lines {
         let at = md.find(&format!("- {l}\n")).expect(l);
         assert!(at < map_at, "{md}");
     }
     for c in &m.cells {
-        let (v, ..) = mmbm::experiment::cell_verdict(c).expect("a verdict");
+        let (v, ..) = mmbm_lab::experiment::cell_verdict(c).expect("a verdict");
         let k = [
-            mmbm::experiment::Verdict::Pays,
-            mmbm::experiment::Verdict::Ties,
-            mmbm::experiment::Verdict::Loses,
+            mmbm_lab::experiment::Verdict::Pays,
+            mmbm_lab::experiment::Verdict::Ties,
+            mmbm_lab::experiment::Verdict::Loses,
         ]
         .iter()
         .position(|x| *x == v)

@@ -1,4 +1,4 @@
-//! The real camera of SPEC section 9 (distortion, camera files, Gyroflow lens
+//! The real camera of docs/spec.md section 9 (distortion, camera files, Gyroflow lens
 //! profiles) against independent computations: finite differences of the
 //! projection, brute-force sensor means, hand-computed profile values.
 
@@ -166,7 +166,7 @@ fn project(cam: &Camera, x: DVec3) -> (f64, f64) {
 }
 
 /// Central difference of the projection of the scene point seen at the
-/// distorted sensor point `(ud, vd)` under twist `tw` (SPEC 2: a scene point
+/// distorted sensor point `(ud, vd)` under twist `tw` (docs/spec.md section 2: a scene point
 /// moves as `dX/dt = -v - w x X` in the camera frame).
 fn fd_flow(cam: &Camera, plane: &Plane, tw: &Twist, ud: f64, vd: f64) -> (f64, f64) {
     let (u, v) = cam.undistort_mm(ud, vd).unwrap();

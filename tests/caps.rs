@@ -225,7 +225,7 @@ fn experiment_lists_are_capped_naming_the_key() {
         assert!(!p.join("xo").exists());
     }
     // At the cap a list is accepted (validation only).
-    let mut cfg = mmbm::experiment::ExperimentConfig {
+    let mut cfg = mmbm_lab::experiment::ExperimentConfig {
         sweep_exposures_s: vec![0.01; mmbm::limits::MAX_LIST_ENTRIES],
         ..Default::default()
     };

@@ -60,7 +60,7 @@ fn eval_json_contract() {
         "gauss:8",
         "--json",
     ]);
-    // Against an independent midpoint sum of SPEC eq. 3.20 over the sensor
+    // Against an independent midpoint sum of docs/spec.md section 3 (thesis eq. 3.20) over the sensor
     // (1280 x 960 cells, f64), with the tilted plane's per-pixel depth.
     let (f, p, w, h) = (4.2548, 0.00465, 640.0, 480.0);
     let (wx, wy, wz, vx, vy, vz) = (-0.1, 0.2, 0.0, 0.0, 0.0, 1.0);

@@ -7,8 +7,8 @@ mod common;
 use common::tree;
 
 use common::mmbm_in;
-use mmbm::dataset::item::{make, FILES};
-use mmbm::dataset::{self, DatasetConfig, ManifestLine, Shard, Sources};
+use mmbm_lab::dataset::item::{make, FILES};
+use mmbm_lab::dataset::{self, DatasetConfig, ManifestLine, Shard, Sources};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
@@ -381,7 +381,7 @@ fn a_camera_section_makes_another_dataset() {
 
 #[test]
 fn a_sensor_section_runs_the_camera_pipeline_on_the_pngs() {
-    use mmbm::dataset::SensorPipeline;
+    use mmbm_lab::dataset::SensorPipeline;
     let mut cfg = small(2);
     cfg.camera.noise = Some(mmbm::camera::Noise::at_light(20_000.0));
     cfg.sensor = Some(SensorPipeline {

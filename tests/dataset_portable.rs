@@ -8,8 +8,8 @@
 mod common;
 
 use common::{mmbm_in, tree};
-use mmbm::dataset::{self, DatasetConfig, Record, Shard, Sources};
 use mmbm::render::SharpAt;
+use mmbm_lab::dataset::{self, DatasetConfig, Record, Shard, Sources};
 use serde_json::Value;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};

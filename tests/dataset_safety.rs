@@ -8,7 +8,7 @@
 mod common;
 
 use common::tree;
-use mmbm::dataset::{self, DatasetConfig, Shard};
+use mmbm_lab::dataset::{self, DatasetConfig, Shard};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 

@@ -9,7 +9,7 @@ mod common;
 use common::tree;
 
 use common::mmbm_in;
-use mmbm::dataset::{self, DatasetConfig, Shard, Sources};
+use mmbm_lab::dataset::{self, DatasetConfig, Shard, Sources};
 use std::path::{Path, PathBuf};
 
 /// A config of tiny items (quick to make), `count` of them, seed `seed`.

@@ -7,8 +7,8 @@
 mod common;
 
 use common::mmbm_in;
-use mmbm::dataset::item::FILES;
-use mmbm::dataset::{self, DatasetConfig, Shard};
+use mmbm_lab::dataset::item::FILES;
+use mmbm_lab::dataset::{self, DatasetConfig, Shard};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 

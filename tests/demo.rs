@@ -100,7 +100,7 @@ fn demo_report_matches_the_docs() {
     // The header and the demo's policies (the |---| rule does not start with "| ").
     assert_eq!(
         quoted.len(),
-        1 + mmbm::experiment::DEMO_POLICIES.len(),
+        1 + mmbm_lab::experiment::DEMO_POLICIES.len(),
         "{section}"
     );
     for r in quoted.iter().skip(1) {

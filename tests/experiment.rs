@@ -1,7 +1,7 @@
 //! The experiment on a tiny configuration, end to end: frames.csv and
 //! report.md are produced and their numbers are sane.
 
-use mmbm::experiment::{self, ExperimentConfig};
+use mmbm_lab::experiment::{self, ExperimentConfig};
 
 #[test]
 fn tiny_experiment_end_to_end() {

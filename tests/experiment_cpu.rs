@@ -3,7 +3,7 @@
 //! twin. The adapter filter below matches nothing, so this test needs no GPU
 //! and behaves the same on machines with one.
 
-use mmbm::experiment::{self, ExperimentConfig};
+use mmbm_lab::experiment::{self, ExperimentConfig};
 
 #[test]
 fn experiment_without_adapter_uses_cpu_twins() {

@@ -1,12 +1,12 @@
-//! The benefit map (SPEC section 10) on a tiny configuration: the report
+//! The benefit map (docs/spec.md section 10) on a tiny configuration: the report
 //! leads with it, its numbers hold together (ratios, winners, the
 //! hindsight choice, families), the heat map is written, and a bad `[map]`
 //! is refused naming its key.
 
 use mmbm::camera::CameraFile;
 use mmbm::camera::Noise;
-use mmbm::experiment::{self, ExperimentConfig, MapSection};
 use mmbm::trigger::PolicyFamily;
+use mmbm_lab::experiment::{self, ExperimentConfig, MapSection};
 
 fn tiny() -> ExperimentConfig {
     ExperimentConfig {

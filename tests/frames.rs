@@ -1,4 +1,4 @@
-//! Rolling-shutter exposure MMBM of video frames (SPEC 3 and 9) against
+//! Rolling-shutter exposure MMBM of video frames (docs/spec.md section 3 and 9) against
 //! independent computations: each line's window integrated directly, a
 //! closed form for a yaw ramp, and the global-shutter time average.
 

@@ -7,11 +7,11 @@ mod common;
 #[path = "fuzz_readers/hostile.rs"]
 mod hostile;
 
-use mmbm::experiment::ExperimentConfig;
 use mmbm::io::gyro::{read_log, GyroOptions};
 use mmbm::io::lines::LineParser;
 use mmbm::sim::{Gait, GaitConfig};
 use mmbm::Camera;
+use mmbm_lab::experiment::ExperimentConfig;
 use proptest::prelude::*;
 use std::path::{Path, PathBuf};
 
@@ -140,7 +140,7 @@ proptest! {
     fn dataset_toml(bytes in inputs(b"count = 24\nseed = 3\nmotion = [\"sim:fast\"]\nexposure_s = [0.01, 0.05]\n")) {
         let d = tempfile::tempdir().unwrap();
         let p = write(d.path(), "ds.toml", &bytes);
-        names_file(mmbm::dataset::DatasetConfig::load(&p), "ds.toml")?;
+        names_file(mmbm_lab::dataset::DatasetConfig::load(&p), "ds.toml")?;
     }
 
     #[test]

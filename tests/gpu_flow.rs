@@ -77,7 +77,7 @@ fn check_field(scene: &Scene, tw: &Twist) {
     assert!((f.mmbm.px_s - px_mean).abs() < 1e-9 * f.mmbm.px_s);
 }
 
-/// Lens distortion (SPEC 9): the kernel undistorts each pixel by 16 Newton
+/// Lens distortion (docs/spec.md section 9): the kernel undistorts each pixel by 16 Newton
 /// steps in f32 and pushes the flow through the Jacobian; the twin runs the
 /// same f32 steps (the fisheye's atan is a polynomial in both, not the
 /// platform's). Same tolerances as the pinhole field (measured on lavapipe:

@@ -1,7 +1,12 @@
-//! The module graph of the library: every top-level module imports only from
-//! its own layer or the ones below it (the table in `src/lib.rs`), and no two
-//! modules import each other, directly or through others: neither between
-//! top-level modules nor between the files of any folder at any depth.
+//! The module graph of the workspace's three library crates (the core in
+//! `core/src`, the library in `src`, the lab in `lab/src`, read as one tree
+//! since the library re-exports the core and the lab imports the library at
+//! the same paths): every top-level module imports only from its own layer or
+//! the ones below it (the table in `src/lib.rs`), each module lives in the
+//! crate its layer row names, and no two modules import each other, directly
+//! or through others: neither between top-level modules nor between the files
+//! of any folder at any depth. Across crates the compiler also enforces the
+//! order (the core cannot name the library, the library cannot name the lab).
 //!
 //! Imports are read from the source text: `crate::` paths, `super::` and
 //! `self::` paths and `use CHILD::` lines, resolved to module paths; circles
@@ -11,38 +16,48 @@
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
-/// Layer of each top-level library module (keep in step with `src/lib.rs`).
-const LAYERS: &[(&str, u32)] = &[
-    ("error", 0),
-    ("check", 0),
-    ("limits", 0),
-    ("bounded", 0),
-    ("stats", 0),
-    ("diagnostics", 0),
-    ("cancel", 0),
-    ("camera", 1),
-    ("model", 1),
-    ("io", 1),
-    ("gpu", 1),
-    ("metric", 2),
-    ("board", 2),
-    ("plot", 2),
-    ("sim", 2),
-    ("assess", 2),
-    ("telemetry", 2),
-    ("field", 3),
-    ("tables", 3),
-    ("series", 4),
-    ("render", 4),
-    ("sync", 4),
-    ("trigger", 5),
-    ("experiment", 6),
-    ("dataset", 6),
-    ("augment", 5),
+/// The workspace's library crates, below to above: (folder of its `lib.rs`
+/// from the workspace root, the name the table in `src/lib.rs` gives it).
+const CRATES: &[(&str, &str)] = &[("core/src", "core"), ("src", "library"), ("lab/src", "lab")];
+
+/// Layer and crate of each top-level library module (keep in step with the
+/// table in `src/lib.rs`).
+const LAYERS: &[(&str, u32, &str)] = &[
+    ("error", 0, "core"),
+    ("check", 0, "core"),
+    ("limits", 0, "core"),
+    ("bounded", 0, "core"),
+    ("stats", 0, "core"),
+    ("diagnostics", 0, "core"),
+    ("cancel", 0, "core"),
+    ("camera", 1, "core"),
+    ("model", 1, "core"),
+    ("io", 1, "core"),
+    ("gpu", 1, "library"),
+    ("metric", 2, "core"),
+    ("board", 2, "library"),
+    ("plot", 2, "lab"),
+    ("sim", 2, "core"),
+    ("assess", 2, "library"),
+    ("telemetry", 2, "library"),
+    ("field", 3, "library"),
+    ("tables", 3, "lab"),
+    ("series", 4, "library"),
+    ("render", 4, "library"),
+    ("sync", 4, "library"),
+    ("trigger", 5, "library"),
+    ("augment", 5, "library"),
+    ("prelude", 5, "library"),
+    ("experiment", 6, "lab"),
+    ("dataset", 6, "lab"),
 ];
 
 fn layer(m: &str) -> Option<u32> {
-    LAYERS.iter().find(|(n, _)| *n == m).map(|&(_, l)| l)
+    LAYERS.iter().find(|(n, ..)| *n == m).map(|&(_, l, _)| l)
+}
+
+fn crate_of(m: &str) -> Option<&'static str> {
+    LAYERS.iter().find(|(n, ..)| *n == m).map(|&(.., c)| c)
 }
 
 fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
@@ -147,12 +162,13 @@ struct Source {
 }
 
 fn library_sources() -> Vec<Source> {
-    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
-    let mut files = Vec::new();
-    rust_files(&src, &mut files);
-    files
-        .into_iter()
-        .filter_map(|p| {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut out = Vec::new();
+    for (dir, _) in CRATES {
+        let src = root.join(dir);
+        let mut files = Vec::new();
+        rust_files(&src, &mut files);
+        out.extend(files.into_iter().filter_map(|p| {
             let rel = p.strip_prefix(&src).ok()?.to_path_buf();
             let mut parts: Vec<String> = rel
                 .iter()
@@ -168,29 +184,55 @@ fn library_sources() -> Vec<Source> {
             Some(Source {
                 module: parts,
                 code: code(&p),
-                path: rel,
+                path: Path::new(dir).join(rel),
             })
-        })
-        .collect()
+        }));
+    }
+    out
 }
 
 #[test]
 fn every_top_level_module_has_a_layer() {
-    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
-    let lib = std::fs::read_to_string(src.join("lib.rs")).expect("lib.rs");
-    for line in lib.lines() {
-        if let Some(m) = line.strip_prefix("pub mod ") {
-            let m = m.trim_end_matches(';');
-            assert!(
-                layer(m).is_some(),
-                "module `{m}` has no layer in tests/layers.rs"
-            );
-            assert!(
-                lib.contains(&format!("[`{m}`]")),
-                "module `{m}` is missing from the layer table in src/lib.rs"
-            );
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let table = std::fs::read_to_string(root.join("src/lib.rs")).expect("src/lib.rs");
+    let mut seen = 0;
+    for (dir, name) in CRATES {
+        let lib = std::fs::read_to_string(root.join(dir).join("lib.rs")).expect("lib.rs");
+        for line in lib.lines() {
+            if let Some(m) = line.strip_prefix("pub mod ") {
+                let m = m.trim_end_matches(';');
+                seen += 1;
+                assert!(
+                    layer(m).is_some(),
+                    "module `{m}` ({dir}) has no layer in tests/layers.rs"
+                );
+                assert_eq!(
+                    crate_of(m),
+                    Some(*name),
+                    "module `{m}` lives in {dir}, but tests/layers.rs puts it elsewhere"
+                );
+                let row = table
+                    .lines()
+                    .find(|l| {
+                        l.starts_with("//! |")
+                            && (l.contains(&format!("[`{m}`]")) || l.contains(&format!("`{m}`")))
+                    })
+                    .unwrap_or_else(|| {
+                        panic!("module `{m}` is missing from the layer table in src/lib.rs")
+                    });
+                let l = layer(m).unwrap();
+                assert!(
+                    row.starts_with(&format!("//! | {l} | {name} |")),
+                    "the table in src/lib.rs puts `{m}` in another row than layer {l}, crate {name}: {row}"
+                );
+            }
         }
     }
+    assert_eq!(
+        seen,
+        LAYERS.len(),
+        "tests/layers.rs lists modules no crate declares"
+    );
 }
 
 #[test]
@@ -402,7 +444,7 @@ fn no_import_circles() {
     let graphs = folder_graphs(&sources);
     assert!(
         graphs.contains_key(&vec!["io".to_string(), "gyro".to_string()]),
-        "the checker no longer sees the files of src/io/gyro/"
+        "the checker no longer sees the files of core/src/io/gyro/"
     );
     let mut bad = Vec::new();
     for (folder, g) in &graphs {
@@ -433,7 +475,7 @@ fn the_checker_sees_circles_and_upward_imports() {
         after(code, "super::"),
         vec![("walk".to_string(), "Walk".to_string())]
     );
-    // A circle three levels down (as src/io/gyro/fast.rs <-> plain.rs once was),
+    // A circle three levels down (as core/src/io/gyro/fast.rs <-> plain.rs once was),
     // through a braced `super::` list and a `use CHILD::` line.
     let src = |m: &str, code: &str| Source {
         module: m.split('/').map(String::from).collect(),

@@ -1,5 +1,5 @@
 //! `docs/limits.md` lists every cap with its value, and this test keeps the
-//! list true: every `pub const` of `src/limits.rs` (a cap added there
+//! list true: every `pub const` of `core/src/limits.rs` (a cap added there
 //! without a line in the table fails here), and the caps elsewhere that the
 //! table cites, must each have a row `` | `NAME` | VALUE ... | `` in the
 //! table "Every cap" whose VALUE is the constant's value.
@@ -13,22 +13,22 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 
-/// Caps outside `src/limits.rs` that the table cites: (name in the table,
+/// Caps outside `core/src/limits.rs` that the table cites: (name in the table,
 /// source file, constant).
 const ELSEWHERE: &[(&str, &str, &str)] = &[
     (
         "metric::MAX_GRID_POINTS",
-        "src/metric/mod.rs",
+        "core/src/metric/mod.rs",
         "MAX_GRID_POINTS",
     ),
     (
         "metric::MAX_GAUSS_NODES",
-        "src/metric/mod.rs",
+        "core/src/metric/mod.rs",
         "MAX_GAUSS_NODES",
     ),
     ("trigger::MAX_FPS", "src/trigger/parse.rs", "MAX_FPS"),
-    ("sim::MAX_SAMPLES", "src/sim/gen.rs", "MAX_SAMPLES"),
-    ("sim::MAX_STEP_HZ", "src/sim/mod.rs", "MAX_STEP_HZ"),
+    ("sim::MAX_SAMPLES", "core/src/sim/gen.rs", "MAX_SAMPLES"),
+    ("sim::MAX_STEP_HZ", "core/src/sim/mod.rs", "MAX_STEP_HZ"),
     ("render::MAX_SAMPLES", "src/render/mod.rs", "MAX_SAMPLES"),
     ("render::MAX_TABLE", "src/render/mod.rs", "MAX_TABLE"),
     (
@@ -38,38 +38,46 @@ const ELSEWHERE: &[(&str, &str, &str)] = &[
     ),
     (
         "bounded::MAX_TEXT_BYTES",
-        "src/bounded.rs",
+        "core/src/bounded.rs",
         "MAX_TEXT_BYTES",
     ),
     (
         "io::input::MAX_LINE_BYTES",
-        "src/io/input.rs",
+        "core/src/io/input.rs",
         "MAX_LINE_BYTES",
     ),
     (
         "io::input::MAX_HEADER_BYTES",
-        "src/io/input.rs",
+        "core/src/io/input.rs",
         "MAX_HEADER_BYTES",
     ),
     (
         "io::mcap::MAX_RECORD_BYTES",
-        "src/io/mcap.rs",
+        "core/src/io/mcap.rs",
         "MAX_RECORD_BYTES",
     ),
     (
         "io::images::MAX_EXR_SAMPLES",
-        "src/io/images.rs",
+        "core/src/io/images.rs",
         "MAX_EXR_SAMPLES",
     ),
     (
         "camera::MAX_CAMERA_BYTES",
-        "src/camera/file.rs",
+        "core/src/camera/file.rs",
         "MAX_CAMERA_BYTES",
     ),
-    ("dataset::MAX_COUNT", "src/dataset/config.rs", "MAX_COUNT"),
-    ("dataset::MAX_SHARDS", "src/dataset/shard.rs", "MAX_SHARDS"),
-    ("error::MAX_MESSAGE", "src/error.rs", "MAX_MESSAGE"),
-    ("error::MAX_SHOWN", "src/error.rs", "MAX_SHOWN"),
+    (
+        "dataset::MAX_COUNT",
+        "lab/src/dataset/config.rs",
+        "MAX_COUNT",
+    ),
+    (
+        "dataset::MAX_SHARDS",
+        "lab/src/dataset/shard.rs",
+        "MAX_SHARDS",
+    ),
+    ("error::MAX_MESSAGE", "core/src/error.rs", "MAX_MESSAGE"),
+    ("error::MAX_SHOWN", "core/src/error.rs", "MAX_SHOWN"),
 ];
 
 fn root() -> &'static Path {
@@ -225,7 +233,7 @@ fn row_fault(rows: &BTreeMap<String, String>, name: &str, v: f64, what: &str) ->
 
 #[test]
 fn every_cap_in_limits_rs_is_in_the_table_with_its_value() {
-    let src = read("src/limits.rs");
+    let src = read("core/src/limits.rs");
     let rows = table();
     let mut known = BTreeMap::new();
     let mut problems = Vec::new();
@@ -263,7 +271,7 @@ fn caps_elsewhere_are_in_the_table_with_their_values() {
 /// the constants themselves), and the table's value forms parse.
 #[test]
 fn the_reader_agrees_with_the_compiler() {
-    let lim = values("src/limits.rs");
+    let lim = values("core/src/limits.rs");
     assert_eq!(lim["MAX_MAP_PIXELS"], mmbm::limits::MAX_MAP_PIXELS as f64);
     assert_eq!(lim["MAX_LIGHT_E_PER_S"], mmbm::limits::MAX_LIGHT_E_PER_S);
     assert_eq!(
@@ -275,15 +283,15 @@ fn the_reader_agrees_with_the_compiler() {
         mmbm::render::MAX_PIXEL_SAMPLES as f64
     );
     assert_eq!(
-        values("src/bounded.rs")["MAX_TEXT_BYTES"],
+        values("core/src/bounded.rs")["MAX_TEXT_BYTES"],
         mmbm::bounded::MAX_TEXT_BYTES as f64
     );
     assert_eq!(
-        values("src/error.rs")["MAX_SHOWN"],
+        values("core/src/error.rs")["MAX_SHOWN"],
         mmbm::error::MAX_SHOWN as f64
     );
     assert_eq!(
-        values("src/sim/gen.rs")["MAX_SAMPLES"],
+        values("core/src/sim/gen.rs")["MAX_SAMPLES"],
         mmbm::sim::MAX_SAMPLES
     );
     assert_eq!(
@@ -291,8 +299,8 @@ fn the_reader_agrees_with_the_compiler() {
         mmbm::render::MAX_SAMPLES as f64
     );
     assert_eq!(
-        values("src/dataset/shard.rs")["MAX_SHARDS"],
-        mmbm::dataset::MAX_SHARDS as f64
+        values("lab/src/dataset/shard.rs")["MAX_SHARDS"],
+        mmbm_lab::dataset::MAX_SHARDS as f64
     );
     for (cell, v) in [
         ("2^26 px", 67_108_864.0),

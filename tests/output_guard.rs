@@ -524,7 +524,7 @@ fn map_fps_above_the_cap_is_refused_up_front() {
     assert!(!d.join("rep").exists());
     // At the cap it passes the check (the run itself is not started here:
     // the library check alone).
-    let mut cfg = mmbm::experiment::ExperimentConfig::default();
+    let mut cfg = mmbm_lab::experiment::ExperimentConfig::default();
     cfg.map.lights_e_per_s = vec![1000.0];
     cfg.map.fps = 1000.0;
     cfg.map.validate(cfg.exposure_s).unwrap();

@@ -1,6 +1,6 @@
-//! The renderer with the real camera of SPEC section 9: rolling-shutter blur
+//! The renderer with the real camera of docs/spec.md section 9: rolling-shutter blur
 //! maps against a closed form, lens distortion against an exact-undistortion
-//! reference and the flow formula, defocus against SPEC 9's disc, the noise
+//! reference and the flow formula, defocus against docs/spec.md section 9's disc, the noise
 //! model on rendered frames (photon transfer over a flat region, seeding).
 
 use glam::DVec3;
@@ -247,7 +247,7 @@ fn readout_beyond_the_trajectory_is_a_clear_error() {
     }
 }
 
-/// Defocus (SPEC 9): a small bright patch at depth `z`, focused at `s`,
+/// Defocus (docs/spec.md section 9): a small bright patch at depth `z`, focused at `s`,
 /// spreads over a disc of diameter `c = A f / (s - f) |z - s| / z`. The
 /// disc's radial second moment is `D^2 / 8`; the in-focus render's moment
 /// (the patch's own size, filtering and pixel area) is subtracted, since
@@ -314,7 +314,9 @@ fn defocus_disc_has_the_spec_diameter() {
         let d = (8.0 * (moment(&img) - m0)).sqrt();
         let lens = cam.lens.unwrap();
         let spec = lens.coc_mm(cam.focal_mm, z) / cam.pitch_x_mm;
-        eprintln!("focus {s} m, point at {z} m: disc {d:.3} px, SPEC 9 {spec:.3} px");
+        eprintln!(
+            "focus {s} m, point at {z} m: disc {d:.3} px, docs/spec.md section 9 {spec:.3} px"
+        );
         assert!((d - spec).abs() < 0.5, "focus {s}: {d} vs {spec}");
     }
     // The analytic integrator cannot sample the aperture.

@@ -1,4 +1,4 @@
-//! Renderer against exact integrals (SPEC section 4): a fronto-parallel
+//! Renderer against exact integrals (docs/spec.md section 4): a fronto-parallel
 //! checkerboard under pure lateral translation has a closed-form
 //! area-and-time integral per pixel (the integral of a square wave is a
 //! triangle wave), computed here independently of the renderer.
@@ -154,7 +154,7 @@ fn check_translation_with(
     assert!(mean <= mean_tol && p99 <= p99_tol, "mean {mean} p99 {p99}");
 }
 
-/// Rolling shutter (SPEC 9) under lateral translation: every line is the
+/// Rolling shutter (docs/spec.md section 9) under lateral translation: every line is the
 /// exact box integral over its own window `[t_r l / n, t_r l / n + t_e]`,
 /// with the same contract as the global shutter, for each readout direction.
 #[test]

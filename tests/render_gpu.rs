@@ -45,7 +45,7 @@ fn scenes(tex: &std::path::Path) -> Vec<(&'static str, RenderJob)> {
             ),
         ),
         (
-            // Lens distortion (SPEC 9): the per-pixel undistortion map.
+            // Lens distortion (docs/spec.md section 9): the per-pixel undistortion map.
             "blobs 6-DoF barrel distortion",
             RenderJob::new(
                 Camera {
@@ -64,7 +64,7 @@ fn scenes(tex: &std::path::Path) -> Vec<(&'static str, RenderJob)> {
             ),
         ),
         (
-            // Defocus (SPEC 9): two aperture dimensions of the lattice, the
+            // Defocus (docs/spec.md section 9): two aperture dimensions of the lattice, the
             // homography's lens derivatives.
             "image 6-DoF defocus",
             RenderJob::new(
@@ -105,7 +105,7 @@ fn scenes(tex: &std::path::Path) -> Vec<(&'static str, RenderJob)> {
             ),
         ),
         (
-            // Rolling shutter (SPEC 9): one table of instants per column; the
+            // Rolling shutter (docs/spec.md section 9): one table of instants per column; the
             // trajectory spans readout + exposure.
             "checker 6-DoF rolling left-to-right",
             RenderJob::new(

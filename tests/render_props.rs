@@ -19,7 +19,7 @@ fn cpu_job(cam: Camera, tr: Trajectory, t: Target, q: Quality) -> RenderJob {
 #[test]
 fn scene_point_motion_matches_flow_formula() {
     // Finite difference of a pixel's scene point, through the renderer's own
-    // trajectory, intersection and projection, against SPEC's flow formula.
+    // trajectory, intersection and projection, against docs/spec.md's flow formula.
     let cam = Camera::thesis();
     let tw = Twist::new(DVec3::new(0.7, -1.1, 0.9), DVec3::new(0.3, -0.2, 0.5));
     let dt = 1e-6;

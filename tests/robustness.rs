@@ -74,7 +74,7 @@ const BAD: &[(&str, &[&str])] = &[
     ("experiment --config exp_val.toml --out rep", &["exp_val.toml", "policies", "fixed:0"]),
     ("trigger --gyro good.csv --policy bogus:1 --exposure 0.05", &["bogus:1"]),
     ("live --policy oracle:0.4", &["oracle"]),
-    // The real-camera flags (SPEC 9) and `frames`.
+    // The real-camera flags (docs/spec.md section 9) and `frames`.
     ("eval --omega 1,1,1 --rolling-readout=-1", &["readout_s", ">= 0"]),
     ("eval --omega 1,1,1 --rolling-readout nan", &["readout_s"]),
     ("eval --omega 1,1,1 --light 0", &["noise.phi_e_per_s"]),

@@ -362,7 +362,7 @@ fn endless_and_gigantic_inputs_are_refused_quickly() {
         .status()
         .unwrap()
         .success());
-    let cfg = |motion: &str| mmbm::dataset::DatasetConfig {
+    let cfg = |motion: &str| mmbm_lab::dataset::DatasetConfig {
         textures: tex.clone(),
         motion: vec![motion.into()],
         count: 1,
@@ -371,8 +371,8 @@ fn endless_and_gigantic_inputs_are_refused_quickly() {
     let (tx, rx) = std::sync::mpsc::channel();
     let (ok, zero) = (cfg("sim:slow"), cfg("log:/dev/zero"));
     std::thread::spawn(move || {
-        let a = mmbm::dataset::Sources::open(&ok).map(|s| s.textures);
-        let b = mmbm::dataset::Sources::open(&zero).map(|_| ());
+        let a = mmbm_lab::dataset::Sources::open(&ok).map(|s| s.textures);
+        let b = mmbm_lab::dataset::Sources::open(&zero).map(|_| ());
         let _ = tx.send((a, b.map_err(|e| e.to_string())));
     });
     let (a, b) = rx

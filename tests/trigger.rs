@@ -540,7 +540,7 @@ fn bad_inputs_are_errors() {
     assert!(e.to_string().contains("sample 3"), "{e}");
 }
 
-/// A rolling shutter (SPEC 9) keeps the camera busy from the first line's
+/// A rolling shutter (docs/spec.md section 9) keeps the camera busy from the first line's
 /// exposure start to the last line's exposure end plus the readout: frames
 /// start at least `t_e + t_rs + t_r` apart.
 #[test]

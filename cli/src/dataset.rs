@@ -2,8 +2,8 @@
 //! Indexed Jobs.
 
 use clap::Args;
-use mmbm::dataset::{self, DatasetConfig, Shard};
 use mmbm::error::{Error, Result};
+use mmbm_lab::dataset::{self, DatasetConfig, Shard};
 use std::path::PathBuf;
 
 /// Generate a blur dataset: sharp/blurred pairs, flow and blur maps, a manifest.

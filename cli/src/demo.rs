@@ -3,7 +3,7 @@
 use super::experiment::run_and_print;
 use clap::Args;
 use mmbm::error::Result;
-use mmbm::experiment::ExperimentConfig;
+use mmbm_lab::experiment::ExperimentConfig;
 use std::path::PathBuf;
 
 /// The thesis experiment with built-in defaults: a simulated moderate walk

@@ -31,7 +31,7 @@ pub struct EvalArgs {
     #[arg(long)]
     pub json: bool,
     /// Also give the expected blur length over an exposure of S seconds, px
-    /// (MMBM x S / pixel pitch, SPEC section 3).
+    /// (MMBM x S / pixel pitch, docs/spec.md section 3).
     #[arg(long, value_name = "S")]
     pub exposure: Option<f64>,
     #[command(flatten)]

@@ -2,7 +2,7 @@
 
 use clap::Args;
 use mmbm::error::Result;
-use mmbm::experiment::{self, ExperimentConfig};
+use mmbm_lab::experiment::{self, ExperimentConfig};
 use std::path::PathBuf;
 
 /// The thesis experiment: walk -> triggers -> rendered frames -> report.

@@ -79,7 +79,7 @@ pub fn run(a: FlowArgs) -> Result<()> {
             &[("flow.u", &f.u), ("flow.v", &f.v), ("flow.speed", &speed)],
         )?;
         if let Some(q) = &a.quiver {
-            mmbm::plot::quiver::quiver_png(&scene.camera, &f.u, &f.v, a.exposure, q)?;
+            mmbm_lab::plot::quiver::quiver_png(&scene.camera, &f.u, &f.v, a.exposure, q)?;
         }
         Ok(())
     })?;

@@ -137,7 +137,7 @@ pub struct SeriesArgs {
     #[arg(long, value_name = "FILE")]
     pub out: Option<PathBuf>,
     /// Add a blur_px column: the expected blur length over an exposure of S
-    /// seconds starting at each sample, px (MMBM x S / pitch, SPEC section 3).
+    /// seconds starting at each sample, px (MMBM x S / pitch, docs/spec.md section 3).
     #[arg(long, value_name = "S")]
     pub exposure: Option<f64>,
     /// Include the log's vx,vy,vz (needs a depth column, --depth or --plane).

@@ -2,7 +2,7 @@
 
 use clap::Args;
 use mmbm::error::Result;
-use mmbm::tables;
+use mmbm_lab::tables;
 use std::path::PathBuf;
 
 /// Regenerate thesis Tables 4.1-4.5 and the Fig. 4.6 grid-rule error.
@@ -52,7 +52,7 @@ pub fn run(a: TablesArgs) -> Result<()> {
         }
     }
     if let Some(p) = &a.plot {
-        mmbm::tables::grid_error_plot(&grid, p)?;
+        mmbm_lab::tables::grid_error_plot(&grid, p)?;
         eprintln!("wrote {}", p.display());
     }
     Ok(())

@@ -55,7 +55,7 @@ _THESIS: Dict[str, Any] = json.loads(_mmbm.camera_thesis())
 
 @dataclass(frozen=True)
 class Camera:
-    """A camera (the keys of mmbm's camera files, SPEC sections 1 and 9).
+    """A camera (the keys of mmbm's camera files, docs/spec.md sections 1 and 9).
 
     ``focal_mm``: focal length, mm; ``pitch_x_mm``, ``pitch_y_mm``: pixel
     pitch, mm; ``width``, ``height``: sensor size, px; ``cx``, ``cy``:
@@ -220,7 +220,7 @@ def frames(
     camera: Optional[Camera] = None,
     maps: bool = False,
 ) -> Dict[str, Any]:
-    """Exposure MMBM of every video frame (SPEC 9: each line over its own
+    """Exposure MMBM of every video frame (docs/spec.md section 9: each line over its own
     rolling-shutter window), as ``mmbm frames``: ``t`` (N,) s and ``omega``
     (N, 3) rad/s of the log; per frame ``t_start`` (the first line's
     exposure start, s), ``exposure_s`` and ``readout_s`` (default: the

@@ -4,7 +4,7 @@
 
 use crate::err;
 use crate::interrupt::interruptible;
-use mmbm::dataset::{make_item, DatasetConfig, Record, Sources};
+use mmbm_lab::dataset::{make_item, DatasetConfig, Record, Sources};
 use pyo3::prelude::*;
 use std::path::PathBuf;
 

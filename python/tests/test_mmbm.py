@@ -41,7 +41,7 @@ def test_metric_equals_cli(method):
 
 
 def numpy_mmbm_star(w, v, z, nu=8, nv=6, f=4.2548, p=0.00465, width=640, height=480):
-    """SPEC eq. 3.20 on the centres of an nu x nv grid (thesis MMBM*), mm/s."""
+    """docs/spec.md section 3 (thesis eq. 3.20) on the centres of an nu x nv grid (thesis MMBM*), mm/s."""
     su, sv = width * p, height * p
     u = (np.arange(nu) + 0.5) / nu * su - su / 2
     vv = (np.arange(nv) + 0.5) / nv * sv - sv / 2
@@ -161,7 +161,7 @@ def test_camera_file(tmp_path):
 
 
 def test_real_camera_file_and_render(tmp_path):
-    # Every SPEC 9 key survives Camera.from_file, and rendering with it equals
+    # Every docs/spec.md section 9 key survives Camera.from_file, and rendering with it equals
     # the CLI (rolling shutter, distortion and seeded noise).
     p = ROOT / "tests" / "fixtures" / "camera" / "opencv.toml"
     c = mmbm.Camera.from_file(p)

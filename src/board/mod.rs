@@ -4,7 +4,8 @@
 //! same board (`render::target`).
 
 pub mod blobs;
-pub(crate) mod pose;
+#[doc(hidden)]
+pub mod pose;
 
 use crate::camera::Camera;
 use crate::check::{finite, positive};

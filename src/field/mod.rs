@@ -1,4 +1,4 @@
-//! Flow fields (`shaders/field.wgsl`): the per-pixel image-plane flow of SPEC
+//! Flow fields (`shaders/field.wgsl`): the per-pixel image-plane flow of docs/spec.md
 //! section 2 at full sensor resolution, its mean speed (MMBM, mm/s), and
 //! batched MMBM for many twists in one dispatch.
 //!

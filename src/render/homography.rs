@@ -49,7 +49,7 @@ pub fn instant(trajectory: &Trajectory, m: u32, n: u32) -> f64 {
 
 /// Line mode of the homography table (`RenderParams::range2[2]`): 0 one set
 /// of instants for every pixel (global shutter), 1 one set per row, 2 one per
-/// column (rolling shutter, SPEC 9).
+/// column (rolling shutter, docs/spec.md section 9).
 pub fn line_mode(cam: &Camera) -> u32 {
     match (cam.shutter.is_global(), cam.shutter.direction.is_rows()) {
         (true, _) => 0,
@@ -127,7 +127,7 @@ pub fn homographies(
     out
 }
 
-/// Defocus (SPEC 9, thin lens): a ray through lens point `L = (lx, ly, 0)`
+/// Defocus (docs/spec.md section 9, thin lens): a ray through lens point `L = (lx, ly, 0)`
 /// m (camera frame) toward the in-focus point of pinhole pixel `p` is the
 /// ray of a camera moved by `R L` through pixel `p - K L / s`. The homography
 /// is affine in the camera centre, so the moved camera's is

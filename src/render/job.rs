@@ -58,7 +58,7 @@ pub struct RenderJob {
     /// Camera motion from the first line's exposure start to the last line's
     /// exposure end: [`Self::exposure_s`] plus the camera's rolling-shutter
     /// readout when it has one (each line is exposed over its own window,
-    /// SPEC 9). Checked when the job renders.
+    /// docs/spec.md section 9). Checked when the job renders.
     pub trajectory: Trajectory,
     /// The target.
     pub target: Target,

@@ -36,7 +36,7 @@ pub use super::layout::{RenderParams, KIND_BLOBS, KIND_CHECKER, KIND_IMAGE, LOD_
 
 /// The defocus parameters ([`RenderParams::lens`]): the aperture radius is
 /// that of `A' = A s / (s - f)` (`A = f / N`), so that a point at depth `z`
-/// spreads over SPEC 9's disc `c = A f / (s - f) |z - s| / z` (the lens is
+/// spreads over docs/spec.md section 9's disc `c = A f / (s - f) |z - s| / z` (the lens is
 /// modelled as a shift of the pinhole by the lens point, toward the in-focus
 /// point at depth `s`).
 pub fn lens_params(cam: &Camera) -> [f32; 4] {

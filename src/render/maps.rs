@@ -1,4 +1,4 @@
-//! Ground-truth blur maps (SPEC section 4): for every pixel, the scene point
+//! Ground-truth blur maps (docs/spec.md section 4): for every pixel, the scene point
 //! seen at its centre at exposure start is followed through the exposure;
 //! its image path length (px), end-to-start displacement (px) and
 //! time-averaged image speed (px/s = path / duration). Their sensor means are
@@ -234,7 +234,7 @@ pub fn max_path_px(cam: &Camera, target: &Target, traj: &Trajectory) -> f64 {
 /// steps so that a chord is well under a pixel, e.g. `max_path_px / 0.25`).
 ///
 /// With a rolling shutter each pixel's path is over its own line's window
-/// of `exposure_s` seconds (the trajectory spans readout + exposure; SPEC 9)
+/// of `exposure_s` seconds (the trajectory spans readout + exposure; docs/spec.md section 9)
 /// and the speed is the path over the line's exposure. With a global
 /// shutter the window is the whole trajectory.
 pub fn blur_maps(

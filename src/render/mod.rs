@@ -1,4 +1,4 @@
-//! Ground-truth motion-blur renderer (SPEC section 4).
+//! Ground-truth motion-blur renderer (docs/spec.md section 4).
 //!
 //! A textured planar [`Target`] seen by a [`Camera`] moving along a
 //! [`Trajectory`] during one exposure (box shutter). Each pixel is the mean
@@ -30,7 +30,8 @@ pub mod poster;
 pub(crate) mod psf;
 mod sampling;
 pub mod sharp;
-pub(crate) mod target;
+#[doc(hidden)]
+pub mod target;
 pub mod texture;
 
 pub use crate::gpu::Backend;

@@ -1,4 +1,4 @@
-//! Planar targets (SPEC section 4): `checker:S`, `blobs[:SCALE]` (the thesis
+//! Planar targets (docs/spec.md section 4): `checker:S`, `blobs[:SCALE]` (the thesis
 //! board) and `image:PATH:WIDTH_M`, on a plane at `distance` m along the
 //! optical axis at exposure start, optionally tilted and offset.
 //!
@@ -7,7 +7,7 @@
 //! normal `n` (away from the camera) are the columns of
 //! `R_y(tilt_y) * R_x(tilt_x)`. A point `P` on the plane has target
 //! coordinates `(a, b) = ((P - O).e1, (P - O).e2)` in metres. With no tilt and
-//! no offset, `(a, b)` are SPEC's `(X, Y)`.
+//! no offset, `(a, b)` are docs/spec.md's `(X, Y)`.
 
 use super::poster::Background;
 use super::texture::MipTexture;

@@ -1,4 +1,4 @@
-//! The exposure MMBM of video frames (SPEC sections 3 and 9): for a frame
+//! The exposure MMBM of video frames (docs/spec.md sections 3 and 9): for a frame
 //! starting at `t0` with exposure `t_e` and rolling-shutter readout `t_r`,
 //! line `j` of `n` is exposed over `[t0 + t_r j / n, t0 + t_r j / n + t_e]`,
 //! and the frame's exposure MMBM is the sensor mean of each point's flow

@@ -4,7 +4,7 @@
 //! `F(s) = F_k + s (F_{k+1} - F_k)` for `s` in `[0, 1]`, and its speed is
 //! `|F(s)|`, not the interpolation of the two speeds (they differ where the
 //! flow turns within the interval). The time integral of `|F|` has a closed
-//! form (the arc length of a parabola's derivative, SPEC 3's square root of a
+//! form (the arc length of a parabola's derivative, docs/spec.md section 3's square root of a
 //! quadratic in time).
 
 /// `integral_{s0}^{s1} |a + s d| ds` for 2-D vectors `a`, `d` (any units;

@@ -1,7 +1,7 @@
 //! Per-pixel blur fields of video frames (`mmbm frames --maps`): for every
 //! pixel of a frame, the image track of the scene point seen at its centre
 //! at its own line's exposure start, followed over that line's exposure
-//! (rolling shutter: each line its own window, SPEC 9), on the renderer's
+//! (rolling shutter: each line its own window, docs/spec.md section 9), on the renderer's
 //! motion ([`Trajectory::from_imu_log`]: the twist interpolated linearly
 //! between gyro samples and integrated on SO(3)). No image is rendered.
 //!

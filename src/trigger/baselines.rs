@@ -1,5 +1,5 @@
 //! The baselines camera users reach for instead of gyro-driven triggering
-//! (SPEC section 10): a fixed short exposure with the gain raised
+//! (docs/spec.md section 10): a fixed short exposure with the gain raised
 //! (`fixed:FPS@Tms`) and a motion-blind auto-exposure (`ae:FPS:cap=Tms`).
 //! Both keep the fixed-rate schedule; neither reads the gyro.
 //!

@@ -1,5 +1,5 @@
 //! The two ways a policy is grouped: its rule ([`Family`], the name before
-//! the first `:`) and its benefit-map family ([`PolicyFamily`], SPEC
+//! the first `:`) and its benefit-map family ([`PolicyFamily`], docs/spec.md
 //! sections 10-11).
 
 /// The family of a policy (its name before the first `:`).
@@ -78,7 +78,7 @@ impl Family {
     }
 }
 
-/// The family of SPEC section 10, by which the benefit map groups the
+/// The family of docs/spec.md section 10, by which the benefit map groups the
 /// policies (the `family` column of `frames.csv`). Not the rule ([`Family`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum PolicyFamily {
@@ -89,7 +89,7 @@ pub enum PolicyFamily {
     /// Motion-blind auto-exposure (`ae:...`, `ae-grad:...`).
     AutoExposure,
     /// Fixed rate, exposure and gain from the gyro (`ae-blur`, `ae-imu`,
-    /// `fixed:FPS[@PHASE]+exp:...`; SPEC section 11).
+    /// `fixed:FPS[@PHASE]+exp:...`; docs/spec.md section 11).
     GyroExposure,
     /// Trigger timing from the gyro, with or without exposure control (MMBM
     /// rules, gates, `deadline`, `task`).

@@ -1,4 +1,4 @@
-//! Gradient auto-exposure (SPEC section 11, family `auto-exposure`,
+//! Gradient auto-exposure (docs/spec.md section 11, family `auto-exposure`,
 //! motion-blind): the exposure that maximises the frame's summed gradient
 //! magnitude after a gamma, searched over a few candidates each frame (after
 //! Shim et al., TCSVT 2018, and Zhang, Forster, Scaramuzza, ICRA 2017).

@@ -1,4 +1,4 @@
-//! The gyro-aware exposure controls camera makers and papers use (SPEC
+//! The gyro-aware exposure controls camera makers and papers use (docs/spec.md
 //! section 11, family `gyro-exposure`): fixed rate, the exposure and gain
 //! from the gyro. Both wrap the motion-blind auto-exposure of
 //! [`AutoExposure`] (same state, same update, same keys) and change only how

@@ -1,4 +1,4 @@
-//! Camera trigger policies driven by the MMBM of a gyro log (SPEC section 6,
+//! Camera trigger policies driven by the MMBM of a gyro log (docs/spec.md section 6,
 //! thesis chapters 5-6).
 //!
 //! # Timing model (thesis Fig. 5.1)

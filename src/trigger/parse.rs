@@ -300,7 +300,7 @@ impl PolicySpec {
         &self.text
     }
 
-    /// The family of SPEC section 10 (the benefit map's grouping).
+    /// The family of docs/spec.md section 10 (the benefit map's grouping).
     pub fn policy_family(&self) -> PolicyFamily {
         if !self.is_causal() {
             PolicyFamily::Oracle

@@ -1,7 +1,7 @@
 //! `task:FPS:light=E[:read=E][:tmin=Tms]`: the exposure and the trigger
 //! instant that maximise the predicted probability that a frame is sharp
 //! (all blobs found), from the blur the gyro predicts and the signal-to-noise
-//! ratio the light gives (SPEC section 10; the EMVA 1288 model of
+//! ratio the light gives (docs/spec.md section 10; the EMVA 1288 model of
 //! `camera::noise`).
 
 use super::numbers::parse_pos;

@@ -49,7 +49,7 @@ impl CameraTiming {
     /// Default pixel pitch, mm: the thesis camera's 4.65 um.
     pub const DEFAULT_PITCH_MM: f64 = 0.00465;
 
-    /// The timing of a rolling-shutter camera (SPEC 9): its last line's
+    /// The timing of a rolling-shutter camera (docs/spec.md section 9): its last line's
     /// exposure ends `rolling_readout_s` after the first line's, so the camera
     /// is busy that much longer before the readout `t_r` that follows.
     pub fn with_rolling_readout(self, rolling_readout_s: f64) -> Self {

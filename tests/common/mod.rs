@@ -40,7 +40,17 @@ pub fn bin() -> PathBuf {
         };
         let root = Path::new(env!("CARGO_MANIFEST_DIR"));
         let mut newest = None;
-        for sub in ["src", "cli/src", "shaders", "Cargo.toml", "cli/Cargo.toml"] {
+        for sub in [
+            "src",
+            "core/src",
+            "lab/src",
+            "cli/src",
+            "shaders",
+            "Cargo.toml",
+            "core/Cargo.toml",
+            "lab/Cargo.toml",
+            "cli/Cargo.toml",
+        ] {
             newest_in(&root.join(sub), &mut newest);
         }
         if let Some((t, f)) = newest {

@@ -143,7 +143,7 @@ fn hostile_camera_files() {
 /// writing nothing; the good manifest still verifies after.
 #[test]
 fn hostile_manifests() {
-    use mmbm::dataset::{self, DatasetConfig, Shard};
+    use mmbm_lab::dataset::{self, DatasetConfig, Shard};
     use serde_json::{json, Value};
     let d = tempfile::tempdir().unwrap();
     let out = d.path().join("data");
@@ -318,7 +318,7 @@ proptest! {
     /// never panics; an error is short.
     #[test]
     fn manifest_mutations(edits in prop::collection::vec((0..3u8, any::<prop::sample::Index>(), any::<u8>()), 1..8)) {
-        use mmbm::dataset::{self, DatasetConfig, Shard};
+        use mmbm_lab::dataset::{self, DatasetConfig, Shard};
         static DIR: std::sync::OnceLock<(tempfile::TempDir, String)> = std::sync::OnceLock::new();
         let (d, good) = DIR.get_or_init(|| {
             let d = tempfile::tempdir().unwrap();

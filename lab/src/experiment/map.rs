@@ -1,0 +1,425 @@
+//! The benefit map (docs/spec.md section 10): when does gyro-driven capture beat
+//! what camera users do instead? Cells are light x gait x board; in each,
+//! the sharp frames per second of every policy (kept, rendered, all 16 blobs
+//! at their true places), the best causal gyro-driven policy (`mmbm`) against
+//! the best fixed exposure in hindsight (`oracle`, over the grid), against
+//! auto-exposure and against the thesis's fixed rate, each ratio paired over
+//! the 2-s blocks of the walks with a 95 % percentile bootstrap over the
+//! blocks of all seeds (the headline's [`BLOCK_S`](super::benefit::BLOCK_S), [`RESAMPLES`](super::benefit::RESAMPLES) and
+//! [`BOOTSTRAP_SEED`](super::benefit::BOOTSTRAP_SEED): [`bootstrap_indices`](super::benefit::bootstrap_indices)).
+//!
+//! The trigger times and exposures do not depend on the light (the
+//! auto-exposure predicts its level from the scene, see
+//! [`crate::trigger::AutoExposure`]), so each frame is rendered once without
+//! noise and judged at every light with that light's noise and gain
+//! ([`super::map_render`]). The best policies of a cell are chosen on all
+//! its blocks (point estimates) and then held fixed in the resamples.
+
+use super::benefit::{bootstrap_indices, Estimate, WalkBlocks};
+use super::config::ExperimentConfig;
+use super::map_render::{judge_at_lights, Judged, Light};
+use super::walk::{make_walk, Walk};
+use crate::camera::Noise;
+use crate::error::Result;
+use crate::metric::Scene;
+use crate::render::Quality;
+use crate::stats::percentile;
+use crate::trigger::{Frame, PolicyFamily, PolicySpec};
+use rayon::prelude::*;
+
+/// One policy in one cell.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CellPolicy {
+    /// The policy.
+    pub policy: PolicySpec,
+    /// Sharp frames per second (all seeds pooled).
+    pub sharp_fps: f64,
+    /// Kept frames.
+    pub frames: usize,
+    /// Sharp frames.
+    pub sharp: usize,
+    /// Mean exposure of the kept frames, s.
+    pub mean_exposure_s: f64,
+    /// Kept frames whose gain the sensor's maximum capped (darker than meant).
+    pub gain_capped: usize,
+    /// Blobs found away from every board place, over all kept frames (clutter, noise).
+    pub false_alarms: usize,
+    /// Mean corner repeatability of the kept frames with corners
+    /// (`corners.rs`; NaN when none had any).
+    pub corner_rep: f64,
+    /// Frames usable for odometry per second: repeatability at least
+    /// `corners::REPEAT_OK` (all seeds pooled).
+    pub vo_fps: f64,
+}
+
+/// One cell of the map.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Cell {
+    /// Light, e-/s for a white pixel.
+    pub light: f64,
+    /// Gait.
+    pub gait: String,
+    /// Board (`blobs:0.5` or `blobs`).
+    pub board: String,
+    /// Every policy, in the map's order.
+    pub policies: Vec<CellPolicy>,
+    /// Index of the best `mmbm` policy.
+    pub best_mmbm: Option<usize>,
+    /// Index of the best fixed exposure in hindsight (over the grid).
+    pub hindsight: Option<usize>,
+    /// Index of the best auto-exposure.
+    pub ae: Option<usize>,
+    /// Index of the thesis's fixed rate.
+    pub fixed: Option<usize>,
+    /// Index of the best `gyro-exposure` policy (fixed rate, exposure from the gyro).
+    pub gyro: Option<usize>,
+    /// Best `mmbm` over the best fixed exposure in hindsight.
+    pub vs_hindsight: Option<Estimate>,
+    /// Best `mmbm` over auto-exposure.
+    pub vs_ae: Option<Estimate>,
+    /// Best `mmbm` over the fixed rate.
+    pub vs_fixed: Option<Estimate>,
+    /// Does timing pay? Best `mmbm` (trigger timing from the gyro) over the
+    /// best `gyro-exposure` policy (docs/spec.md section 11).
+    pub vs_gyro: Option<Estimate>,
+    /// Index of the policy with the most sharp frames per second.
+    pub winner: usize,
+    /// Blocks resampled.
+    pub blocks: usize,
+}
+
+/// The whole map.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BenefitMap {
+    /// The cells, light-major (lights in configuration order, then gait, then board).
+    pub cells: Vec<Cell>,
+    /// Light levels, e-/s.
+    pub lights: Vec<f64>,
+    /// Gaits.
+    pub gaits: Vec<String>,
+    /// Boards.
+    pub boards: Vec<String>,
+    /// Seeds.
+    pub seeds: Vec<u64>,
+    /// The sensor (read noise, full well, bits, noise seed).
+    pub sensor: Noise,
+    /// The reference exposure, s.
+    pub t_ref_s: f64,
+    /// The maximum gain in units of the full-well gain.
+    pub max_gain_x: f64,
+    /// The fixed-exposure grid, ms.
+    pub grid_ms: Vec<f64>,
+    /// The frame rate of `fixed` and of the grid, frames/s.
+    pub fps: f64,
+    /// Frames rendered (each judged at every light).
+    pub renders: usize,
+    /// Wall time, s.
+    pub seconds: f64,
+}
+
+/// The map's policies: the configured ones, the fixed rate and the grid
+/// (`fixed:FPS@Tms`; the grid's `T_ref` is the fixed rate itself).
+pub fn map_policies(cfg: &ExperimentConfig) -> Result<Vec<PolicySpec>> {
+    let m = &cfg.map;
+    let fixed = format!("fixed:{}", m.fps);
+    let mut out: Vec<PolicySpec> = Vec::new();
+    let mut push = |s: String| -> Result<()> {
+        let p = PolicySpec::parse(&s)?;
+        if !out.iter().any(|q| q.as_str() == p.as_str()) {
+            out.push(p);
+        }
+        Ok(())
+    };
+    push(fixed.clone())?;
+    for p in &m.policies {
+        push(p.clone())?;
+    }
+    for &t in &m.grid_ms {
+        if (t * 1e-3 - cfg.exposure_s).abs() > 1e-9 {
+            push(format!("{fixed}@{t}ms"))?;
+        }
+    }
+    Ok(out)
+}
+
+/// True when policy `p` is in the hindsight grid.
+fn in_grid(cfg: &ExperimentConfig, p: &PolicySpec) -> bool {
+    match p.policy_family() {
+        PolicyFamily::FixedExposure => true,
+        PolicyFamily::Fixed => cfg
+            .map
+            .grid_ms
+            .iter()
+            .any(|&t| (t * 1e-3 - cfg.exposure_s).abs() <= 1e-9),
+        _ => false,
+    }
+}
+
+/// Per light and policy: what its kept frames gave.
+#[derive(Debug, Clone, Copy, Default)]
+struct Tally {
+    frames: usize,
+    sharp: usize,
+    exposure_s: f64,
+    capped: usize,
+    false_alarms: usize,
+    rep_sum: f64,
+    rep_n: usize,
+    vo: usize,
+}
+
+/// Per block: its seconds and, per light and policy, its sharp frames.
+struct Block {
+    seconds: f64,
+    sharp: Vec<f64>,
+}
+
+/// Runs the map (None when `map.lights_e_per_s` is empty).
+pub fn benefit_map(
+    cfg: &ExperimentConfig,
+    quality: Quality,
+    progress: bool,
+) -> Result<Option<BenefitMap>> {
+    let m = &cfg.map;
+    if m.lights_e_per_s.is_empty() {
+        return Ok(None);
+    }
+    let t_start = std::time::Instant::now();
+    let policies = map_policies(cfg)?;
+    let np = policies.len();
+    let gaits = if m.gaits.is_empty() {
+        cfg.walks.clone()
+    } else {
+        m.gaits.clone()
+    };
+    let seeds = if m.seeds.is_empty() {
+        cfg.seed_list()
+    } else {
+        m.seeds.clone()
+    };
+    let sensor = cfg.camera.noise.unwrap_or_else(|| Noise::at_light(1.0));
+    let surround: crate::render::Background = cfg.background.parse()?;
+    let lights: Vec<Light> = m
+        .lights_e_per_s
+        .iter()
+        .map(|&phi| Light::new(&sensor, phi, cfg.exposure_s, m.max_gain_x))
+        .collect();
+    let nl = lights.len();
+    let cam = crate::camera::Camera {
+        noise: None,
+        ..cfg.camera()
+    };
+    let scene = Scene {
+        camera: cam,
+        plane: None,
+    };
+    let mcfg = ExperimentConfig {
+        policies: policies.iter().map(|p| p.as_str().to_string()).collect(),
+        gyro: None,
+        ..cfg.clone()
+    };
+    let mut walks: Vec<(usize, Walk)> = Vec::new();
+    for (gi, g) in gaits.iter().enumerate() {
+        for &s in &seeds {
+            walks.push((gi, make_walk(&mcfg, g, s, true, &scene)?));
+        }
+    }
+    let kept = |w: &Walk| -> usize {
+        w.runs
+            .iter()
+            .map(|(_, f)| f.iter().filter(|f| f.kept).count())
+            .sum()
+    };
+    let total: usize = walks.iter().map(|(_, w)| kept(w)).sum::<usize>() * m.boards.len();
+    let bar = crate::diagnostics::progress(progress, "benefit map: frames", total as u64);
+    let mut cells = Vec::new();
+    // Per (gait, board): the blocks of all seeds; per light, the cells.
+    let mut per_column: Vec<Vec<Cell>> = Vec::new();
+    let mut renders = 0usize;
+    for (gi, g) in gaits.iter().enumerate() {
+        for board in &m.boards {
+            let mut blocks: Vec<Block> = Vec::new();
+            // Per light and policy.
+            let mut tally = vec![Tally::default(); nl * np];
+            for (_, w) in walks.iter().filter(|(wg, _)| *wg == gi) {
+                let wb = WalkBlocks::of(w);
+                let first = blocks.len();
+                for &seconds in &wb.seconds {
+                    blocks.push(Block {
+                        seconds,
+                        sharp: vec![0.0; nl * np],
+                    });
+                }
+                for (pi, (_, frames)) in w.runs.iter().enumerate() {
+                    // The policy's kept frames are judged in parallel (each
+                    // frame's seed is its place in the serial order, so the
+                    // result does not depend on the thread count), then
+                    // tallied in order.
+                    let kept: Vec<&Frame> = frames.iter().filter(|f| f.kept).collect();
+                    if let Some(f) = kept.first() {
+                        bar.message(&format!("{g} {board} {}", f.policy));
+                    }
+                    let judged: Vec<Vec<Judged>> = kept
+                        .par_iter()
+                        .enumerate()
+                        .map(|(j, f)| {
+                            judge_at_lights(
+                                board,
+                                surround,
+                                w,
+                                f,
+                                cam,
+                                quality,
+                                (renders + j) as u32,
+                                &lights,
+                            )
+                        })
+                        .collect::<Result<_>>()?;
+                    renders += kept.len();
+                    bar.advance(kept.len() as u64);
+                    for (f, judged) in kept.iter().zip(&judged) {
+                        let b = wb.index(f.trigger_t);
+                        for (li, j) in judged.iter().enumerate() {
+                            let k = li * np + pi;
+                            blocks[first + b].sharp[k] += f64::from(u8::from(j.ok));
+                            let t = &mut tally[k];
+                            t.frames += 1;
+                            t.sharp += usize::from(j.ok);
+                            t.exposure_s += f.exposure_s();
+                            t.capped += usize::from(lights[li].capped(f.gain));
+                            t.false_alarms += j.false_alarms;
+                            if j.corner_rep.is_finite() {
+                                t.rep_sum += j.corner_rep;
+                                t.rep_n += 1;
+                                t.vo += usize::from(j.corner_rep >= super::corners::REPEAT_OK);
+                            }
+                        }
+                    }
+                }
+            }
+            let mut column = Vec::new();
+            for (li, light) in m.lights_e_per_s.iter().enumerate() {
+                column.push(cell(
+                    cfg,
+                    &policies,
+                    &blocks,
+                    li,
+                    &tally[li * np..(li + 1) * np],
+                    (*light, g, board),
+                ));
+            }
+            per_column.push(column);
+        }
+    }
+    drop(bar);
+    for li in 0..nl {
+        for col in &per_column {
+            cells.push(col[li].clone());
+        }
+    }
+    Ok(Some(BenefitMap {
+        cells,
+        lights: m.lights_e_per_s.clone(),
+        gaits,
+        boards: m.boards.clone(),
+        seeds,
+        sensor,
+        t_ref_s: cfg.exposure_s,
+        max_gain_x: m.max_gain_x,
+        grid_ms: m.grid_ms.clone(),
+        fps: m.fps,
+        renders,
+        seconds: t_start.elapsed().as_secs_f64(),
+    }))
+}
+
+/// The best policy (highest point estimate; the first of ties) among those `pick` accepts.
+fn best(ps: &[CellPolicy], pick: impl Fn(&CellPolicy) -> bool) -> Option<usize> {
+    let mut out: Option<usize> = None;
+    for (i, p) in ps.iter().enumerate().filter(|(_, p)| pick(p)) {
+        if out.is_none_or(|b| p.sharp_fps > ps[b].sharp_fps) {
+            out = Some(i);
+        }
+    }
+    out
+}
+
+/// One cell from its blocks.
+fn cell(
+    cfg: &ExperimentConfig,
+    policies: &[PolicySpec],
+    blocks: &[Block],
+    li: usize,
+    tally: &[Tally],
+    (light, gait, board): (f64, &str, &str),
+) -> Cell {
+    let np = policies.len();
+    let fps = |idx: &mut dyn Iterator<Item = usize>, pi: usize| {
+        let (mut ok, mut secs) = (0.0, 0.0);
+        for k in idx {
+            ok += blocks[k].sharp[li * np + pi];
+            secs += blocks[k].seconds;
+        }
+        ok / secs
+    };
+    let seconds: f64 = blocks.iter().map(|b| b.seconds).sum();
+    let ps: Vec<CellPolicy> = policies
+        .iter()
+        .enumerate()
+        .map(|(pi, p)| CellPolicy {
+            policy: p.clone(),
+            sharp_fps: fps(&mut (0..blocks.len()), pi),
+            frames: tally[pi].frames,
+            sharp: tally[pi].sharp,
+            mean_exposure_s: tally[pi].exposure_s / tally[pi].frames.max(1) as f64,
+            gain_capped: tally[pi].capped,
+            false_alarms: tally[pi].false_alarms,
+            corner_rep: if tally[pi].rep_n > 0 {
+                tally[pi].rep_sum / tally[pi].rep_n as f64
+            } else {
+                f64::NAN
+            },
+            vo_fps: tally[pi].vo as f64 / seconds,
+        })
+        .collect();
+    let fam = |f: PolicyFamily| move |p: &CellPolicy| p.policy.policy_family() == f;
+    let best_mmbm = best(&ps, fam(PolicyFamily::Mmbm));
+    let hindsight = best(&ps, |p| in_grid(cfg, &p.policy));
+    let ae = best(&ps, fam(PolicyFamily::AutoExposure));
+    let gyro = best(&ps, fam(PolicyFamily::GyroExposure));
+    let fixed = ps.iter().position(|p| p.policy.is_baseline());
+    let winner = best(&ps, |_| true).unwrap_or(0);
+    let samples = bootstrap_indices(blocks.len());
+    let ratio = |a: Option<usize>, b: Option<usize>| -> Option<Estimate> {
+        let (a, b) = (a?, b?);
+        let value = ps[a].sharp_fps / ps[b].sharp_fps;
+        let mut draws: Vec<f64> = samples
+            .iter()
+            .map(|s| fps(&mut s.iter().copied(), a) / fps(&mut s.iter().copied(), b))
+            .filter(|x| x.is_finite())
+            .collect();
+        draws.sort_by(f64::total_cmp);
+        Some(Estimate {
+            value,
+            lo: percentile(&draws, 2.5).unwrap_or(f64::NAN),
+            hi: percentile(&draws, 97.5).unwrap_or(f64::NAN),
+        })
+    };
+    Cell {
+        light,
+        gait: gait.to_string(),
+        board: board.to_string(),
+        vs_hindsight: ratio(best_mmbm, hindsight),
+        vs_ae: ratio(best_mmbm, ae),
+        vs_fixed: ratio(best_mmbm, fixed),
+        vs_gyro: ratio(best_mmbm, gyro),
+        policies: ps,
+        best_mmbm,
+        hindsight,
+        ae,
+        fixed,
+        gyro,
+        winner,
+        blocks: blocks.len(),
+    }
+}

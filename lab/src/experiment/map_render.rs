@@ -1,0 +1,182 @@
+//! The benefit map's renders: each frame rendered once without noise, then
+//! judged (blob extraction) at every light level with the sensor noise of
+//! that light and the gain a camera would set there (docs/spec.md section 10).
+
+use super::corners;
+use super::measure::{blob_metrics, bulk_job, frame_motion};
+use super::walk::Walk;
+use crate::camera::{Camera, Noise};
+use crate::error::Result;
+use crate::io::images::to_rgb8;
+use crate::render::{self, Background, Quality, Target};
+use crate::trigger::Frame;
+
+/// The window judged at each light: the blob grid padded by this many blob pitches.
+pub const WINDOW_PITCHES: f64 = 3.0;
+
+/// The camera's gain at one light level (docs/spec.md section 10).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Light {
+    /// The sensor at this light (its `gain_dn_per_e` is the reference gain `K_ref`).
+    pub noise: Noise,
+    /// The reference exposure `T_ref`, s (white fills the range there).
+    pub t_ref_s: f64,
+    /// The sensor's maximum gain, DN/e-.
+    pub max_gain_dn_per_e: f64,
+}
+
+impl Light {
+    /// The sensor `base` (read noise, full well, bits, seed) at `phi` e-/s,
+    /// with `K_ref = (2^bits - 1) / (phi T_ref)` capped at `max_gain_x` times
+    /// the full-well gain `(2^bits - 1) / full_well`.
+    pub fn new(base: &Noise, phi: f64, t_ref_s: f64, max_gain_x: f64) -> Self {
+        let mut noise = Noise {
+            phi_e_per_s: phi,
+            gain_dn_per_e: None,
+            ..*base
+        };
+        let max_gain = max_gain_x * noise.max_dn() / noise.full_well_e;
+        noise.gain_dn_per_e = Some((noise.max_dn() / (phi * t_ref_s)).min(max_gain));
+        Light {
+            noise,
+            t_ref_s,
+            max_gain_dn_per_e: max_gain,
+        }
+    }
+
+    /// The sensor for a frame whose policy raised the gain by `relative`:
+    /// `K_ref * relative`, capped at the maximum gain.
+    pub fn for_gain(&self, relative: f64) -> Noise {
+        Noise {
+            gain_dn_per_e: Some((self.noise.gain() * relative).min(self.max_gain_dn_per_e)),
+            ..self.noise
+        }
+    }
+
+    /// True when the cap binds for a relative gain (the frame is darker than intended).
+    pub fn capped(&self, relative: f64) -> bool {
+        self.noise.gain() * relative > self.max_gain_dn_per_e * (1.0 + 1e-12)
+    }
+}
+
+/// What a frame gave at one light.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Judged {
+    /// All 16 blobs extracted at their true places (and no other).
+    pub ok: bool,
+    /// Blobs found away from every board place.
+    pub false_alarms: usize,
+    /// Corner repeatability in the window ([`super::corners`]); NaN without corners.
+    pub corner_rep: f64,
+}
+
+/// Renders `frame` of `walk` on `target` (`blobs` or `blobs:0.5`, with
+/// `surround` behind it) once with the noiseless camera `cam` and returns,
+/// for each of `lights`, the blob verdict, the false alarms and the corner
+/// repeatability against the sharp frame at mid-exposure (noiseless, the
+/// same window). `seed` seeds the render's sampling lattice and the noise
+/// (RNG stream `seed * 64 + light index`).
+#[allow(clippy::too_many_arguments)]
+pub fn judge_at_lights(
+    target: &str,
+    surround: Background,
+    walk: &Walk,
+    frame: &Frame,
+    cam: Camera,
+    quality: Quality,
+    seed: u32,
+    lights: &[Light],
+) -> Result<Vec<Judged>> {
+    let cam = Camera { noise: None, ..cam };
+    let rolling = cam.shutter.readout_s;
+    let exposure = frame.exposure_s();
+    let (distance, traj) = frame_motion(walk, frame, rolling)?;
+    let mut target = Target::parse(target, distance)?;
+    target.surround = surround;
+    let mut job = bulk_job(cam, exposure, &traj, &target, quality, seed);
+    job.with_maps = false;
+    let out = render::render_frame(&job)?;
+    // True blob centres at mid-exposure, as the experiment's measure.
+    let mid = traj.pose_at(0.5 * (exposure + rolling));
+    let expected: Vec<(f64, f64)> = target
+        .blob_centres()
+        .unwrap_or_default()
+        .iter()
+        .filter_map(|&p| render::project(&cam, &mid, p))
+        .collect();
+    // Noise, extraction and corners on a window around the board (the blob
+    // grid padded by WINDOW_PITCHES pitches), not the whole frame: the noise
+    // is most of the cost.
+    let (w, h) = (cam.width as usize, cam.height as usize);
+    let pad = WINDOW_PITCHES * super::crop::pitch_px(&expected);
+    let lo = |v: f64| (v - pad).floor().max(0.0) as usize;
+    let (xs, ys) = (expected.iter().map(|p| p.0), expected.iter().map(|p| p.1));
+    let x0 = lo(xs.clone().fold(f64::INFINITY, f64::min)).min(w - 1);
+    let y0 = lo(ys.clone().fold(f64::INFINITY, f64::min)).min(h - 1);
+    let x1 =
+        ((xs.fold(f64::NEG_INFINITY, f64::max) + pad).ceil().max(0.0) as usize).clamp(x0 + 1, w);
+    let y1 =
+        ((ys.fold(f64::NEG_INFINITY, f64::max) + pad).ceil().max(0.0) as usize).clamp(y0 + 1, h);
+    let (cw, ch) = if expected.is_empty() {
+        (w, h)
+    } else {
+        (x1 - x0, y1 - y0)
+    };
+    let (x0, y0) = if expected.is_empty() {
+        (0, 0)
+    } else {
+        (x0, y0)
+    };
+    let cut = |rgb: &[f32]| {
+        let mut window = Vec::with_capacity(cw * ch * 3);
+        for y in y0..y0 + ch {
+            window.extend_from_slice(&rgb[3 * (y * w + x0)..3 * (y * w + x0 + cw)]);
+        }
+        window
+    };
+    let window = cut(&out.rgb);
+    let sharp = cut(&corners::sharp_at(&job, mid)?);
+    let sharp_corners = corners::corners(&corners::luma(cw as u32, ch as u32, &sharp)?);
+    let shifted: Vec<(f64, f64)> = expected
+        .iter()
+        .map(|&(x, y)| (x - x0 as f64, y - y0 as f64))
+        .collect();
+    let mut ok = Vec::with_capacity(lights.len());
+    for (k, light) in lights.iter().enumerate() {
+        let mut rgb = window.clone();
+        light
+            .for_gain(frame.gain)
+            .apply(&mut rgb, exposure, u64::from(seed) * 64 + k as u64)?;
+        let img = to_rgb8(cw as u32, ch as u32, &rgb)?;
+        let b = blob_metrics(&img, &shifted);
+        let found = corners::corners(&crate::assess::luma(&img));
+        ok.push(Judged {
+            ok: b.ok,
+            false_alarms: b.false_alarms,
+            corner_rep: corners::repeatability_strongest(&sharp_corners, &found)
+                .unwrap_or(f64::NAN),
+        });
+    }
+    Ok(ok)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn reference_gain_fills_the_range_and_is_capped() {
+        let base = Noise::at_light(1.0);
+        // 20,000 e-/s: 1,400 e- of white in 70 ms fill 255 DN.
+        let l = Light::new(&base, 20_000.0, 0.07, 256.0);
+        assert!((l.noise.gain() * 1400.0 - 255.0).abs() < 1e-9);
+        // The maximum: 256 x 255 / 10,000 DN/e-.
+        assert!((l.max_gain_dn_per_e - 6.528).abs() < 1e-12);
+        // 3 ms at 23.3x the gain is below the cap; 1 ms at 70x is not.
+        assert!(!l.capped(0.07 / 0.003) && l.capped(70.0));
+        assert!((l.for_gain(1e6).gain() - 6.528).abs() < 1e-12);
+        // 500 e-/s: even the reference gain (7.3 DN/e-) is above the cap.
+        let dim = Light::new(&base, 500.0, 0.07, 256.0);
+        assert!((dim.noise.gain() - 6.528).abs() < 1e-12 && dim.capped(1.0 + 1e-6));
+    }
+}

@@ -1,0 +1,30 @@
+//! # mmbm-lab — the research apparatus of mmbm
+//!
+//! The thesis experiment end to end, its tables and figures, and blur
+//! datasets at scale, on top of the [`mmbm`] library, with their own
+//! dependencies (plotters, tar, sha2, fs4) so that a program that computes
+//! the metric, fields or renders links none of them.
+//!
+//! # Layers
+//!
+//! Modules import only from their own layer or the ones below it, in this
+//! crate or the library below it (checked by `tests/layers.rs`):
+//!
+//! | layer | modules | holds |
+//! |---|---|---|
+//! | 2 | [`plot`] | figures |
+//! | 3 | [`tables`] | thesis tables |
+//! | 6 | [`experiment`], [`dataset`] | the thesis experiment end to end; blur datasets at scale |
+#![deny(unsafe_code)]
+#![warn(missing_docs)]
+
+pub mod dataset;
+pub mod experiment;
+pub mod plot;
+pub mod tables;
+
+// The library's modules at the paths the moved code uses (`crate::render::...`).
+use mmbm::{
+    assess, board, camera, cancel, check, diagnostics, error, field, gpu, io, limits, metric,
+    model, render, series, sim, stats, trigger, Result,
+};
