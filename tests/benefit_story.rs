@@ -6,8 +6,8 @@
 mod common;
 
 use mmbm::camera::{CameraFile, Noise};
-use mmbm_lab::experiment::{self, ExperimentConfig, MapSection};
 use mmbm::trigger::{run, CameraTiming, Frame, PolicyFamily, PolicySpec};
+use mmbm_lab::experiment::{self, ExperimentConfig, MapSection};
 
 /// 20 s at 600 Hz of an MMBM that swings between 0 and 2 mm/s (a gait-like
 /// 1.7 Hz cycle), run through `spec` on the thesis camera (70 ms, 4.65 um).
