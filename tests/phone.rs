@@ -293,13 +293,21 @@ fn bad_rows_name_the_file_and_line() {
     let _ = std::fs::remove_dir_all(&d);
 }
 
-/// The `mmbm` commands of `docs/frames.md`, continuation lines joined.
+/// The `mmbm` commands of `docs/frames.md`'s worked example (its numbered
+/// sections 1-4, on the phone's files), continuation lines joined. The
+/// sections after it ("Syncing the gyro to the video", "Gyro from the
+/// camera's own files") show commands on placeholder files (a GoPro clip, a
+/// Gyroflow project): `tests/sync.rs` and `tests/telemetry.rs` run those
+/// commands on files they make.
 fn doc_commands() -> Vec<Vec<String>> {
     let doc =
         std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/docs/frames.md")).unwrap();
+    let end = doc
+        .find("\n## Syncing the gyro to the video")
+        .expect("docs/frames.md has its sync section after the worked example");
     let mut out = Vec::new();
     let (mut fenced, mut cur) = (false, String::new());
-    for line in doc.lines() {
+    for line in doc[..end].lines() {
         if line.trim_start().starts_with("```") {
             fenced = !fenced;
             continue;

@@ -22,10 +22,10 @@ pub(crate) mod cpu;
 pub(crate) mod exact;
 pub(crate) mod gpu;
 pub(crate) mod homography;
-mod job;
 pub(crate) mod kernel;
 mod layout;
 pub mod maps;
+mod motion;
 pub mod poster;
 pub(crate) mod psf;
 mod sampling;
@@ -36,13 +36,14 @@ pub mod texture;
 
 pub use crate::gpu::Backend;
 pub use crate::model::trajectory::{Pose, Trajectory};
-pub use job::{FrameMotion, RenderJob};
 pub use maps::{blur_maps, BlurMaps, BlurMeans};
+pub use motion::FrameMotion;
 pub use poster::Background;
 pub use psf::{psf, Psf};
 pub use sharp::{render_sharp_at, SharpAt};
 pub use target::{project, Target, TargetKind, DEFAULT_BACKGROUND};
 
+use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::gpu::Resolved;
 use std::fmt;
@@ -207,6 +208,87 @@ impl fmt::Display for Integrator {
             Integrator::Analytic => "analytic",
             Integrator::Lattice => "lattice",
         })
+    }
+}
+
+/// One frame to render.
+#[derive(Debug, Clone)]
+pub struct RenderJob {
+    /// Camera intrinsics.
+    pub camera: Camera,
+    /// Exposure of each line, s (the whole frame's with a global shutter).
+    pub exposure_s: f64,
+    /// Camera motion from the first line's exposure start to the last line's
+    /// exposure end: [`Self::exposure_s`] plus the camera's rolling-shutter
+    /// readout when it has one (each line is exposed over its own window,
+    /// docs/spec.md section 9). Checked when the job renders.
+    pub trajectory: Trajectory,
+    /// The target.
+    pub target: Target,
+    /// Sampling quality.
+    pub quality: Quality,
+    /// GPU or CPU.
+    pub backend: Backend,
+    /// Seed of the per-pixel sample shifts.
+    pub seed: u32,
+    /// Also compute the per-pixel blur maps.
+    pub with_maps: bool,
+    /// Area integration.
+    pub integrator: Integrator,
+}
+
+impl RenderJob {
+    /// A frame exposed `exposure_s` seconds per line along `trajectory` (which
+    /// spans the camera's readout plus the exposure): default quality,
+    /// automatic backend, seed 0, with maps.
+    pub fn new(camera: Camera, exposure_s: f64, trajectory: Trajectory, target: Target) -> Self {
+        RenderJob {
+            camera,
+            exposure_s,
+            trajectory,
+            target,
+            quality: Quality::Default,
+            backend: Backend::Auto,
+            seed: 0,
+            with_maps: true,
+            integrator: Integrator::Auto,
+        }
+    }
+
+    /// A frame exposed `exposure_s` seconds per line while the camera moves as
+    /// `motion` says: the trajectory spans the camera's busy time (exposure
+    /// plus readout). The target is checked against the camera. Defaults as
+    /// [`Self::new`].
+    pub fn for_motion(
+        camera: Camera,
+        exposure_s: f64,
+        motion: FrameMotion<'_>,
+        target: Target,
+    ) -> Result<Self> {
+        let trajectory = motion.trajectory(&camera, exposure_s)?;
+        target.validate_for(&camera)?;
+        Ok(Self::new(camera, exposure_s, trajectory, target))
+    }
+
+    /// Checks the job's timing: a positive exposure, and a trajectory that
+    /// spans the camera's readout plus the exposure (first line's exposure
+    /// start to the last line's exposure end).
+    pub(crate) fn check_timing(&self) -> Result<()> {
+        crate::check::positive("exposure", self.exposure_s)?;
+        let readout = self.camera.shutter.readout_s;
+        let span = self.camera.shutter.busy_s(self.exposure_s);
+        let dur = self.trajectory.duration();
+        if (dur - span).abs() > 1e-9 * span.max(1.0) {
+            return Err(Error::invalid(
+                "trajectory",
+                format!(
+                    "spans {dur} s, but an exposure of {} s with the camera's readout_s {readout} s \
+                     needs {span} s (readout + exposure)",
+                    self.exposure_s
+                ),
+            ));
+        }
+        Ok(())
     }
 }
 

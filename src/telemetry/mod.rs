@@ -146,10 +146,21 @@ pub fn sniff(path: &Path) -> Result<Format> {
         ));
     }
     if h.contains(&0) && &h[..h.len().min(8)] != b"\x89MCAP0\r\n" {
-        return Err(mp4::bad(
-            path,
-            "file",
-            format!("binary content of no known format; accepted: {ACCEPTED}"),
+        // Where the first NUL is (line, 1-based) and how the file starts, as
+        // the text readers name a bad byte.
+        let nul = h.iter().position(|&b| b == 0).unwrap_or(0);
+        let line = 1 + h[..nul].iter().filter(|&&b| b == b'\n').count();
+        let start: String = h[..h.len().min(8)]
+            .iter()
+            .flat_map(|&b| std::ascii::escape_default(b))
+            .map(char::from)
+            .collect();
+        return Err(Error::invalid(
+            format!("{}:{line}", path.display()),
+            format!(
+                "binary content of no known format (a NUL byte; the file starts with '{start}'); \
+                 accepted: {ACCEPTED}"
+            ),
         ));
     }
     Ok(Format::Log)

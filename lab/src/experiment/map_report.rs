@@ -6,6 +6,7 @@
 use super::benefit::{Estimate, BLOCK_S, BOOTSTRAP_SEED, RESAMPLES};
 use super::corners::{FAST_THRESHOLD, MATCH_PX, NMS_RADIUS, REPEAT_OK};
 use super::map::{BenefitMap, Cell};
+use super::verdict::column;
 use crate::error::Result;
 use crate::io::atomic::write_atomic_path;
 use crate::plot::{ensure_font, plot_error};
@@ -28,19 +29,6 @@ fn ci(e: &Estimate) -> String {
 
 fn opt(e: &Option<Estimate>) -> String {
     e.as_ref().map_or("-".into(), ci)
-}
-
-fn board_name(b: &str) -> &str {
-    match b {
-        "blobs:0.5" | "blobs-half" => "half board",
-        "blobs" => "full board",
-        other => other,
-    }
-}
-
-/// The cell's column name: gait and board.
-pub fn column(c: &Cell) -> String {
-    format!("{}, {}", c.gait, board_name(&c.board))
 }
 
 /// True when the cell is lost: the best `mmbm` policy is below the best

@@ -10,7 +10,6 @@
 
 use super::benefit::Estimate;
 use super::map::{BenefitMap, Cell};
-use super::map_report::column;
 
 /// A cell's verdict.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -95,6 +94,19 @@ pub fn three_lines(m: &BenefitMap) -> [String; 3] {
         line("It ties", &parts[1]),
         line("It loses", &parts[2]),
     ]
+}
+
+/// The cell's column name: gait and board.
+pub fn column(c: &Cell) -> String {
+    format!("{}, {}", c.gait, board_name(&c.board))
+}
+
+fn board_name(b: &str) -> &str {
+    match b {
+        "blobs:0.5" | "blobs-half" => "half board",
+        "blobs" => "full board",
+        other => other,
+    }
 }
 
 #[cfg(test)]
