@@ -9,7 +9,8 @@
 
 use crate::error::{show_path, Error, Result};
 use crate::limits::{SYNC_MAX_FRAMES, SYNC_MAX_WIDTH_PX};
-use std::io::{BufRead, BufReader, Read};
+use crate::series::select::video::read_frame;
+use std::io::{BufRead, BufReader};
 use std::path::Path;
 use std::process::{Command, Stdio};
 
@@ -219,7 +220,7 @@ pub fn decode(
     let mut k = 0usize;
     let mut failed = None;
     loop {
-        match read_full(&mut stdout, &mut buf) {
+        match read_frame(&mut stdout, &mut buf) {
             Ok(true) => {}
             Ok(false) => break,
             Err(e) => {
@@ -276,26 +277,6 @@ pub fn decode(
         ));
     }
     Ok(times)
-}
-
-/// Fills `buf` from `r`: `Ok(false)` at a clean end before the first byte.
-fn read_full(r: &mut impl Read, buf: &mut [u8]) -> std::io::Result<bool> {
-    let mut got = 0;
-    while got < buf.len() {
-        match r.read(&mut buf[got..]) {
-            Ok(0) if got == 0 => return Ok(false),
-            Ok(0) => {
-                return Err(std::io::Error::new(
-                    std::io::ErrorKind::UnexpectedEof,
-                    "ffmpeg's output ended inside a frame",
-                ))
-            }
-            Ok(n) => got += n,
-            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
-            Err(e) => return Err(e),
-        }
-    }
-    Ok(true)
 }
 
 #[cfg(test)]

@@ -213,8 +213,10 @@ pub fn score_frames(video: &Path, metric: ImageMetric, frames: usize) -> Result<
     Ok(scores)
 }
 
-/// Reads one whole frame into `buf`: false at a clean end of stream.
-fn read_frame(r: &mut impl Read, buf: &mut [u8]) -> std::io::Result<bool> {
+/// Reads one whole raw frame of ffmpeg's output into `buf`: false at a
+/// clean end of stream before the frame's first byte, an error when the
+/// stream ends inside it (also `mmbm sync`'s decoder).
+pub fn read_frame(r: &mut impl Read, buf: &mut [u8]) -> std::io::Result<bool> {
     let mut got = 0;
     while got < buf.len() {
         match r.read(&mut buf[got..]) {
