@@ -188,22 +188,31 @@ pub fn check_output_dir(path: &Path) -> Result<()> {
             Err(e) => return Err(Error::io(dir, e)),
         }
     }
+    probe_dir(dir, path, None)
+}
+
+/// Checks that a file can be created in `dir` (a probe file, removed at
+/// once); an error names `path` (the output asked for), the directory and,
+/// when given, the `flag` the output came from.
+pub(crate) fn probe_dir(dir: &Path, path: &Path, flag: Option<&str>) -> Result<()> {
     tempfile::Builder::new()
         .prefix(".mmbm-probe-")
         .tempfile_in(dir)
         .map(drop)
         .map_err(|e| {
+            let flag = flag.map(|f| format!(" ({f})")).unwrap_or_default();
             Error::io(
                 path,
                 std::io::Error::new(
                     e.kind(),
-                    format!("cannot write in '{}': {}", show_path(dir), plain(&e)),
+                    format!("cannot write in '{}'{flag}: {}", show_path(dir), plain(&e)),
                 ),
             )
         })
 }
 
-fn parent_dir(path: &Path) -> &Path {
+/// The directory `path` lies in (`.` for a bare file name).
+pub(crate) fn parent_dir(path: &Path) -> &Path {
     match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),

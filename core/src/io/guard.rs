@@ -16,7 +16,7 @@
 //!
 //! Nothing is read or written by the check but the probe files.
 
-use super::atomic::{check_output_dir, check_outputs, plain, Destination};
+use super::atomic::{check_output_dir, check_outputs, Destination};
 use crate::error::{show_path, Error, Result};
 use std::path::{Component, Path, PathBuf};
 
@@ -165,27 +165,7 @@ fn probe_file(flag: &str, p: &Path, d: &Destination) -> Result<()> {
             )),
         },
         Destination::File(t) => {
-            let dir = match t.parent() {
-                Some(d) if !d.as_os_str().is_empty() => d,
-                _ => Path::new("."),
-            };
-            tempfile::Builder::new()
-                .prefix(".mmbm-probe-")
-                .tempfile_in(dir)
-                .map(drop)
-                .map_err(|e| {
-                    Error::io(
-                        p,
-                        std::io::Error::new(
-                            e.kind(),
-                            format!(
-                                "cannot write in '{}' ({flag}): {}",
-                                show_path(dir),
-                                plain(&e)
-                            ),
-                        ),
-                    )
-                })
+            super::atomic::probe_dir(super::atomic::parent_dir(t), p, Some(flag))
         }
     }
 }
