@@ -1,4 +1,5 @@
-//! Every `.wgsl` file under `shaders/` parses and validates with naga (no GPU needed).
+//! Every `.wgsl` file under `src/` (each shader beside its kernel) parses and
+//! validates with naga (no GPU needed).
 
 use std::path::Path;
 
@@ -20,19 +21,28 @@ fn validate(path: &Path) -> Result<(), String> {
     Ok(())
 }
 
+/// Every `.wgsl` file under `dir`, recursively.
+fn wgsl_files(dir: &Path, out: &mut Vec<std::path::PathBuf>) {
+    for e in std::fs::read_dir(dir).unwrap_or_else(|e| panic!("{}: {e}", dir.display())) {
+        let p = e.expect("directory entry").path();
+        if p.is_dir() {
+            wgsl_files(&p, out);
+        } else if p.extension().is_some_and(|e| e == "wgsl") {
+            out.push(p);
+        }
+    }
+}
+
 #[test]
 fn all_shaders_validate() {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("shaders");
-    let mut files: Vec<_> = std::fs::read_dir(&dir)
-        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
-        .map(|e| e.expect("directory entry").path())
-        .filter(|p| p.extension().is_some_and(|e| e == "wgsl"))
-        .collect();
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let mut files = Vec::new();
+    wgsl_files(&dir, &mut files);
     files.sort();
     for name in ["field.wgsl", "maps.wgsl", "render.wgsl", "texture.wgsl"] {
         assert!(
             files.iter().any(|p| p.ends_with(name)),
-            "shaders/{name} not found in {files:?}"
+            "{name} not found under src/: {files:?}"
         );
     }
     let errors: Vec<String> = files.iter().filter_map(|p| validate(p).err()).collect();

@@ -11,7 +11,7 @@ use crate::gpu::{gpu, GpuContext};
 use std::sync::{Arc, OnceLock};
 
 /// The WGSL source of the flow kernels.
-pub const FIELD_WGSL: &str = include_str!("../../shaders/field.wgsl");
+pub const FIELD_WGSL: &str = include_str!("field.wgsl");
 
 /// Grids of at most this many samples use `rows_per_twist` (one thread per
 /// twist) for batches; larger ones use `flow_tiles` (one workgroup per tile).

@@ -12,10 +12,10 @@ use crate::gpu::{compute, GpuContext};
 use std::sync::OnceLock;
 
 /// WGSL source of the kernel.
-pub const SHADER: &str = include_str!("../../shaders/render.wgsl");
+pub const SHADER: &str = include_str!("render.wgsl");
 
 /// WGSL source of the `analytic` kernel for image textures (same bindings).
-pub const TEXTURE_SHADER: &str = include_str!("../../shaders/texture.wgsl");
+pub const TEXTURE_SHADER: &str = include_str!("texture.wgsl");
 
 /// Upper bound of pixel-samples in one dispatch.
 pub const SAMPLES_PER_DISPATCH: u64 = 1 << 25;

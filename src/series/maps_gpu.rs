@@ -16,7 +16,7 @@ use std::sync::atomic::AtomicBool;
 use std::sync::OnceLock;
 
 /// The WGSL source of the maps kernel.
-pub const MAPS_WGSL: &str = include_str!("../../shaders/maps.wgsl");
+pub const MAPS_WGSL: &str = include_str!("maps.wgsl");
 
 struct Kernel {
     bgl: wgpu::BindGroupLayout,
