@@ -52,7 +52,15 @@ fn table_lenses() -> Vec<(String, Camera)> {
         Distortion::OpencvStandard { k },
     ]
     .into_iter()
-    .map(|d| (d.name().to_string(), Camera { distortion: d, ..base }))
+    .map(|d| {
+        (
+            d.name().to_string(),
+            Camera {
+                distortion: d,
+                ..base
+            },
+        )
+    })
     .collect();
     let p = Camera::load(&profile()).unwrap();
     out.push(("p02 superview".into(), p.scaled_to(160, 90)));
@@ -133,12 +141,21 @@ fn table_mode_matches_f64_and_kernel_matches_twin() {
                 .unwrap();
             assert!(cpu.mean_path_px().1 > 0.5, "{name}: a blur to measure");
             let (t, fl) = worst(&twin, &cpu);
-            assert!(t < 2e-4 && fl < 1e-5, "{name}: twin vs f64 {t:.2e} {fl:.2e}");
+            assert!(
+                t < 2e-4 && fl < 1e-5,
+                "{name}: twin vs f64 {t:.2e} {fl:.2e}"
+            );
             (wt, wf) = (wt.max(t), wf.max(fl));
             if let Some(r) = runner.as_mut() {
-                let gpu = r.frame_maps(&job(&log, &o, &rays, &frame)).unwrap().unwrap();
+                let gpu = r
+                    .frame_maps(&job(&log, &o, &rays, &frame))
+                    .unwrap()
+                    .unwrap();
                 let (t, fl) = worst(&gpu, &twin);
-                assert!(t < 2e-5 && fl < 1e-6, "{name}: kernel vs twin {t:.2e} {fl:.2e}");
+                assert!(
+                    t < 2e-5 && fl < 1e-6,
+                    "{name}: kernel vs twin {t:.2e} {fl:.2e}"
+                );
                 (gt, gf) = (gt.max(t), gf.max(fl));
             }
         }

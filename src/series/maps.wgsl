@@ -60,7 +60,9 @@ struct Step {
 // host (src/series/maps_table.rs, f64): per node its distorted point and
 // its derivatives, d/dx and d/dy times the spacing and d2/dxdy times its
 // square. The kernel interpolates bicubically (Hermite), continuing the
-// border cells' cubics beyond the grid. Must match `NodeGpu` (32 bytes).
+// border cells' cubics beyond the grid. The Jacobian at each pixel's ray
+// (for its flow) is the host's too (`ray_jac`, as the field kernel's lens
+// table). Must match `NodeGpu` (32 bytes).
 struct Node {
     d: vec2<f32>,
     dx: vec2<f32>,
@@ -74,6 +76,7 @@ struct Node {
 @group(0) @binding(3) var<storage, read> steps: array<Step>;       // steps + 1 per line
 @group(0) @binding(4) var<storage, read_write> out: array<f32>;    // 5 planes of width * height
 @group(0) @binding(5) var<storage, read> nodes: array<Node>;       // lens table (one dummy node otherwise)
+@group(0) @binding(6) var<storage, read> ray_jac: array<vec4<f32>>; // table mode: per pixel the Jacobian's rows at its ray (one dummy otherwise)
 
 const WG: u32 = 64u;
 
@@ -85,12 +88,6 @@ fn hermite(s: f32) -> vec4<f32> {
     let s2 = s * s;
     let s3 = s2 * s;
     return vec4<f32>(2.0 * s3 - 3.0 * s2 + 1.0, s3 - 2.0 * s2 + s, 3.0 * s2 - 2.0 * s3, s3 - s2);
-}
-
-// Its derivative in s.
-fn hermite_d(s: f32) -> vec4<f32> {
-    let s2 = s * s;
-    return vec4<f32>(6.0 * s2 - 6.0 * s, 3.0 * s2 - 4.0 * s + 1.0, 6.0 * s - 6.0 * s2, 3.0 * s2 - 2.0 * s);
 }
 
 // The table cell of q: its first node's column and row in xy (clamped to
@@ -140,14 +137,6 @@ fn table_sum(c: vec4<f32>, ws: vec4<f32>, wt: vec4<f32>) -> vec2<f32> {
 fn table_distort(c: vec4<f32>, e: vec2<f32>) -> vec2<f32> {
     let m = table_move(c, e);
     return (nodes[table_node(m)].d - nodes[table_node(c)].d) + table_sum(m, hermite(m.z), hermite(m.w));
-}
-
-// Table mode: rows of the distortion's Jacobian at the ray of cell place c
-// (the interpolant's derivatives).
-fn table_jacobian(c: vec4<f32>) -> array<vec2<f32>, 2> {
-    let gx = table_sum(c, hermite_d(c.z), hermite(c.w)) * params.table.z;
-    let gy = table_sum(c, hermite(c.z), hermite_d(c.w)) * params.table.z;
-    return array<vec2<f32>, 2>(vec2<f32>(gx.x, gy.x), vec2<f32>(gx.y, gy.y));
 }
 
 // The flow (mm/s, undistorted sensor) of line l at sensor point (u, v) mm.
@@ -246,7 +235,8 @@ fn maps(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) l
     if (params.lens.model != 0u) {
         var jm: array<vec2<f32>, 2>;
         if (params.lens.model == 3u) {
-            jm = table_jacobian(c);
+            let g = ray_jac[pix];
+            jm = array<vec2<f32>, 2>(g.xy, g.zw);
         } else {
             jm = jacobian(params.lens, r.xy);
         }

@@ -35,6 +35,7 @@ fn build(ctx: &GpuContext) -> Result<Kernel> {
         storage_entry(3, true),
         storage_entry(4, false),
         storage_entry(5, true),
+        storage_entry(6, true),
     ];
     let p = compute::build(ctx, "maps.wgsl", MAPS_WGSL, Some(&layout), &["maps"])?;
     let pipeline = p
@@ -60,6 +61,7 @@ pub struct MapsRunner {
     rays: Option<Buf>,
     table: Option<mk::MapsTable>,
     nodes: Option<Buf>,
+    ray_jac: Option<Buf>,
     lines: Option<Buf>,
     steps: Option<Buf>,
     out: Option<Buf>,
@@ -85,6 +87,7 @@ impl MapsRunner {
             rays: None,
             table: None,
             nodes: None,
+            ray_jac: None,
             lines: None,
             steps: None,
             out: None,
@@ -156,6 +159,17 @@ impl MapsRunner {
                 "maps lens table",
             )?;
             ctx.queue.write_buffer(buf, 0, bytes);
+            let dummy = [[0.0f32; 4]];
+            let jac = self.table.as_ref().map_or(&dummy[..], |t| &t.jac[..]);
+            let bytes: &[u8] = bytemuck::cast_slice(jac);
+            let buf = ensure(
+                ctx,
+                &mut self.ray_jac,
+                bytes.len() as u64,
+                STORAGE_DST,
+                "maps ray Jacobians",
+            )?;
+            ctx.queue.write_buffer(buf, 0, bytes);
             self.rays_of = Some(*job.rays.camera());
         }
         let out_bytes = n * 4 * PLANES as u64;
@@ -204,18 +218,24 @@ impl MapsRunner {
             STORAGE_DST,
             "maps steps",
         )?;
-        let (rays, lbuf, sbuf, out, nodes) =
-            match (&self.rays, &self.lines, &self.steps, &self.out, &self.nodes) {
-                (Some(a), Some(b), Some(c), Some(d), Some(e)) => {
-                    (&a.buf, &b.buf, &c.buf, &d.buf, &e.buf)
-                }
-                _ => return Err(Error::Gpu("maps buffers missing".into())),
-            };
+        let (rays, lbuf, sbuf, out, nodes, jac) = match (
+            &self.rays,
+            &self.lines,
+            &self.steps,
+            &self.out,
+            &self.nodes,
+            &self.ray_jac,
+        ) {
+            (Some(a), Some(b), Some(c), Some(d), Some(e), Some(f)) => {
+                (&a.buf, &b.buf, &c.buf, &d.buf, &e.buf, &f.buf)
+            }
+            _ => return Err(Error::Gpu("maps buffers missing".into())),
+        };
         ctx.queue
             .write_buffer(&self.params, 0, bytemuck::bytes_of(p));
         ctx.queue.write_buffer(lbuf, 0, lb);
         ctx.queue.write_buffer(sbuf, 0, sb);
-        let entries: Vec<wgpu::BindGroupEntry> = [&self.params, rays, lbuf, sbuf, out, nodes]
+        let entries: Vec<wgpu::BindGroupEntry> = [&self.params, rays, lbuf, sbuf, out, nodes, jac]
             .iter()
             .enumerate()
             .map(|(k, b)| wgpu::BindGroupEntry {

@@ -386,7 +386,10 @@ fn thread(
     let (mut fu, mut fv) = line_flow(l, p.f_mm * r[0], p.f_mm * r[1]);
     if p.lens.model != MODEL_NONE {
         let jm = match lp {
-            ThreadLens::Table(t, c) => t.jacobian(c),
+            ThreadLens::Table(t, _) => {
+                let g = t.jac[pix];
+                [[g[0], g[1]], [g[2], g[3]]]
+            }
             ThreadLens::Module(m) => lens::jacobian(m, r[0], r[1]),
         };
         (fu, fv) = (jm[0][0] * fu + jm[0][1] * fv, jm[1][0] * fu + jm[1][1] * fv);
