@@ -204,7 +204,17 @@ fn cli_gyroflow_profile_gpu_matches_cpu() {
             |ch: &[(String, Vec<f32>)], n: &str| ch.iter().find(|c| c.0 == n).unwrap().1.clone();
         let path = get(&b, "path_px");
         let (fu, fv) = (get(&b, "flow.u"), get(&b, "flow.v"));
-        mean = mean.max(path.iter().map(|&p| p as f64).sum::<f64>() / path.len() as f64);
+        let valid: Vec<f64> = path
+            .iter()
+            .filter(|p| p.is_finite())
+            .map(|&p| p as f64)
+            .collect();
+        assert!(
+            valid.len() > path.len() / 2,
+            "{name}: {} pixels with maps",
+            valid.len()
+        );
+        mean = mean.max(valid.iter().sum::<f64>() / valid.len() as f64);
         for n in ["disp.u", "disp.v", "path_px", "flow.u", "flow.v"] {
             let (x, y) = (get(&a, n), get(&b, n));
             for i in 0..y.len() {

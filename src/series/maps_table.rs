@@ -80,7 +80,7 @@ impl MapsTable {
                 hi = [hi[0].max(x), hi[1].max(y)];
             }
         }
-        if !(lo[0] <= hi[0] && lo[1] <= hi[1]) {
+        if lo[0] > hi[0] || lo[1] > hi[1] {
             return Err(Error::invalid(
                 "distortion",
                 "no pixel of the camera has a ray: no lens table for the maps kernel",
