@@ -133,3 +133,40 @@ fn validator_rejects_a_broken_shader() {
     std::fs::write(&p, "fn f() -> f32 { return 1u; }").unwrap();
     assert!(validate(&p).is_err());
 }
+
+/// The size of WGSL struct `name` in `src` (naga's layout).
+fn struct_size(src: &str, name: &str) -> usize {
+    let m = naga::front::wgsl::parse_str(src).expect("parses");
+    let mut layouter = naga::proc::Layouter::default();
+    layouter.update(m.to_ctx()).expect("layout");
+    let (h, _) = m
+        .types
+        .iter()
+        .find(|(_, t)| t.name.as_deref() == Some(name))
+        .unwrap_or_else(|| panic!("no struct {name}"));
+    layouter[h].size as usize
+}
+
+/// One host lens struct: every kernel that evaluates the lens holds the
+/// lens module's `Lens` in its `Params`, and the WGSL sizes are the host's.
+#[test]
+fn host_structs_match_the_joined_shaders() {
+    use mmbm::gpu::lens::{LensGpu, LENS_WGSL};
+    use std::mem::size_of;
+    let lens = size_of::<LensGpu>();
+    assert_eq!(struct_size(LENS_WGSL, "Lens"), lens);
+    for (src, params) in [
+        (
+            mmbm::field::FIELD_WGSL,
+            size_of::<mmbm::field::FlowParams>(),
+        ),
+        (
+            mmbm::series::maps_gpu::MAPS_WGSL,
+            size_of::<mmbm::series::maps_kernel::MapsParams>(),
+        ),
+    ] {
+        assert_eq!(struct_size(src, "Lens"), lens);
+        assert_eq!(struct_size(src, "Params"), params);
+        assert!(src.contains("    lens: Lens,"), "Params holds the Lens");
+    }
+}
