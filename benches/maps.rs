@@ -3,7 +3,7 @@
 //! what `mmbm frames --maps` computes before writing each EXR), pinhole and
 //! through a wide-angle lens, on one thread and on all cores, and the
 //! throughput for a minute of 60 fps video; then the GPU path
-//! (`series::maps_gpu`, `shaders/maps.wgsl`) where an adapter exists, with
+//! (`series::maps_gpu`, `src/series/maps.wgsl`) where an adapter exists, with
 //! its largest difference per pixel from its CPU twin and from the f64
 //! maps at full size. The motion is the shared
 //! running log's (`../shared/data/running_phone`, its blurriest frames) when

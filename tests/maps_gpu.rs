@@ -1,8 +1,8 @@
-//! The GPU path of `frames --maps` (`shaders/maps.wgsl`): its CPU twin
+//! The GPU path of `frames --maps` (`src/series/maps.wgsl`): its CPU twin
 //! against the f64 maps (`series::maps::frame_maps`) on both shared logs and
 //! a synthetic log with translation, the kernel against the twin per pixel
-//! (lavapipe or any adapter), the lens models it refuses, and the CLI's
-//! `--backend`.
+//! (lavapipe or any adapter), every lens model taken (table mode:
+//! `tests/maps_gpu_lens.rs`), and the CLI's `--backend`.
 //!
 //! Tolerances: twin vs f64, |difference| <= 2e-4 x (1 + path px) for the
 //! displacement and path and 1e-5 x (1 + |flow|) for the flow (px/s): a
@@ -263,10 +263,11 @@ fn gpu_matches_twin_per_pixel() {
     eprintln!("GPU vs twin: track {wt:.2e} x (1 + path), flow {wf:.2e} x (1 + |flow|)");
 }
 
-/// Lens models the kernel lacks: an error naming the model for `gpu`, the
-/// CPU path for `auto` and `cpu`.
+/// Every lens model has a path in the kernel (the lens module's formulas or
+/// the lens table): `gpu` and `auto` take a Gyroflow model too (it was refused
+/// by name), `cpu` stays on the CPU.
 #[test]
-fn unsupported_lens_is_refused_or_falls_back() {
+fn every_lens_model_is_taken() {
     let cam = Camera {
         distortion: Distortion::Poly3 { k1: 0.01 },
         ..Camera::thesis().scaled_to(64, 48)
@@ -277,28 +278,23 @@ fn unsupported_lens_is_refused_or_falls_back() {
     if common::gpu().is_none() {
         return;
     }
-    let e = resolve(Backend::Gpu, &cam)
-        .err()
-        .expect("refused")
-        .to_string();
-    assert!(e.contains("poly3"), "{e}");
-    assert!(resolve(Backend::Auto, &cam).unwrap().is_none());
+    assert!(resolve(Backend::Gpu, &cam).unwrap().is_some());
+    assert!(resolve(Backend::Auto, &cam).unwrap().is_some());
     assert!(resolve(Backend::Gpu, &Camera::thesis()).unwrap().is_some());
-    // The runner itself refuses it too, before any work.
     let (log, f, _, _) = synthetic();
     let o = opts(cam, None, false);
     let rays = MapRays::new(&cam).unwrap();
-    let e = MapsRunner::new()
+    let m = MapsRunner::new()
         .unwrap()
         .frame_maps(&job(&log, &o, &rays, 0, &f))
-        .unwrap_err()
-        .to_string();
-    assert!(e.contains("poly3"), "{e}");
+        .unwrap()
+        .expect("maps");
+    assert!(m.mean_path_px().1 > 0.5);
 }
 
 /// `frames --maps --backend gpu` writes the kernel's maps, within the twin
-/// tolerance of `--backend cpu`'s (f64), and names the adapter; a lens
-/// model the kernel lacks is an error with `gpu` and the CPU with `auto`.
+/// tolerance of `--backend cpu`'s (f64), and names the adapter; a Gyroflow
+/// lens model (table mode) is computed on the GPU too, with `gpu` and `auto`.
 #[test]
 fn cli_frames_maps_backend() {
     let Some(gyro) = common::shared_log("running_phone") else {
@@ -347,8 +343,8 @@ fn cli_frames_maps_backend() {
             }
         }
     }
-    // A lens model the kernel lacks: `--backend gpu` is an error naming
-    // it, `--backend auto` computes on the CPU and says why.
+    // A Gyroflow lens model (poly3: table mode) is computed on the GPU with
+    // `--backend gpu` and `--backend auto` alike (it was refused by name).
     std::fs::write(&table, "t_start,exposure_s\n5.258,0.0013\n").unwrap();
     let cam = tmp.path().join("poly3.toml");
     std::fs::write(
@@ -358,17 +354,14 @@ fn cli_frames_maps_backend() {
     )
     .unwrap();
     let f = tmp.path().join("f.csv");
-    let gpu = tmp.path().join("poly3_gpu");
-    let out = frames_maps(&gyro, &table, &cam, &gpu, &f, &["--backend", "gpu"]);
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(!out.status.success() && err.contains("poly3"), "{err}");
-    assert!(!gpu.join("frame_000001.exr").exists());
-    let auto = tmp.path().join("poly3_auto");
-    let out = frames_maps(&gyro, &table, &cam, &auto, &f, &["--backend", "auto"]);
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "{err}");
-    assert!(err.contains("poly3") && err.contains("on the CPU"), "{err}");
-    assert!(auto.join("frame_000001.exr").exists());
+    for backend in ["gpu", "auto"] {
+        let dir = tmp.path().join(format!("poly3_{backend}"));
+        let out = frames_maps(&gyro, &table, &cam, &dir, &f, &["--backend", backend]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "{backend}: {err}");
+        assert!(!err.contains("on the CPU"), "{backend}: {err}");
+        assert!(dir.join("frame_000001.exr").exists());
+    }
 }
 
 /// A `--backend` that is none of the four is refused by name, before any file is read.

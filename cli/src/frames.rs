@@ -84,8 +84,8 @@ pub struct FramesArgs {
     #[arg(long, value_name = "LIST", requires = "maps")]
     pub maps_channels: Option<String>,
     /// Where --maps computes: cpu (f64, all cores), gpu (the maps kernel, or an error), auto
-    /// (GPU if any adapter, else CPU) or bulk (a hardware GPU, else CPU). Lens models the
-    /// kernel lacks run on the CPU (auto, bulk) or are an error (gpu).
+    /// (GPU if any adapter, else CPU) or bulk (a hardware GPU, else CPU). The kernel takes
+    /// every lens model (OpenCV and fisheye by formula, the others through a lens table).
     #[arg(long, default_value = "bulk")]
     pub backend: mmbm::gpu::Backend,
     /// Include the log's vx,vy,vz (needs a depth column, --depth or --plane).

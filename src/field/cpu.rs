@@ -1,4 +1,4 @@
-//! CPU twins of `shaders/field.wgsl`: the same f32 formula and summation
+//! CPU twins of `field.wgsl` (the lens module's are in [`crate::gpu::lens`]): the same f32 formula and summation
 //! order as the kernels (single-threaded and rayon), plus an f64 reference
 //! built from the library's own [`crate::model::flow::flow_distorted`] and [`Camera`] maps.
 
@@ -6,6 +6,7 @@ use super::kernel::{FlowParams, Grid, TwistGpu, CHUNK, TILE, WG};
 use super::table::{valid_len, LensSample, LensTable};
 use crate::camera::Camera;
 use crate::error::Result;
+use crate::gpu::lens::{MODEL_NONE, MODEL_TABLE};
 use crate::model::flow::flow_distorted;
 use crate::model::motion::{Plane, Twist};
 use rayon::prelude::*;
@@ -32,127 +33,8 @@ pub fn flow_mm(p: &FlowParams, tw: &TwistGpu, u: f32, v: f32) -> (f32, f32) {
     (du, dv)
 }
 
-/// Newton steps of the shader's `undistort` (`UNDISTORT_STEPS`).
-pub const UNDISTORT_STEPS: u32 = 16;
-
-/// Twin of the shader's `atan_poly`: atan(x) for x >= 0 (Abramowitz & Stegun
-/// 4.4.49, |error| <= 2e-8 on [0, 1]; reflected above 1).
-#[inline(always)]
-#[allow(clippy::excessive_precision)]
-pub fn atan_poly(x: f32) -> f32 {
-    let inv = x > 1.0;
-    let z = if inv { 1.0 / x } else { x };
-    let z2 = z * z;
-    let p = 1.0
-        + z2 * (-0.3333314528
-            + z2 * (0.1999355085
-                + z2 * (-0.1420889944
-                    + z2 * (0.1065626393
-                        + z2 * (-0.0752896400
-                            + z2 * (0.0429096138 + z2 * (-0.0161657367 + z2 * 0.0028662257)))))));
-    let a = z * p;
-    if inv {
-        std::f32::consts::FRAC_PI_2 - a
-    } else {
-        a
-    }
-}
-
-/// Twin of the shader's `fisheye_theta_d`: `theta_d(theta)` and its derivative.
-#[inline(always)]
-fn fisheye_theta_d(p: &FlowParams, th: f32) -> (f32, f32) {
-    let k = p.dist;
-    let t2 = th * th;
-    let poly = 1.0 + t2 * (k[0] + t2 * (k[1] + t2 * (k[2] + t2 * k[3])));
-    let d = 1.0 + t2 * (3.0 * k[0] + t2 * (5.0 * k[1] + t2 * (7.0 * k[2] + t2 * 9.0 * k[3])));
-    (th * poly, d)
-}
-
-/// Twin of the shader's `fisheye_scale`: `s = theta_d / r` and `(ds/dr) / r`.
-#[inline(always)]
-fn fisheye_scale(p: &FlowParams, x: f32, y: f32) -> (f32, f32) {
-    let k = p.dist;
-    let r2 = x * x + y * y;
-    if r2 < 1e-4 {
-        let c = k[0] - 1.0 / 3.0;
-        let e = 0.2 - k[0] + k[1];
-        return (1.0 + r2 * (c + r2 * e), 2.0 * c + 4.0 * e * r2);
-    }
-    let r = r2.sqrt();
-    let (td, dtd) = fisheye_theta_d(p, atan_poly(r));
-    let s = td / r;
-    (s, (dtd / (1.0 + r2) - s) / r2)
-}
-
-/// Twin of the shader's `distort` (normalised coordinates; model 1 or 2).
-#[inline(always)]
-pub fn distort(p: &FlowParams, x: f32, y: f32) -> (f32, f32) {
-    if p.dist_model == 1 {
-        let k = p.dist;
-        let r2 = x * x + y * y;
-        let radial = 1.0 + r2 * (k[0] + r2 * (k[1] + r2 * p.dist_k3));
-        return (
-            x * radial + 2.0 * k[2] * x * y + k[3] * (r2 + 2.0 * x * x),
-            y * radial + k[2] * (r2 + 2.0 * y * y) + 2.0 * k[3] * x * y,
-        );
-    }
-    let s = fisheye_scale(p, x, y).0;
-    (s * x, s * y)
-}
-
-/// Twin of the shader's `jacobian`: rows `(dxd/dx, dxd/dy), (dyd/dx, dyd/dy)`.
-#[inline(always)]
-pub fn jacobian(p: &FlowParams, x: f32, y: f32) -> [[f32; 2]; 2] {
-    if p.dist_model == 1 {
-        let k = p.dist;
-        let r2 = x * x + y * y;
-        let radial = 1.0 + r2 * (k[0] + r2 * (k[1] + r2 * p.dist_k3));
-        let drad = k[0] + r2 * (2.0 * k[1] + r2 * 3.0 * p.dist_k3);
-        let off = 2.0 * x * y * drad + 2.0 * k[2] * x + 2.0 * k[3] * y;
-        return [
-            [
-                radial + 2.0 * x * x * drad + 2.0 * k[2] * y + 6.0 * k[3] * x,
-                off,
-            ],
-            [
-                off,
-                radial + 2.0 * y * y * drad + 6.0 * k[2] * y + 2.0 * k[3] * x,
-            ],
-        ];
-    }
-    let (s, g) = fisheye_scale(p, x, y);
-    let off = g * x * y;
-    [[s + g * x * x, off], [off, s + g * y * y]]
-}
-
-/// Twin of the shader's `undistort`: `UNDISTORT_STEPS` Newton steps.
-#[inline(always)]
-pub fn undistort(p: &FlowParams, xd: f32, yd: f32) -> (f32, f32) {
-    if p.dist_model == 2 {
-        let rd = (xd * xd + yd * yd).sqrt();
-        if rd == 0.0 {
-            return (xd, yd);
-        }
-        // Newton on r: theta_d(atan(r)) = r_d, d/dr = theta_d'(theta) / (1 + r^2).
-        let mut r = rd;
-        for _ in 0..UNDISTORT_STEPS {
-            let (td, dtd) = fisheye_theta_d(p, atan_poly(r));
-            r = (r - (td - rd) * (1.0 + r * r) / dtd).max(0.0);
-        }
-        let s = r / rd;
-        return (xd * s, yd * s);
-    }
-    let (mut x, mut y) = (xd, yd);
-    for _ in 0..UNDISTORT_STEPS {
-        let (fx, fy) = distort(p, x, y);
-        let (ex, ey) = (fx - xd, fy - yd);
-        let j = jacobian(p, x, y);
-        let det = j[0][0] * j[1][1] - j[0][1] * j[1][0];
-        x -= (j[1][1] * ex - j[0][1] * ey) / det;
-        y -= (-j[1][0] * ex + j[0][0] * ey) / det;
-    }
-    (x, y)
-}
+/// The lens functions' twins are the lens module's ([`crate::gpu::lens`]).
+pub use crate::gpu::lens::{atan_poly, distort, jacobian, undistort, UNDISTORT_STEPS};
 
 /// Twin of the shader's `sample_flow`: the flow (mm/s on the distorted
 /// sensor) at the centre of grid cell `(i, j)`; in table mode (model 3) the
@@ -166,19 +48,19 @@ pub fn sample_flow(
     i: u32,
     j: u32,
 ) -> (f32, f32) {
-    if p.dist_model == 3 {
+    if p.lens.model == MODEL_TABLE {
         let s = &lens[(j * p.grid_w + i) as usize];
         let (a, b) = flow_mm(p, tw, s.q[0] * p.f_mm, s.q[1] * p.f_mm);
         return (s.j0[0] * a + s.j0[1] * b, s.j1[0] * a + s.j1[1] * b);
     }
     let (u, v) = sensor_point(p, i, j);
-    if p.dist_model == 0 {
+    if p.lens.model == MODEL_NONE {
         return flow_mm(p, tw, u, v);
     }
     let f = p.f_mm;
-    let (x, y) = undistort(p, u / f, v / f);
+    let (x, y) = undistort(&p.lens, u / f, v / f);
     let (a, b) = flow_mm(p, tw, x * f, y * f);
-    let jm = jacobian(p, x, y);
+    let jm = jacobian(&p.lens, x, y);
     (jm[0][0] * a + jm[0][1] * b, jm[1][0] * a + jm[1][1] * b)
 }
 

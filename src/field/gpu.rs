@@ -1,4 +1,4 @@
-//! The compiled `shaders/field.wgsl` kernels and a runner that owns reusable
+//! The compiled flow kernels (`src/gpu/lens.wgsl` joined with `field.wgsl`) and a runner that owns reusable
 //! buffers and dispatches them. CPU twins: [`super::cpu`].
 
 use super::kernel::{FlowParams, Grid, TwistGpu, MAX_DISPATCH, WG};
@@ -10,8 +10,9 @@ use crate::gpu::compute::{
 use crate::gpu::{gpu, GpuContext};
 use std::sync::{Arc, OnceLock};
 
-/// The WGSL source of the flow kernels.
-pub const FIELD_WGSL: &str = include_str!("../../shaders/field.wgsl");
+/// The WGSL source of the flow kernels: the shared lens module
+/// ([`crate::gpu::lens::LENS_WGSL`]) joined with `field.wgsl`.
+pub const FIELD_WGSL: &str = concat!(include_str!("../gpu/lens.wgsl"), include_str!("field.wgsl"));
 
 /// Grids of at most this many samples use `rows_per_twist` (one thread per
 /// twist) for batches; larger ones use `flow_tiles` (one workgroup per tile).
@@ -46,7 +47,7 @@ fn build(ctx: &GpuContext) -> Result<Kernels> {
             tiles,
             rows,
         }),
-        _ => Err(Error::Gpu("shaders/field.wgsl: pipelines missing".into())),
+        _ => Err(Error::Gpu("field.wgsl: pipelines missing".into())),
     }
 }
 

@@ -1,9 +1,10 @@
-//! Host-side structs shared with `shaders/field.wgsl` (`Params`, `Twist`;
+//! Host-side structs shared with `field.wgsl` (`Params`, `Twist`;
 //! `LensSample` is in [`super::table`]), with layout asserts, and the sample
 //! grid they describe.
 
 use crate::camera::Camera;
 use crate::error::{Error, Result};
+use crate::gpu::lens::LensGpu;
 use crate::model::motion::{Plane, Twist};
 use bytemuck::{Pod, Zeroable};
 
@@ -48,17 +49,12 @@ pub struct FlowParams {
     pub tiles_x: u32,
     /// 1 to write the field (one twist), else 0.
     pub write_field: u32,
-    /// Lens distortion model: 0 none, 1 OpenCV, 2 fisheye, 3 the lens table
-    /// (every other model, and masked cameras: [`super::table`]).
-    pub dist_model: u32,
-    /// Padding (to align `dist`).
-    pub pad0: u32,
-    /// Distortion coefficients: OpenCV `k1, k2, p1, p2`; fisheye `k1..k4`.
-    pub dist: [f32; 4],
-    /// OpenCV `k3`.
-    pub dist_k3: f32,
-    /// Padding to 96 bytes.
-    pub pad: [u32; 3],
+    /// Padding (to align `lens`).
+    pub pad: [u32; 2],
+    /// The lens ([`crate::gpu::lens`]): none, OpenCV or fisheye analytic,
+    /// else the lens table (every other model, and masked cameras:
+    /// [`super::table`]).
+    pub lens: LensGpu,
 }
 
 /// The shader's `Twist`: one camera twist and its scene's inverse depth.
@@ -75,9 +71,8 @@ pub struct TwistGpu {
 }
 
 const _: () = assert!(std::mem::size_of::<FlowParams>() == 96);
-const _: () = assert!(std::mem::offset_of!(FlowParams, dist_model) == 56);
-const _: () = assert!(std::mem::offset_of!(FlowParams, dist) == 64);
-const _: () = assert!(std::mem::offset_of!(FlowParams, dist_k3) == 80);
+const _: () = assert!(std::mem::offset_of!(FlowParams, pad) == 56);
+const _: () = assert!(std::mem::offset_of!(FlowParams, lens) == 64);
 const _: () = assert!(std::mem::offset_of!(FlowParams, step_y) == 28);
 const _: () = assert!(std::mem::offset_of!(FlowParams, grid_w) == 32);
 const _: () = assert!(std::mem::offset_of!(FlowParams, write_field) == 52);
@@ -150,7 +145,7 @@ impl Grid {
         })
     }
 
-    /// True when the kernel reads a lens table (`dist_model` 3,
+    /// True when the kernel reads a lens table (lens model 3,
     /// [`super::table::LensTable`]): for the models without an analytic
     /// path in the kernel, and for every camera with a radial distortion
     /// limit that masks part of the sensor.
@@ -186,9 +181,9 @@ impl Grid {
         let c = &self.camera;
         let (sx, sy) = self.step();
         let tiles = self.tiles();
-        let (model, k) = match c.distortion.coefficients() {
-            Some(m) if !self.table => m,
-            _ => (3, [0.0; 5]),
+        let lens = match c.distortion.coefficients() {
+            Some(m) if !self.table => LensGpu::new(Some(m)),
+            _ => LensGpu::table(),
         };
         FlowParams {
             f_mm: c.focal_mm as f32,
@@ -205,11 +200,8 @@ impl Grid {
             tiles,
             tiles_x: tiles.min(MAX_DISPATCH),
             write_field: write_field as u32,
-            dist_model: model,
-            pad0: 0,
-            dist: [k[0] as f32, k[1] as f32, k[2] as f32, k[3] as f32],
-            dist_k3: k[4] as f32,
-            pad: [0; 3],
+            pad: [0; 2],
+            lens,
         }
     }
 }

@@ -1,4 +1,4 @@
-//! Flow fields (`shaders/field.wgsl`): the per-pixel image-plane flow of docs/spec.md
+//! Flow fields (`field.wgsl`): the per-pixel image-plane flow of docs/spec.md
 //! section 2 at full sensor resolution, its mean speed (MMBM, mm/s), and
 //! batched MMBM for many twists in one dispatch.
 //!
@@ -24,7 +24,7 @@ pub(crate) mod table;
 
 pub use crate::gpu::Backend;
 pub use cpu::FieldMean;
-pub use gpu::FlowRunner;
+pub use gpu::{FlowRunner, FIELD_WGSL};
 pub use kernel::{FlowParams, Grid, TwistGpu};
 pub use table::{LensSample, LensTable};
 

@@ -1,5 +1,5 @@
-//! The lens table of the field kernel's table mode (`dist_model` 3 in
-//! `shaders/field.wgsl`): for every lens model the kernel has no analytic
+//! The lens table of the field kernel's table mode (lens model 3,
+//! [`crate::gpu::lens::MODEL_TABLE`], in `field.wgsl`): for every lens model the kernel has no analytic
 //! formula for (Gyroflow's 12-coefficient `opencv_standard`, `poly3`,
 //! `poly5`, `ptlens`, `insta360`, `sony`, `generic_polynomial`, digital
 //! lenses), and for every camera with a radial distortion limit, the host

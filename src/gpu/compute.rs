@@ -86,13 +86,13 @@ pub fn build(
         })
         .collect();
     if let Some(e) = pollster::block_on(scope.pop()) {
-        return Err(Error::Gpu(format!("building shaders/{file}: {e}")));
+        return Err(Error::Gpu(format!("building {file}: {e}")));
     }
     let bgl = match explicit {
         Some((bgl, _)) => bgl,
         None => pipelines
             .first()
-            .ok_or_else(|| Error::Gpu(format!("shaders/{file}: no entry point asked for")))?
+            .ok_or_else(|| Error::Gpu(format!("{file}: no entry point asked for")))?
             .get_bind_group_layout(0),
     };
     Ok(Pipelines { bgl, pipelines })

@@ -1,11 +1,13 @@
 //! GPU support through wgpu: the process-wide device ([`context`]), the
 //! compute plumbing every kernel shares (`compute`: shader build under an
-//! error scope, buffers, read-back) and the [`Backend`] choice. The kernels
-//! themselves live with their features (`field`, `render`), each beside its
-//! CPU twin.
+//! error scope, buffers, read-back), the kernels' one lens module ([`lens`]:
+//! `lens.wgsl`, its host struct and twins) and the [`Backend`] choice. The
+//! kernels themselves live with their features (`field`, `series`,
+//! `render`), each shader beside its kernel and its CPU twin.
 
 pub(crate) mod compute;
 pub mod context;
+pub mod lens;
 mod runtime_dir;
 
 pub use context::{gpu, GpuContext};

@@ -1,4 +1,4 @@
-//! CPU twin of `shaders/render.wgsl`: the same samples, homography table,
+//! CPU twin of `render.wgsl`: the same samples, homography table,
 //! background box and texture maths in f32, one pixel per task (rayon).
 
 use super::layout::{GpuHomography, RenderParams, KIND_BLOBS, KIND_CHECKER};

@@ -1,5 +1,5 @@
 //! Closed-form pixel area for image textures (the `analytic` integrator on
-//! `image:` targets): CPU twin of `shaders/texture.wgsl` (same names, f32).
+//! `image:` targets): CPU twin of `texture.wgsl` (same names, f32).
 //!
 //! The image is the bilinear interpolant of the linear-light texels of one
 //! mip level (texel centres at integer texel coordinates `x = u w - 1/2`,

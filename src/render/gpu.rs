@@ -1,4 +1,6 @@
-//! GPU path of the renderer: `shaders/render.wgsl` on the shared wgpu device.
+//! GPU path of the renderer: `render.wgsl` and `texture.wgsl`, each joined
+//! with the renderer's prelude (`prelude.wgsl`: Params, the homography
+//! table entry, the bindings, `line_base`), on the shared wgpu device.
 //! Big images and long sample sets are split into dispatches of at most
 //! [`SAMPLES_PER_DISPATCH`] pixel-samples (row tiles, then sample ranges
 //! accumulated in place), each submitted and waited for separately, so that no
@@ -11,11 +13,16 @@ use crate::error::{Error, Result};
 use crate::gpu::{compute, GpuContext};
 use std::sync::OnceLock;
 
-/// WGSL source of the kernel.
-pub const SHADER: &str = include_str!("../../shaders/render.wgsl");
+/// WGSL source of the renderer's prelude alone (valid by itself).
+pub const PRELUDE: &str = include_str!("prelude.wgsl");
 
-/// WGSL source of the `analytic` kernel for image textures (same bindings).
-pub const TEXTURE_SHADER: &str = include_str!("../../shaders/texture.wgsl");
+/// WGSL source of the kernel: the prelude joined with `render.wgsl`.
+pub const SHADER: &str = concat!(include_str!("prelude.wgsl"), include_str!("render.wgsl"));
+
+/// WGSL source of the `analytic` kernel for image textures: the prelude
+/// joined with `texture.wgsl` (same bindings).
+pub const TEXTURE_SHADER: &str =
+    concat!(include_str!("prelude.wgsl"), include_str!("texture.wgsl"));
 
 /// Upper bound of pixel-samples in one dispatch.
 pub const SAMPLES_PER_DISPATCH: u64 = 1 << 25;

@@ -1,5 +1,5 @@
 //! What the render kernel sees: the parameter block shared with
-//! `shaders/render.wgsl` (bytemuck Pod, layout asserted), the per-pixel
+//! `render.wgsl` (bytemuck Pod, layout asserted), the per-pixel
 //! sample set, and the homography table.
 //!
 //! Sample set: per pixel a rank-1 lattice of `N` points in (x, y, t) with

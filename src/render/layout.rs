@@ -1,5 +1,5 @@
 //! The render kernel's memory layout: the parameter block and the
-//! homography-table entry shared with `shaders/render.wgsl` (bytemuck Pod,
+//! homography-table entry shared with `render.wgsl` (bytemuck Pod,
 //! sizes and offsets asserted), and the target kinds' codes.
 
 use bytemuck::{Pod, Zeroable};

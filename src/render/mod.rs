@@ -13,7 +13,7 @@
 //! `exact`); `lattice` (any target; the reference) supersamples area and time
 //! with a rank-1 lattice and a per-pixel shift, at least `quality.min_samples()`.
 //!
-//! The GPU kernel is `shaders/render.wgsl` (`gpu`); its CPU twin (`cpu`) is
+//! The GPU kernel is `render.wgsl` (`gpu`); its CPU twin (`cpu`) is
 //! used when no adapter exists (announced once on stderr). [`maps`] gives the
 //! per-pixel blur ground truth (path length, displacement, speed), `psf` the
 //! point-spread function at a pixel.
@@ -36,6 +36,7 @@ pub mod texture;
 
 pub use crate::gpu::Backend;
 pub use crate::model::trajectory::{Pose, Trajectory};
+pub use gpu::{PRELUDE as PRELUDE_WGSL, SHADER as RENDER_WGSL, TEXTURE_SHADER as TEXTURE_WGSL};
 pub use maps::{blur_maps, BlurMaps, BlurMeans};
 pub use motion::FrameMotion;
 pub use poster::Background;
@@ -176,8 +177,8 @@ pub enum Integrator {
     #[default]
     Auto,
     /// One sample per instant at the pixel centre, the area in closed form:
-    /// the checker's and the blob board's (`shaders/render.wgsl`), an image's
-    /// bilinear interpolant (`shaders/texture.wgsl`).
+    /// the checker's and the blob board's (`render.wgsl`), an image's
+    /// bilinear interpolant (`texture.wgsl`).
     Analytic,
     /// Supersampling of area and time (a rank-1 lattice; any target).
     Lattice,

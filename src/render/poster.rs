@@ -15,7 +15,7 @@
 //! poster's mean over the plane is the plain background's level). Each layer
 //! is a product of two square waves, so the renderer's `analytic` integrator
 //! averages it over a pixel's footprint in closed form, exactly as it does
-//! the checker (the same functions, `shaders/render.wgsl`); at the board's
+//! the checker (the same functions, `render.wgsl`); at the board's
 //! edge the poster's and the board's coverage of a footprint are combined as
 //! independent (approximate only in pixels the board's edge crosses).
 //! Side lengths from 2.3 cm to 37 cm: about 3.5 to 56 px at 6 m with the

@@ -2,7 +2,7 @@
 //! sRGB converted to linear light, and a mip pyramid (2x2 box averages in
 //! linear light) for minification. Sampling is trilinear (bilinear within a
 //! level, linear between levels), clamped to the edge; the same maths runs in
-//! `shaders/render.wgsl`.
+//! `render.wgsl`.
 
 use crate::error::{Error, Result};
 use crate::io::images::{read_rgb8, srgb8_to_linear};

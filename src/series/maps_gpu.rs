@@ -1,22 +1,26 @@
-//! The GPU path of `frames --maps`: the compiled `shaders/maps.wgsl` and a
-//! runner that keeps the camera's rays on the device and dispatches a
+//! The GPU path of `frames --maps`: the compiled `maps.wgsl` (joined with
+//! the lens module, `src/gpu/lens.wgsl`) and a runner that keeps the
+//! camera's rays and lens table on the device and dispatches a
 //! frame's lines. CPU twin: [`super::maps_kernel::frame_maps_twin`]; the
 //! packing and the dispatch loop are shared with it
 //! ([`super::maps_kernel`]).
 
 use super::maps::{FrameMaps, MapsJob};
 use super::maps_kernel::{self as mk, LineGpu, MapsParams, StepGpu, PLANES};
+use super::maps_table::NodeGpu;
 use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::gpu::compute::{
     self, ensure, read_back, storage_entry, uniform_entry, Buf, READ, STORAGE_DST, STORAGE_SRC,
 };
 use crate::gpu::{Backend, GpuContext, Resolved};
+use bytemuck::Zeroable;
 use std::sync::atomic::AtomicBool;
 use std::sync::OnceLock;
 
-/// The WGSL source of the maps kernel.
-pub const MAPS_WGSL: &str = include_str!("../../shaders/maps.wgsl");
+/// The WGSL source of the maps kernel: the shared lens module
+/// ([`crate::gpu::lens::LENS_WGSL`]) joined with `maps.wgsl`.
+pub const MAPS_WGSL: &str = concat!(include_str!("../gpu/lens.wgsl"), include_str!("maps.wgsl"));
 
 struct Kernel {
     bgl: wgpu::BindGroupLayout,
@@ -30,13 +34,15 @@ fn build(ctx: &GpuContext) -> Result<Kernel> {
         storage_entry(2, true),
         storage_entry(3, true),
         storage_entry(4, false),
+        storage_entry(5, true),
+        storage_entry(6, true),
     ];
     let p = compute::build(ctx, "maps.wgsl", MAPS_WGSL, Some(&layout), &["maps"])?;
     let pipeline = p
         .pipelines
         .into_iter()
         .next()
-        .ok_or_else(|| Error::Gpu("shaders/maps.wgsl: pipeline missing".into()))?;
+        .ok_or_else(|| Error::Gpu("maps.wgsl: pipeline missing".into()))?;
     Ok(Kernel {
         bgl: p.bgl,
         pipeline,
@@ -53,6 +59,9 @@ pub struct MapsRunner {
     params: wgpu::Buffer,
     rays_of: Option<Camera>,
     rays: Option<Buf>,
+    table: Option<mk::MapsTable>,
+    nodes: Option<Buf>,
+    ray_jac: Option<Buf>,
     lines: Option<Buf>,
     steps: Option<Buf>,
     out: Option<Buf>,
@@ -76,6 +85,9 @@ impl MapsRunner {
             params,
             rays_of: None,
             rays: None,
+            table: None,
+            nodes: None,
+            ray_jac: None,
             lines: None,
             steps: None,
             out: None,
@@ -95,10 +107,9 @@ impl MapsRunner {
         &self.ctx.description
     }
 
-    /// Checks that the kernel takes `cam`: its lens model
-    /// ([`mk::check_lens`]) and its buffers within the device's limits.
+    /// Checks that the kernel takes `cam`: its buffers within the
+    /// device's limits (every lens model: the lens module's or the table).
     pub fn check(&self, cam: &Camera) -> Result<()> {
-        mk::check_lens(cam)?;
         let n = cam.width as u64 * cam.height as u64;
         let lim = self.ctx.device.limits();
         let most = lim.max_storage_buffer_binding_size.min(lim.max_buffer_size);
@@ -117,7 +128,8 @@ impl MapsRunner {
     }
 
     /// The maps of a frame on the GPU, as [`super::maps::frame_maps`]
-    /// (f32 throughout; the lens must be one [`mk::check_lens`] accepts).
+    /// (f32 throughout; lenses without a formula in the lens module through
+    /// the lens table, [`mk::lens_table`]).
     pub fn frame_maps(&mut self, job: &MapsJob) -> Result<Option<FrameMaps>> {
         let cam = job.opts.scene.camera;
         self.check(&cam)?;
@@ -134,12 +146,41 @@ impl MapsRunner {
                 "maps rays",
             )?;
             ctx.queue.write_buffer(buf, 0, bytes);
+            // The lens table (one dummy node without one).
+            self.table = mk::lens_table(job.rays)?;
+            let dummy = [NodeGpu::zeroed()];
+            let nodes = self.table.as_ref().map_or(&dummy[..], |t| &t.nodes[..]);
+            let bytes: &[u8] = bytemuck::cast_slice(nodes);
+            let buf = ensure(
+                ctx,
+                &mut self.nodes,
+                bytes.len() as u64,
+                STORAGE_DST,
+                "maps lens table",
+            )?;
+            ctx.queue.write_buffer(buf, 0, bytes);
+            let dummy = [[0.0f32; 4]];
+            let jac = self.table.as_ref().map_or(&dummy[..], |t| &t.jac[..]);
+            let bytes: &[u8] = bytemuck::cast_slice(jac);
+            let buf = ensure(
+                ctx,
+                &mut self.ray_jac,
+                bytes.len() as u64,
+                STORAGE_DST,
+                "maps ray Jacobians",
+            )?;
+            ctx.queue.write_buffer(buf, 0, bytes);
             self.rays_of = Some(*job.rays.camera());
         }
         let out_bytes = n * 4 * PLANES as u64;
         ensure(ctx, &mut self.out, out_bytes, STORAGE_SRC, "maps output")?;
         ensure(ctx, &mut self.read, out_bytes, READ, "maps readback")?;
-        let Some(plan) = mk::drive(job, self.step_bytes, |p, l, s| self.dispatch(p, l, s))? else {
+        let table = self.table.take();
+        let plan = mk::drive(job, table.as_ref(), self.step_bytes, |p, l, s| {
+            self.dispatch(p, l, s)
+        });
+        self.table = table;
+        let Some(plan) = plan? else {
             return Ok(None);
         };
         let (out, read) = match (&self.out, &self.read) {
@@ -177,15 +218,24 @@ impl MapsRunner {
             STORAGE_DST,
             "maps steps",
         )?;
-        let (rays, lbuf, sbuf, out) = match (&self.rays, &self.lines, &self.steps, &self.out) {
-            (Some(a), Some(b), Some(c), Some(d)) => (&a.buf, &b.buf, &c.buf, &d.buf),
+        let (rays, lbuf, sbuf, out, nodes, jac) = match (
+            &self.rays,
+            &self.lines,
+            &self.steps,
+            &self.out,
+            &self.nodes,
+            &self.ray_jac,
+        ) {
+            (Some(a), Some(b), Some(c), Some(d), Some(e), Some(f)) => {
+                (&a.buf, &b.buf, &c.buf, &d.buf, &e.buf, &f.buf)
+            }
             _ => return Err(Error::Gpu("maps buffers missing".into())),
         };
         ctx.queue
             .write_buffer(&self.params, 0, bytemuck::bytes_of(p));
         ctx.queue.write_buffer(lbuf, 0, lb);
         ctx.queue.write_buffer(sbuf, 0, sb);
-        let entries: Vec<wgpu::BindGroupEntry> = [&self.params, rays, lbuf, sbuf, out]
+        let entries: Vec<wgpu::BindGroupEntry> = [&self.params, rays, lbuf, sbuf, out, nodes, jac]
             .iter()
             .enumerate()
             .map(|(k, b)| wgpu::BindGroupEntry {

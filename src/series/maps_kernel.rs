@@ -1,17 +1,18 @@
-//! Host side of `shaders/maps.wgsl` (the GPU path of `frames --maps`): the
+//! Host side of `maps.wgsl` (the GPU path of `frames --maps`): the
 //! structs shared with WGSL (with layout asserts), their packing from a
 //! frame's [`Plan`], the dispatch loop both backends share, and the CPU twin
 //! of the kernel: the same f32 operations, function by function (the lens
-//! functions are `field.wgsl`'s, twinned in [`crate::field::cpu`]).
+//! module's are twinned in [`crate::gpu::lens`], the lens table's in
+//! [`super::maps_table`]).
 //!
 //! The f64 reference is [`super::maps::frame_maps`]; the twin and the kernel
 //! agree with it to f32 rounding of the track (see `tests/maps_gpu.rs`).
 
 use super::maps::{plan, FrameMaps, MapRays, MapsJob, Plan};
 use super::maps_line::LineMotion;
-use crate::camera::Camera;
+pub use super::maps_table::MapsTable;
 use crate::error::{Error, Result};
-use crate::field::FlowParams;
+use crate::gpu::lens::{self, LensGpu, MODEL_NONE, MODEL_TABLE};
 use bytemuck::{Pod, Zeroable};
 use rayon::prelude::*;
 
@@ -59,16 +60,15 @@ pub struct MapsParams {
     pub pitch_y: f32,
     /// Skew (px) over the focal length (mm).
     pub skew_over_f: f32,
-    /// Lens distortion: 0 none, 1 OpenCV, 2 fisheye.
-    pub dist_model: u32,
-    /// OpenCV `k1, k2, p1, p2`; fisheye `k1..k4`.
-    pub dist: [f32; 4],
-    /// OpenCV `k3`.
-    pub dist_k3: f32,
     /// Workgroups along x.
     pub groups_x: u32,
-    /// Padding to 96 bytes.
-    pub pad: [u32; 2],
+    /// The lens ([`crate::gpu::lens`]): none, OpenCV or fisheye analytic,
+    /// else the lens table ([`MapsTable`]).
+    pub lens: LensGpu,
+    /// The lens table's [`MapsTable::geometry`] (zeros without one).
+    pub table: [f32; 4],
+    /// The lens table's [`MapsTable::n`] (zeros without one).
+    pub table_n: [u32; 4],
 }
 
 /// The shader's `Line`: the start flow polynomial and the scene plane.
@@ -91,36 +91,44 @@ pub struct StepGpu {
     pub b: [f32; 4],
 }
 
-const _: () = assert!(std::mem::size_of::<MapsParams>() == 96);
+const _: () = assert!(std::mem::size_of::<MapsParams>() == 128);
 const _: () = assert!(std::mem::offset_of!(MapsParams, f_mm) == 32);
-const _: () = assert!(std::mem::offset_of!(MapsParams, dist_model) == 60);
-const _: () = assert!(std::mem::offset_of!(MapsParams, dist) == 64);
-const _: () = assert!(std::mem::offset_of!(MapsParams, dist_k3) == 80);
-const _: () = assert!(std::mem::offset_of!(MapsParams, groups_x) == 84);
+const _: () = assert!(std::mem::offset_of!(MapsParams, groups_x) == 60);
+const _: () = assert!(std::mem::offset_of!(MapsParams, lens) == 64);
+const _: () = assert!(std::mem::offset_of!(MapsParams, table) == 96);
+const _: () = assert!(std::mem::offset_of!(MapsParams, table_n) == 112);
 const _: () = assert!(std::mem::size_of::<LineGpu>() == 64);
 const _: () = assert!(std::mem::offset_of!(LineGpu, plane) == 48);
 const _: () = assert!(std::mem::size_of::<StepGpu>() == 32);
 const _: () = assert!(std::mem::offset_of!(StepGpu, b) == 16);
 
-/// Checks that the kernel has `cam`'s lens: none, OpenCV (k1, k2, p1, p2,
-/// k3) or OpenCV fisheye; other models are an error naming the model.
-pub fn check_lens(cam: &Camera) -> Result<(u32, [f64; 5])> {
-    cam.distortion.coefficients().ok_or_else(|| {
-        Error::invalid(
-            "distortion",
-            format!(
-                "the {} model is not in the GPU maps kernel (it has none, opencv with k1, k2, \
-                 p1, p2, k3 and opencv_fisheye): use --backend cpu",
-                cam.distortion.name()
-            ),
-        )
-    })
+/// The lens table of `rays`' camera when the kernel needs one (a model
+/// without a formula in the lens module: [`MODEL_TABLE`]), else `None`.
+pub fn lens_table(rays: &MapRays) -> Result<Option<MapsTable>> {
+    match rays.camera().distortion.coefficients() {
+        Some(_) => Ok(None),
+        None => MapsTable::new(rays).map(Some),
+    }
 }
 
-/// The parameters of `plan`'s frame (lines 0..0 of the dispatch).
-fn params(plan: &Plan) -> Result<MapsParams> {
+/// The parameters of `plan`'s frame (lines 0..0 of the dispatch), with
+/// `table`'s geometry in table mode.
+fn params(plan: &Plan, table: Option<&MapsTable>) -> Result<MapsParams> {
     let c = &plan.cam;
-    let (model, k) = check_lens(c)?;
+    let lens = LensGpu::new(c.distortion.coefficients());
+    let (table, table_n) = match (lens.model, table) {
+        (MODEL_TABLE, Some(t)) => (t.geometry, t.n),
+        (MODEL_TABLE, None) => {
+            return Err(Error::invalid(
+                "distortion",
+                format!(
+                    "the {} model needs the maps kernel's lens table",
+                    c.distortion.name()
+                ),
+            ))
+        }
+        _ => ([0.0; 4], [0; 4]),
+    };
     let steps = u32::try_from(plan.steps)
         .map_err(|_| Error::invalid("maps", format!("{} steps per line", plan.steps)))?;
     Ok(MapsParams {
@@ -139,11 +147,10 @@ fn params(plan: &Plan) -> Result<MapsParams> {
         pitch_x: c.pitch_x_mm as f32,
         pitch_y: c.pitch_y_mm as f32,
         skew_over_f: (c.skew / c.focal_mm) as f32,
-        dist_model: model,
-        dist: [k[0] as f32, k[1] as f32, k[2] as f32, k[3] as f32],
-        dist_k3: k[4] as f32,
         groups_x: 0,
-        pad: [0; 2],
+        lens,
+        table,
+        table_n,
     })
 }
 
@@ -187,11 +194,13 @@ fn pack_line(m: &LineMotion, steps: &mut [StepGpu]) -> LineGpu {
 
 /// Runs `dispatch(params, lines, steps)` over the job's frame's lines
 /// (split so a dispatch's motion samples stay under `step_bytes`) and
-/// returns the plan; `None` as [`super::maps::frame_maps`].
+/// returns the plan; `None` as [`super::maps::frame_maps`]. `table`: the
+/// camera's [`lens_table`].
 /// `params.groups_x` is for a 1-D grid of `n_lines * line_len` threads in
 /// up to [`MAX_DISPATCH`] columns.
 pub(crate) fn drive(
     job: &MapsJob,
+    table: Option<&MapsTable>,
     step_bytes: usize,
     mut dispatch: impl FnMut(&MapsParams, &[LineGpu], &[StepGpu]) -> Result<()>,
 ) -> Result<Option<Plan>> {
@@ -199,7 +208,7 @@ pub(crate) fn drive(
         return Ok(None);
     };
     let log = job.log;
-    let mut p = params(&plan)?;
+    let mut p = params(&plan, table)?;
     let (n_lines, len) = plan.lines();
     let per_line = plan.steps + 1;
     let chunk = (step_bytes / (per_line * std::mem::size_of::<StepGpu>())).clamp(1, n_lines);
@@ -237,25 +246,27 @@ pub(crate) fn unpack(plan: &Plan, index: usize, out: &[f32]) -> FrameMaps {
     plan.finish(index, ch)
 }
 
-/// The blur fields of a job's frame by the CPU twin of `shaders/maps.wgsl`
+/// The blur fields of a job's frame by the CPU twin of `maps.wgsl`
 /// (f32, rayon), in the kernel's dispatches; as [`super::maps::frame_maps`].
 pub fn frame_maps_twin(job: &MapsJob) -> Result<Option<FrameMaps>> {
     let cam = &job.opts.scene.camera;
     let n = cam.width as usize * cam.height as usize;
     let packed = pack_rays(job.rays);
+    let table = lens_table(job.rays)?;
     let mut out = vec![0.0f32; PLANES * n];
-    let plan = drive(job, STEP_BYTES, |p, l, s| {
-        dispatch_twin(p, &packed, l, s, &mut out);
+    let plan = drive(job, table.as_ref(), STEP_BYTES, |p, l, s| {
+        dispatch_twin(p, &packed, table.as_ref(), l, s, &mut out);
         Ok(())
     })?;
     Ok(plan.map(|plan| unpack(&plan, job.index, &out)))
 }
 
 /// Twin of one dispatch of `maps`: every thread (pixel of the dispatch's
-/// lines) writes its planes of `out`.
+/// lines) writes its planes of `out`. `table`: the lens table in table mode.
 pub fn dispatch_twin(
     p: &MapsParams,
     rays: &[[f32; 4]],
+    table: Option<&MapsTable>,
     lines: &[LineGpu],
     steps: &[StepGpu],
     out: &mut [f32],
@@ -264,7 +275,7 @@ pub fn dispatch_twin(
     let vals: Vec<(usize, Option<[f32; PLANES]>)> = (0..p.n_lines * p.line_len)
         .into_par_iter()
         .with_min_len(256)
-        .map(|idx| thread(p, rays, lines, steps, idx))
+        .map(|idx| thread(p, rays, table, lines, steps, idx))
         .collect();
     for (pix, v) in vals {
         match v {
@@ -275,18 +286,6 @@ pub fn dispatch_twin(
             }
             None => out[2 * n + pix] = -1.0,
         }
-    }
-}
-
-/// The shader's lens parameters as the field kernel's, for its twins
-/// ([`crate::field::cpu::distort`], [`crate::field::cpu::jacobian`]).
-fn lens(p: &MapsParams) -> FlowParams {
-    FlowParams {
-        f_mm: p.f_mm,
-        dist_model: p.dist_model,
-        dist: p.dist,
-        dist_k3: p.dist_k3,
-        ..FlowParams::zeroed()
     }
 }
 
@@ -320,13 +319,22 @@ fn moved(st: &StepGpu, r: [f32; 3], s: f32) -> [f32; 3] {
     [(d[0] - r[0] * d[2]) / z, (d[1] - r[1] * d[2]) / z, z]
 }
 
+/// The lens of a thread: the lens module's, or the table with the cell of
+/// the pixel's ray.
+enum ThreadLens<'a> {
+    Module(&'a LensGpu),
+    Table(&'a MapsTable, [f32; 4]),
+}
+
 /// Twin of the shader's `position`.
 #[inline(always)]
-fn position(p: &MapsParams, lp: &FlowParams, r: [f32; 2], e: [f32; 2]) -> [f32; 2] {
-    let q = if p.dist_model != 0 {
-        crate::field::cpu::distort(lp, r[0] + e[0], r[1] + e[1])
-    } else {
-        (e[0], e[1])
+fn position(p: &MapsParams, l: &ThreadLens, r: [f32; 2], e: [f32; 2]) -> [f32; 2] {
+    let q = match l {
+        ThreadLens::Table(t, c) => t.distort(*c, e),
+        ThreadLens::Module(m) if m.model != MODEL_NONE => {
+            lens::distort(m, r[0] + e[0], r[1] + e[1])
+        }
+        ThreadLens::Module(_) => (e[0], e[1]),
     };
     [p.fx * q.0 + p.skew * q.1, p.fy * q.1]
 }
@@ -338,6 +346,7 @@ fn position(p: &MapsParams, lp: &FlowParams, r: [f32; 2], e: [f32; 2]) -> [f32; 
 fn thread(
     p: &MapsParams,
     rays: &[[f32; 4]],
+    table: Option<&MapsTable>,
     lines: &[LineGpu],
     steps: &[StepGpu],
     idx: u32,
@@ -354,7 +363,10 @@ fn thread(
     if !(ray[2] != 0.0 && (p.use_plane == 0 || s > 0.0)) {
         return (pix, None);
     }
-    let lp = lens(p);
+    let lp = match table {
+        Some(t) if p.lens.model == MODEL_TABLE => ThreadLens::Table(t, t.cell(r[0], r[1])),
+        _ => ThreadLens::Module(&p.lens),
+    };
     let base = (ll * (p.steps + 1)) as usize;
     let (mut first, mut prev, mut path) = ([0.0f32; 2], [0.0f32; 2], 0.0f32);
     for (k, st) in steps[base..=base + p.steps as usize].iter().enumerate() {
@@ -372,8 +384,14 @@ fn thread(
         prev = q;
     }
     let (mut fu, mut fv) = line_flow(l, p.f_mm * r[0], p.f_mm * r[1]);
-    if p.dist_model != 0 {
-        let jm = crate::field::cpu::jacobian(&lp, r[0], r[1]);
+    if p.lens.model != MODEL_NONE {
+        let jm = match lp {
+            ThreadLens::Table(t, _) => {
+                let g = t.jac[pix];
+                [[g[0], g[1]], [g[2], g[3]]]
+            }
+            ThreadLens::Module(m) => lens::jacobian(m, r[0], r[1]),
+        };
         (fu, fv) = (jm[0][0] * fu + jm[0][1] * fv, jm[1][0] * fu + jm[1][1] * fv);
     }
     // Twin of the shader's `px_velocity`.
@@ -387,6 +405,7 @@ fn thread(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::camera::Camera;
 
     /// The shader's `const` of this name, as a u32.
     fn shader_const(m: &naga::Module, name: &str) -> u32 {
@@ -405,6 +424,7 @@ mod tests {
     #[test]
     fn shader_constants_and_struct_sizes_match_host() {
         let m = naga::front::wgsl::parse_str(super::super::maps_gpu::MAPS_WGSL).expect("parses");
+        assert_eq!(shader_const(&m, "UNDISTORT_STEPS"), lens::UNDISTORT_STEPS);
         assert_eq!(shader_const(&m, "WG"), WG);
         assert_eq!(m.entry_points.len(), 1);
         assert_eq!(m.entry_points[0].workgroup_size, [WG, 1, 1]);
@@ -415,6 +435,11 @@ mod tests {
             ("Params", std::mem::size_of::<MapsParams>()),
             ("Line", std::mem::size_of::<LineGpu>()),
             ("Step", std::mem::size_of::<StepGpu>()),
+            (
+                "Node",
+                std::mem::size_of::<super::super::maps_table::NodeGpu>(),
+            ),
+            ("Lens", std::mem::size_of::<LensGpu>()),
         ] {
             let (h, _) = m
                 .types
@@ -425,39 +450,17 @@ mod tests {
         }
     }
 
-    /// The body of WGSL function `name` in `src` (its `fn` line to its closing brace).
-    fn wgsl_fn<'a>(src: &'a str, name: &str) -> &'a str {
-        let start = src
-            .find(&format!("\nfn {name}("))
-            .unwrap_or_else(|| panic!("no fn {name}"));
-        let len = src[start..].find("\n}\n").expect("closing brace");
-        &src[start..start + len]
-    }
-
     #[test]
-    fn lens_functions_are_copies_of_field_wgsl() {
-        // Their CPU twins are field.wgsl's: the copies must not drift.
-        let field = crate::field::gpu::FIELD_WGSL;
-        let maps = super::super::maps_gpu::MAPS_WGSL;
-        for f in [
-            "atan_poly",
-            "fisheye_theta_d",
-            "fisheye_scale",
-            "distort",
-            "jacobian",
-        ] {
-            assert_eq!(wgsl_fn(maps, f), wgsl_fn(field, f), "fn {f}");
-        }
-    }
-
-    #[test]
-    fn unsupported_lens_is_named() {
+    fn every_model_has_a_lens_strategy() {
+        // The analytic models run from the lens module, every other from the table.
         let cam = Camera {
             distortion: crate::camera::Distortion::Poly3 { k1: 0.01 },
-            ..Camera::thesis()
+            ..Camera::thesis().scaled_to(32, 24)
         };
-        let e = check_lens(&cam).unwrap_err().to_string();
-        assert!(e.contains("poly3") && e.contains("--backend cpu"), "{e}");
-        assert!(check_lens(&Camera::thesis()).is_ok());
+        let rays = MapRays::new(&cam).unwrap();
+        let t = lens_table(&rays).unwrap().expect("poly3 takes the table");
+        assert_eq!(t.nodes.len(), (t.n[0] * t.n[1]) as usize);
+        let thesis = MapRays::new(&Camera::thesis().scaled_to(32, 24)).unwrap();
+        assert!(lens_table(&thesis).unwrap().is_none());
     }
 }

@@ -14,6 +14,7 @@ pub mod maps;
 pub mod maps_gpu;
 pub mod maps_kernel;
 mod maps_line;
+pub mod maps_table;
 pub mod maps_write;
 pub mod select;
 

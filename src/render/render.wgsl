@@ -21,33 +21,8 @@
 // edge crosses the footprint; it is approximate only where two edges do (a
 // corner inside a pixel). Formulas and their derivation: src/render/cpu.rs.
 
-struct Params {
-    background: vec4<f32>,
-    tex: vec4<f32>,
-    colour_a: vec4<f32>,
-    colour_b: vec4<f32>,
-    lod: vec4<f32>,        // LOD_SCALE, 1/N, poster layers (0: plain background), 0
-    dims: vec4<u32>,       // width, height, kind, N
-    lattice: vec4<u32>,    // g1, g2, distortion map offset (0: none), seed
-    range: vec4<u32>,      // row0, k0, k1, (k0 g1) mod N
-    range2: vec4<u32>,     // (k0 g2) mod N, rows, line mode, 0
-    bbox: vec4<u32>,       // x0, y0, x1, y1 (end exclusive)
-    lens: vec4<f32>,       // aperture radius (m; 0: pinhole), fx / s, fy / s, skew / s
-    lens_gen: vec4<u32>,   // g3, g4, (k0 g3) mod N, (k0 g4) mod N
-    poster: array<vec4<f32>, 8>, // per layer [S, 1/S, pa, pb], [r, g, b, 0] (src/render/poster.rs)
-}
-
-struct Homography {
-    h0: vec4<f32>,
-    h1: vec4<f32>,
-    h2: vec4<f32>,         // row 2, |det H|
-}
-
-@group(0) @binding(0) var<uniform> P: Params;
-@group(0) @binding(1) var<storage, read> homs: array<Homography>;
-@group(0) @binding(2) var<storage, read> texels: array<f32>;
-@group(0) @binding(3) var<storage, read> levels: array<vec4<u32>>;
-@group(0) @binding(4) var<storage, read_write> out_rgb: array<vec4<f32>>;
+// Params, Homography, the bindings and line_base: src/render/prelude.wgsl,
+// joined in front of this file at build (src/render/gpu.rs).
 
 fn pcg(v: u32) -> u32 {
     let state = v * 747796405u + 2891336453u;
@@ -202,19 +177,6 @@ fn lens_sample(e: u32, l: vec2<f32>, q: vec2<f32>) -> vec3<f32> {
         vec4<f32>(h.h2.xyz + l.x * gx.h2.xyz + l.y * gy.h2.xyz, h.h2.w));
     let p = q - vec2<f32>(l.x * P.lens.y + l.y * P.lens.w, l.y * P.lens.z);
     return shade(hl, p.x, p.y);
-}
-
-// Rolling shutter (docs/spec.md section 9): the first table entry of pixel (i, j)'s line.
-// Line mode range2.z: 0 one set of N instants for every pixel, 1 one set per
-// row, 2 one per column (each line's own exposure window).
-fn line_base(i: u32, j: u32) -> u32 {
-    if (P.range2.z == 1u) {
-        return j * P.dims.w;
-    }
-    if (P.range2.z == 2u) {
-        return i * P.dims.w;
-    }
-    return 0u;
 }
 
 @compute @workgroup_size(8, 8, 1)

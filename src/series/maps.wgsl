@@ -1,7 +1,8 @@
 // Per-pixel blur fields of a video frame (`mmbm frames --maps`, docs/spec.md section
 // 9): each pixel's image track over its own line's exposure (rolling
 // shutter), its displacement, path length and start flow. The CPU twin of
-// every function is in src/series/maps_kernel.rs, the f64 reference in
+// every function is in src/series/maps_kernel.rs (the lens table's in
+// src/series/maps_table.rs), the f64 reference in
 // src/series/maps.rs, the host structs in src/series/maps_kernel.rs.
 //
 // Per pixel the host gives the undistorted ray r = (x, y, 1) (normalised;
@@ -14,7 +15,7 @@
 // its start (px, +x right, +y down). Units: px for positions, px/s for the
 // flow, the flow polynomial in mm/s at sensor points in mm.
 
-// Camera, lines and lens. Must match `MapsParams` (96 bytes).
+// Camera, lines and lens. Must match `MapsParams` (128 bytes).
 struct Params {
     width: u32,         // frame size, px
     height: u32,
@@ -31,12 +32,10 @@ struct Params {
     pitch_x: f32,       // pixel pitch, mm
     pitch_y: f32,
     skew_over_f: f32,   // skew (px) / f (mm)
-    dist_model: u32,    // lens distortion: 0 none, 1 OpenCV (k1 k2 p1 p2 | k3), 2 fisheye (k1..k4)
-    dist: vec4<f32>,    // OpenCV: k1, k2, p1, p2; fisheye: k1, k2, k3, k4
-    dist_k3: f32,       // OpenCV: k3
     groups_x: u32,      // workgroups along x of the dispatch
-    pad0: u32,
-    pad1: u32,
+    lens: Lens,         // lens distortion (src/gpu/lens.wgsl); model 3: the lens table
+    table: vec4<f32>,   // lens table: node (0, 0) at (x, y) (normalised), 1 / spacing, spacing
+    table_n: vec4<u32>, // lens table: nodes along x, along y, 0, 0
 }
 
 // One line. Must match `LineGpu` (64 bytes).
@@ -55,88 +54,89 @@ struct Step {
     b: vec4<f32>,   // xyz: offset of the start's centre, m
 }
 
+// Lens table mode (lens model 3, every model without a formula in the lens
+// module): the distortion map on a regular grid of the undistorted
+// normalised plane covering the camera's rays with a margin, computed on the
+// host (src/series/maps_table.rs, f64): per node its distorted point and
+// its derivatives, d/dx and d/dy times the spacing and d2/dxdy times its
+// square. The kernel interpolates bicubically (Hermite), continuing the
+// border cells' cubics beyond the grid. The Jacobian at each pixel's ray
+// (for its flow) is the host's too (`ray_jac`, as the field kernel's lens
+// table). Must match `NodeGpu` (32 bytes).
+struct Node {
+    d: vec2<f32>,
+    dx: vec2<f32>,
+    dy: vec2<f32>,
+    dxy: vec2<f32>,
+}
+
 @group(0) @binding(0) var<uniform> params: Params;
 @group(0) @binding(1) var<storage, read> rays: array<vec4<f32>>;   // per pixel (x, y, ok, 0)
 @group(0) @binding(2) var<storage, read> lines: array<Line>;       // this dispatch's lines
 @group(0) @binding(3) var<storage, read> steps: array<Step>;       // steps + 1 per line
 @group(0) @binding(4) var<storage, read_write> out: array<f32>;    // 5 planes of width * height
+@group(0) @binding(5) var<storage, read> nodes: array<Node>;       // lens table (one dummy node otherwise)
+@group(0) @binding(6) var<storage, read> ray_jac: array<vec4<f32>>; // table mode: per pixel the Jacobian's rows at its ray (one dummy otherwise)
 
 const WG: u32 = 64u;
 
-// Lens distortion (docs/spec.md section 9) in normalised coordinates: copied from
-// shaders/field.wgsl (a test keeps the copies equal); twins in src/field/cpu.rs.
-// atan(x) for x >= 0.
-fn atan_poly(x: f32) -> f32 {
-    let inv = x > 1.0;
-    var z = x;
-    if (inv) {
-        z = 1.0 / x;
-    }
-    let z2 = z * z;
-    let p = 1.0 + z2 * (-0.3333314528 + z2 * (0.1999355085 + z2 * (-0.1420889944
-        + z2 * (0.1065626393 + z2 * (-0.0752896400 + z2 * (0.0429096138
-        + z2 * (-0.0161657367 + z2 * 0.0028662257)))))));
-    let a = z * p;
-    if (inv) {
-        return 1.5707964 - a; // pi/2 in f32, as the twin's FRAC_PI_2
-    }
-    return a;
+// Lens distortion: src/gpu/lens.wgsl (`Lens`, `distort`, `jacobian`), joined
+// in front of this file at build (src/series/maps_gpu.rs).
+
+// Cubic Hermite basis at s: h00, h10, h01, h11.
+fn hermite(s: f32) -> vec4<f32> {
+    let s2 = s * s;
+    let s3 = s2 * s;
+    return vec4<f32>(2.0 * s3 - 3.0 * s2 + 1.0, s3 - 2.0 * s2 + s, 3.0 * s2 - 2.0 * s3, s3 - s2);
 }
 
-// Fisheye: theta_d(theta) and its derivative.
-fn fisheye_theta_d(th: f32) -> vec2<f32> {
-    let k = params.dist;
-    let t2 = th * th;
-    let poly = 1.0 + t2 * (k.x + t2 * (k.y + t2 * (k.z + t2 * k.w)));
-    let d = 1.0 + t2 * (3.0 * k.x + t2 * (5.0 * k.y + t2 * (7.0 * k.z + t2 * 9.0 * k.w)));
-    return vec2<f32>(th * poly, d);
+// The table cell of q: its first node's column and row in xy (clamped to
+// the grid's cells) and q's place in it in zw (in spacings; outside [0, 1]
+// beyond the grid).
+fn table_cell(q: vec2<f32>) -> vec4<f32> {
+    let u = (q.x - params.table.x) * params.table.z;
+    let v = (q.y - params.table.y) * params.table.z;
+    let i = clamp(floor(u), 0.0, f32(params.table_n.x - 2u));
+    let j = clamp(floor(v), 0.0, f32(params.table_n.y - 2u));
+    return vec4<f32>(i, j, u - i, v - j);
 }
 
-// Fisheye: s = theta_d / r and (ds/dr) / r at q (series near the axis).
-fn fisheye_scale(q: vec2<f32>) -> vec2<f32> {
-    let k = params.dist;
-    let r2 = q.x * q.x + q.y * q.y;
-    if (r2 < 1e-4) {
-        let c = k.x - 1.0 / 3.0;
-        let e = 0.2 - k.x + k.y;
-        return vec2<f32>(1.0 + r2 * (c + r2 * e), 2.0 * c + 4.0 * e * r2);
-    }
-    let r = sqrt(r2);
-    let th = atan_poly(r);
-    let td = fisheye_theta_d(th);
-    let s = td.x / r;
-    return vec2<f32>(s, (td.y / (1.0 + r2) - s) / r2);
+// The table cell of the ray r + e from r's cell c: the offset is added to
+// the place within the cell (small numbers, so a track's points keep their
+// digits relative to each other), then the cell moved by whole spacings.
+fn table_move(c: vec4<f32>, e: vec2<f32>) -> vec4<f32> {
+    let s = c.z + e.x * params.table.z;
+    let t = c.w + e.y * params.table.z;
+    let i = clamp(c.x + floor(s), 0.0, f32(params.table_n.x - 2u));
+    let j = clamp(c.y + floor(t), 0.0, f32(params.table_n.y - 2u));
+    return vec4<f32>(i, j, s - (i - c.x), t - (j - c.y));
 }
 
-fn distort(q: vec2<f32>) -> vec2<f32> {
-    if (params.dist_model == 1u) {
-        let k = params.dist;
-        let r2 = q.x * q.x + q.y * q.y;
-        let radial = 1.0 + r2 * (k.x + r2 * (k.y + r2 * params.dist_k3));
-        return vec2<f32>(
-            q.x * radial + 2.0 * k.z * q.x * q.y + k.w * (r2 + 2.0 * q.x * q.x),
-            q.y * radial + k.z * (r2 + 2.0 * q.y * q.y) + 2.0 * k.w * q.x * q.y);
-    }
-    return fisheye_scale(q).x * q;
+// The index of cell c's first node.
+fn table_node(c: vec4<f32>) -> u32 {
+    return u32(c.y) * params.table_n.x + u32(c.x);
 }
 
-// Rows of the Jacobian: (dxd/dx, dxd/dy), (dyd/dx, dyd/dy).
-fn jacobian(q: vec2<f32>) -> array<vec2<f32>, 2> {
-    if (params.dist_model == 1u) {
-        let k = params.dist;
-        let r2 = q.x * q.x + q.y * q.y;
-        let radial = 1.0 + r2 * (k.x + r2 * (k.y + r2 * params.dist_k3));
-        let drad = k.x + r2 * (2.0 * k.y + r2 * 3.0 * params.dist_k3);
-        let off = 2.0 * q.x * q.y * drad + 2.0 * k.z * q.x + 2.0 * k.w * q.y;
-        return array<vec2<f32>, 2>(
-            vec2<f32>(radial + 2.0 * q.x * q.x * drad + 2.0 * k.z * q.y + 6.0 * k.w * q.x, off),
-            vec2<f32>(off, radial + 2.0 * q.y * q.y * drad + 6.0 * k.z * q.y + 2.0 * k.w * q.x));
-    }
-    let sg = fisheye_scale(q);
-    let off = sg.y * q.x * q.y;
-    return array<vec2<f32>, 2>(
-        vec2<f32>(sg.x + sg.y * q.x * q.x, off),
-        vec2<f32>(off, sg.x + sg.y * q.y * q.y));
+// The interpolant's sum over cell c's four nodes with weights ws (in x)
+// and wt (in y), less the first node's value (the value weights sum to 1,
+// the derivative weights to 0: the differences keep the digits).
+fn table_sum(c: vec4<f32>, ws: vec4<f32>, wt: vec4<f32>) -> vec2<f32> {
+    let k = table_node(c);
+    let a = nodes[k];
+    let b = nodes[k + 1u];
+    let e = nodes[k + params.table_n.x];
+    let g = nodes[k + params.table_n.x + 1u];
+    return ws.y * wt.x * a.dx + ws.x * wt.y * a.dy + ws.y * wt.y * a.dxy
+        + ws.z * wt.x * (b.d - a.d) + ws.w * wt.x * b.dx + ws.z * wt.y * b.dy + ws.w * wt.y * b.dxy
+        + ws.x * wt.z * (e.d - a.d) + ws.y * wt.z * e.dx + ws.x * wt.w * e.dy + ws.y * wt.w * e.dxy
+        + ws.z * wt.z * (g.d - a.d) + ws.w * wt.z * g.dx + ws.z * wt.w * g.dy + ws.w * wt.w * g.dxy;
+}
+
+// Table mode: the distorted point of the ray r + e less that of r's cell's
+// first node (positions enter only as differences), from r's cell c.
+fn table_distort(c: vec4<f32>, e: vec2<f32>) -> vec2<f32> {
+    let m = table_move(c, e);
+    return (nodes[table_node(m)].d - nodes[table_node(c)].d) + table_sum(m, hermite(m.z), hermite(m.w));
 }
 
 // The flow (mm/s, undistorted sensor) of line l at sensor point (u, v) mm.
@@ -161,12 +161,15 @@ fn moved(st: Step, r: vec3<f32>, s: f32) -> vec3<f32> {
     return vec3<f32>((d.x - r.x * d.z) / z, (d.y - r.y * d.z) / z, z);
 }
 
-// Pixel position (less the principal point) of the ray r + e: without
-// distortion that of e alone (positions enter only as differences).
-fn position(r: vec2<f32>, e: vec2<f32>) -> vec2<f32> {
+// Pixel position (less a point fixed per pixel) of the ray r + e: without
+// distortion that of e alone, in table mode from r's cell c (positions
+// enter only as differences).
+fn position(r: vec2<f32>, c: vec4<f32>, e: vec2<f32>) -> vec2<f32> {
     var q = e;
-    if (params.dist_model != 0u) {
-        q = distort(r + e);
+    if (params.lens.model == 3u) {
+        q = table_distort(c, e);
+    } else if (params.lens.model != 0u) {
+        q = distort(params.lens, r + e);
     }
     return vec2<f32>(params.fx * q.x + params.skew * q.y, params.fy * q.y);
 }
@@ -201,6 +204,10 @@ fn maps(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) l
     let r = vec3<f32>(ray.x, ray.y, 1.0);
     let s = l.plane.x * r.x + l.plane.y * r.y + l.plane.z;
     var ok = ray.z != 0.0 && (params.use_plane == 0u || s > 0.0);
+    var c = vec4<f32>(0.0);
+    if (params.lens.model == 3u) {
+        c = table_cell(r.xy);
+    }
     var first = vec2<f32>(0.0, 0.0);
     var prev = vec2<f32>(0.0, 0.0);
     var path = 0.0;
@@ -211,7 +218,7 @@ fn maps(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) l
             ok = false;
             break;
         }
-        let p = position(r.xy, t.xy);
+        let p = position(r.xy, c, t.xy);
         if (k == 0u) {
             first = p;
         } else {
@@ -225,8 +232,14 @@ fn maps(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) l
         return;
     }
     var fl = line_flow(l, params.f_mm * r.x, params.f_mm * r.y);
-    if (params.dist_model != 0u) {
-        let jm = jacobian(r.xy);
+    if (params.lens.model != 0u) {
+        var jm: array<vec2<f32>, 2>;
+        if (params.lens.model == 3u) {
+            let g = ray_jac[pix];
+            jm = array<vec2<f32>, 2>(g.xy, g.zw);
+        } else {
+            jm = jacobian(params.lens, r.xy);
+        }
         fl = vec2<f32>(dot(jm[0], fl), dot(jm[1], fl));
     }
     let fv = px_velocity(fl);

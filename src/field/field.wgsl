@@ -24,13 +24,9 @@ struct Params {
     tiles: u32,         // tiles per twist (flow_tiles)
     tiles_x: u32,       // workgroups along x per dispatch row
     write_field: u32,   // 1: write the field (one twist only)
-    dist_model: u32,    // lens distortion: 0 none, 1 OpenCV (k1 k2 p1 p2 | k3), 2 fisheye (k1..k4), 3 lens table
     pad0: u32,
-    dist: vec4<f32>,    // OpenCV: k1, k2, p1, p2; fisheye: k1, k2, k3, k4
-    dist_k3: f32,       // OpenCV: k3
     pad1: u32,
-    pad2: u32,
-    pad3: u32,
+    lens: Lens,         // lens distortion (src/gpu/lens.wgsl); model 3: the lens table below
 }
 
 // One twist. Must match `TwistGpu` (48 bytes).
@@ -40,7 +36,7 @@ struct Twist {
     inv_depth: vec4<f32>, // 1/z = x + y*u + z*v (1/m; zero for rotation only)
 }
 
-// Lens table mode (dist_model 3): per grid sample, its undistorted normalised
+// Lens table mode (lens model 3): per grid sample, its undistorted normalised
 // point q and the rows of the distortion chain's Jacobian at q, computed on
 // the host (src/field/table.rs; all zero for a masked sample, whose flow is
 // then 0). Must match `LensSample` (24 bytes). One dummy entry otherwise.
@@ -54,7 +50,7 @@ struct LensSample {
 @group(0) @binding(1) var<storage, read> twists: array<Twist>;
 @group(0) @binding(2) var<storage, read_write> field: array<vec2<f32>>;
 @group(0) @binding(3) var<storage, read_write> partials: array<f32>;
-@group(0) @binding(4) var<storage, read> lens: array<LensSample>;
+@group(0) @binding(4) var<storage, read> lens_table: array<LensSample>;
 
 // Workgroup size and samples per thread of flow_tiles: a tile is WG * CHUNK
 // consecutive samples (row-major); sample k of thread t is tile*TILE + k*WG + t.
@@ -84,130 +80,26 @@ fn flow_mm(p: vec2<f32>, tw: Twist) -> vec2<f32> {
     return vec2<f32>(du, dv);
 }
 
-// Lens distortion (docs/spec.md section 9) in normalised coordinates q = (x, y):
-// the Jacobian of the distortion map at q, and its inverse by Newton's method
-// (a fixed UNDISTORT_STEPS steps from the distorted point). Twins:
-// distort/jacobian/undistort in src/field/cpu.rs. The fisheye model needs
-// atan; WGSL's built-in is only specified to 4096 ULP, so the kernel uses its
-// own polynomial (Abramowitz & Stegun 4.4.49, |error| <= 2e-8 on [0, 1]) that
-// the twin evaluates with the same operations.
-const UNDISTORT_STEPS: u32 = 16u;
-
-// atan(x) for x >= 0.
-fn atan_poly(x: f32) -> f32 {
-    let inv = x > 1.0;
-    var z = x;
-    if (inv) {
-        z = 1.0 / x;
-    }
-    let z2 = z * z;
-    let p = 1.0 + z2 * (-0.3333314528 + z2 * (0.1999355085 + z2 * (-0.1420889944
-        + z2 * (0.1065626393 + z2 * (-0.0752896400 + z2 * (0.0429096138
-        + z2 * (-0.0161657367 + z2 * 0.0028662257)))))));
-    let a = z * p;
-    if (inv) {
-        return 1.5707964 - a; // pi/2 in f32, as the twin's FRAC_PI_2
-    }
-    return a;
-}
-
-// Fisheye: theta_d(theta) and its derivative.
-fn fisheye_theta_d(th: f32) -> vec2<f32> {
-    let k = params.dist;
-    let t2 = th * th;
-    let poly = 1.0 + t2 * (k.x + t2 * (k.y + t2 * (k.z + t2 * k.w)));
-    let d = 1.0 + t2 * (3.0 * k.x + t2 * (5.0 * k.y + t2 * (7.0 * k.z + t2 * 9.0 * k.w)));
-    return vec2<f32>(th * poly, d);
-}
-
-// Fisheye: s = theta_d / r and (ds/dr) / r at q (series near the axis).
-fn fisheye_scale(q: vec2<f32>) -> vec2<f32> {
-    let k = params.dist;
-    let r2 = q.x * q.x + q.y * q.y;
-    if (r2 < 1e-4) {
-        let c = k.x - 1.0 / 3.0;
-        let e = 0.2 - k.x + k.y;
-        return vec2<f32>(1.0 + r2 * (c + r2 * e), 2.0 * c + 4.0 * e * r2);
-    }
-    let r = sqrt(r2);
-    let th = atan_poly(r);
-    let td = fisheye_theta_d(th);
-    let s = td.x / r;
-    return vec2<f32>(s, (td.y / (1.0 + r2) - s) / r2);
-}
-
-fn distort(q: vec2<f32>) -> vec2<f32> {
-    if (params.dist_model == 1u) {
-        let k = params.dist;
-        let r2 = q.x * q.x + q.y * q.y;
-        let radial = 1.0 + r2 * (k.x + r2 * (k.y + r2 * params.dist_k3));
-        return vec2<f32>(
-            q.x * radial + 2.0 * k.z * q.x * q.y + k.w * (r2 + 2.0 * q.x * q.x),
-            q.y * radial + k.z * (r2 + 2.0 * q.y * q.y) + 2.0 * k.w * q.x * q.y);
-    }
-    return fisheye_scale(q).x * q;
-}
-
-// Rows of the Jacobian: (dxd/dx, dxd/dy), (dyd/dx, dyd/dy).
-fn jacobian(q: vec2<f32>) -> array<vec2<f32>, 2> {
-    if (params.dist_model == 1u) {
-        let k = params.dist;
-        let r2 = q.x * q.x + q.y * q.y;
-        let radial = 1.0 + r2 * (k.x + r2 * (k.y + r2 * params.dist_k3));
-        let drad = k.x + r2 * (2.0 * k.y + r2 * 3.0 * params.dist_k3);
-        let off = 2.0 * q.x * q.y * drad + 2.0 * k.z * q.x + 2.0 * k.w * q.y;
-        return array<vec2<f32>, 2>(
-            vec2<f32>(radial + 2.0 * q.x * q.x * drad + 2.0 * k.z * q.y + 6.0 * k.w * q.x, off),
-            vec2<f32>(off, radial + 2.0 * q.y * q.y * drad + 6.0 * k.z * q.y + 2.0 * k.w * q.x));
-    }
-    let sg = fisheye_scale(q);
-    let off = sg.y * q.x * q.y;
-    return array<vec2<f32>, 2>(
-        vec2<f32>(sg.x + sg.y * q.x * q.x, off),
-        vec2<f32>(off, sg.x + sg.y * q.y * q.y));
-}
-
-fn undistort(qd: vec2<f32>) -> vec2<f32> {
-    if (params.dist_model == 2u) {
-        let rd = length(qd);
-        if (rd == 0.0) {
-            return qd;
-        }
-        // Newton on r: theta_d(atan(r)) = r_d, d/dr = theta_d'(theta) / (1 + r^2).
-        var r = rd;
-        for (var k = 0u; k < UNDISTORT_STEPS; k++) {
-            let td = fisheye_theta_d(atan_poly(r));
-            r = max(r - (td.x - rd) * (1.0 + r * r) / td.y, 0.0);
-        }
-        return qd * (r / rd);
-    }
-    var q = qd;
-    for (var k = 0u; k < UNDISTORT_STEPS; k++) {
-        let e = distort(q) - qd;
-        let j = jacobian(q);
-        let det = j[0].x * j[1].y - j[0].y * j[1].x;
-        q -= vec2<f32>(j[1].y * e.x - j[0].y * e.y, -j[1].x * e.x + j[0].x * e.y) / det;
-    }
-    return q;
-}
+// Lens distortion: src/gpu/lens.wgsl (`Lens`, `distort`, `jacobian`,
+// `undistort`), joined in front of this file at build (src/field/gpu.rs).
 
 // The flow (mm/s on the distorted sensor) at the centre of grid cell (i, j):
 // the pinhole flow of its undistorted point through the distortion's Jacobian.
 // Table mode: the pinhole flow at the sample's q through its Jacobian.
 fn sample_flow(i: u32, j: u32, tw: Twist) -> vec2<f32> {
-    if (params.dist_model == 3u) {
-        let s = lens[j * params.grid_w + i];
+    if (params.lens.model == 3u) {
+        let s = lens_table[j * params.grid_w + i];
         let fl = flow_mm(s.q * params.f_mm, tw);
         return vec2<f32>(dot(s.j0, fl), dot(s.j1, fl));
     }
     let pd = sensor_point(i, j);
-    if (params.dist_model == 0u) {
+    if (params.lens.model == 0u) {
         return flow_mm(pd, tw);
     }
     let f = params.f_mm;
-    let q = undistort(pd / f);
+    let q = undistort(params.lens, pd / f);
     let fl = flow_mm(q * f, tw);
-    let jm = jacobian(q);
+    let jm = jacobian(params.lens, q);
     return vec2<f32>(dot(jm[0], fl), dot(jm[1], fl));
 }
 

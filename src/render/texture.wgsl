@@ -9,35 +9,11 @@
 // the trapezoid, at the finest mip level where the footprint reaches at most
 // MAX_REACH texels per axis. f32: every weight is computed relative to its
 // node from values of a few texels, so nothing large cancels (no summed-area
-// table: its f32 differences would). Bindings and Params: as
-// shaders/render.wgsl (src/render/layout.rs; the same bind group layout).
+// table: its f32 differences would). Bindings and Params: the renderer's
+// prelude (src/render/prelude.wgsl; the same bind group layout).
 
-struct Params {
-    background: vec4<f32>,
-    tex: vec4<f32>,        // width_m, height_m, texels per m (level 0), levels
-    colour_a: vec4<f32>,
-    colour_b: vec4<f32>,
-    lod: vec4<f32>,        // LOD_SCALE, 1/N, 0, 0
-    dims: vec4<u32>,       // width, height, kind, N
-    lattice: vec4<u32>,    // g1, g2, distortion map offset (0: none), seed
-    range: vec4<u32>,      // row0, k0, k1, (k0 g1) mod N
-    range2: vec4<u32>,     // (k0 g2) mod N, rows, line mode, 0
-    bbox: vec4<u32>,       // x0, y0, x1, y1 (end exclusive)
-    lens: vec4<f32>,
-    lens_gen: vec4<u32>,
-}
-
-struct Homography {
-    h0: vec4<f32>,
-    h1: vec4<f32>,
-    h2: vec4<f32>,
-}
-
-@group(0) @binding(0) var<uniform> P: Params;
-@group(0) @binding(1) var<storage, read> homs: array<Homography>;
-@group(0) @binding(2) var<storage, read> texels: array<f32>;
-@group(0) @binding(3) var<storage, read> levels: array<vec4<u32>>;
-@group(0) @binding(4) var<storage, read_write> out_rgb: array<vec4<f32>>;
+// Params, Homography, the bindings and line_base: src/render/prelude.wgsl,
+// joined in front of this file at build (src/render/gpu.rs).
 
 const MAX_NODES: u32 = 8u;
 const MAX_REACH: f32 = 2.5;
@@ -219,17 +195,6 @@ fn texture_mean(h: Homography, px: f32, py: f32, l0: vec2<f32>, l1: vec2<f32>) -
     let sby = (h.h1.y - b * h.h2.y) * r;
     return footprint_eval(a, b, abs(sax * l0.x + say * l1.x), abs(sax * l0.y + say * l1.y),
         abs(sbx * l0.x + sby * l1.x), abs(sbx * l0.y + sby * l1.y));
-}
-
-// Rolling shutter: the first table entry of pixel (i, j)'s line (as render.wgsl).
-fn line_base(i: u32, j: u32) -> u32 {
-    if (P.range2.z == 1u) {
-        return j * P.dims.w;
-    }
-    if (P.range2.z == 2u) {
-        return i * P.dims.w;
-    }
-    return 0u;
 }
 
 @compute @workgroup_size(8, 8, 1)
