@@ -6,7 +6,7 @@ use clap::Args;
 use mmbm::error::{Error, Result};
 use mmbm::io::frames::read_frame_table;
 use mmbm::series::frames::frame_mmbm;
-use mmbm::series::maps_write::{is_map_name, parse_channels, stage_maps, MapsFormat, MapsOutput};
+use mmbm::series::maps::write::{is_map_name, parse_channels, stage_maps, MapsFormat, MapsOutput};
 use mmbm::series::select::clock::{check_clock, Spans};
 use mmbm::series::SeriesOptions;
 use mmbm::{AnyMethod, Scene};
@@ -242,7 +242,7 @@ pub fn run(a: FramesArgs) -> Result<()> {
     };
     let extracted = match (&a.choice.extract, &a.choice.video) {
         (Some(dir), Some(video)) => {
-            let mut staged = mmbm::series::maps_write::StagedMaps::empty(dir)?;
+            let mut staged = mmbm::series::maps::write::StagedMaps::empty(dir)?;
             let names = mmbm::series::select::video::extract(
                 video,
                 keep,

@@ -11,10 +11,6 @@ pub mod frames;
 pub mod gpu;
 pub mod lerp;
 pub mod maps;
-pub mod maps_gpu;
-pub mod maps_kernel;
-mod maps_line;
-pub mod maps_write;
 pub mod select;
 
 use crate::error::{Error, Result};

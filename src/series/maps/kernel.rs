@@ -4,11 +4,11 @@
 //! of the kernel: the same f32 operations, function by function (the lens
 //! functions are `field.wgsl`'s, twinned in [`crate::field::cpu`]).
 //!
-//! The f64 reference is [`super::maps::frame_maps`]; the twin and the kernel
+//! The f64 reference is [`super::frame_maps`]; the twin and the kernel
 //! agree with it to f32 rounding of the track (see `tests/maps_gpu.rs`).
 
-use super::maps::{plan, FrameMaps, MapRays, MapsJob, Plan};
-use super::maps_line::LineMotion;
+use super::line::LineMotion;
+use super::{plan, FrameMaps, MapRays, MapsJob, Plan};
 use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::field::FlowParams;
@@ -187,7 +187,7 @@ fn pack_line(m: &LineMotion, steps: &mut [StepGpu]) -> LineGpu {
 
 /// Runs `dispatch(params, lines, steps)` over the job's frame's lines
 /// (split so a dispatch's motion samples stay under `step_bytes`) and
-/// returns the plan; `None` as [`super::maps::frame_maps`].
+/// returns the plan; `None` as [`super::frame_maps`].
 /// `params.groups_x` is for a 1-D grid of `n_lines * line_len` threads in
 /// up to [`MAX_DISPATCH`] columns.
 pub(crate) fn drive(
@@ -238,7 +238,7 @@ pub(crate) fn unpack(plan: &Plan, index: usize, out: &[f32]) -> FrameMaps {
 }
 
 /// The blur fields of a job's frame by the CPU twin of `shaders/maps.wgsl`
-/// (f32, rayon), in the kernel's dispatches; as [`super::maps::frame_maps`].
+/// (f32, rayon), in the kernel's dispatches; as [`super::frame_maps`].
 pub fn frame_maps_twin(job: &MapsJob) -> Result<Option<FrameMaps>> {
     let cam = &job.opts.scene.camera;
     let n = cam.width as usize * cam.height as usize;
@@ -404,7 +404,7 @@ mod tests {
 
     #[test]
     fn shader_constants_and_struct_sizes_match_host() {
-        let m = naga::front::wgsl::parse_str(super::super::maps_gpu::MAPS_WGSL).expect("parses");
+        let m = naga::front::wgsl::parse_str(super::super::gpu::MAPS_WGSL).expect("parses");
         assert_eq!(shader_const(&m, "WG"), WG);
         assert_eq!(m.entry_points.len(), 1);
         assert_eq!(m.entry_points[0].workgroup_size, [WG, 1, 1]);
@@ -438,7 +438,7 @@ mod tests {
     fn lens_functions_are_copies_of_field_wgsl() {
         // Their CPU twins are field.wgsl's: the copies must not drift.
         let field = crate::field::gpu::FIELD_WGSL;
-        let maps = super::super::maps_gpu::MAPS_WGSL;
+        let maps = super::super::gpu::MAPS_WGSL;
         for f in [
             "atan_poly",
             "fisheye_theta_d",

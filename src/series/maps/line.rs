@@ -1,6 +1,6 @@
 //! One line of a frame's maps: its motion over its exposure ([`LineMotion`],
 //! which the GPU path packs) and its track in f64, the CPU path of
-//! [`super::maps::frame_maps`] (the motion as matrices, each pixel
+//! [`super::frame_maps`] (the motion as matrices, each pixel
 //! projected through them).
 
 use crate::camera::Camera;

@@ -1,11 +1,11 @@
 //! The GPU path of `frames --maps`: the compiled `shaders/maps.wgsl` and a
 //! runner that keeps the camera's rays on the device and dispatches a
-//! frame's lines. CPU twin: [`super::maps_kernel::frame_maps_twin`]; the
+//! frame's lines. CPU twin: [`super::kernel::frame_maps_twin`]; the
 //! packing and the dispatch loop are shared with it
-//! ([`super::maps_kernel`]).
+//! ([`super::kernel`]).
 
-use super::maps::{FrameMaps, MapsJob};
-use super::maps_kernel::{self as mk, LineGpu, MapsParams, StepGpu, PLANES};
+use super::kernel::{self as mk, LineGpu, MapsParams, StepGpu, PLANES};
+use super::{FrameMaps, MapsJob};
 use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::gpu::compute::{
@@ -16,7 +16,7 @@ use std::sync::atomic::AtomicBool;
 use std::sync::OnceLock;
 
 /// The WGSL source of the maps kernel.
-pub const MAPS_WGSL: &str = include_str!("../../shaders/maps.wgsl");
+pub const MAPS_WGSL: &str = include_str!("../../../shaders/maps.wgsl");
 
 struct Kernel {
     bgl: wgpu::BindGroupLayout,
@@ -116,7 +116,7 @@ impl MapsRunner {
         Ok(())
     }
 
-    /// The maps of a frame on the GPU, as [`super::maps::frame_maps`]
+    /// The maps of a frame on the GPU, as [`super::frame_maps`]
     /// (f32 throughout; the lens must be one [`mk::check_lens`] accepts).
     pub fn frame_maps(&mut self, job: &MapsJob) -> Result<Option<FrameMaps>> {
         let cam = job.opts.scene.camera;

@@ -21,8 +21,11 @@
 //! point is lost (behind the camera or off the plane) are NaN in every
 //! channel.
 
-use super::maps_line::LineMotion;
-use super::SeriesOptions;
+pub mod gpu;
+pub mod kernel;
+mod line;
+pub mod write;
+
 use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::io::frames::VideoFrame;
@@ -30,6 +33,8 @@ pub use crate::limits::MAX_MAP_PIXELS;
 use crate::model::log::ImuLog;
 use crate::model::motion::Plane;
 use crate::model::trajectory::Trajectory;
+use crate::series::SeriesOptions;
+use line::LineMotion;
 use rayon::prelude::*;
 
 /// Channels of a frame's maps, in the EXR's order of [`FrameMaps::channels`].
@@ -240,8 +245,8 @@ pub(crate) struct Plan {
 
 /// One frame's maps to compute: the arguments of [`frame_maps`], as the
 /// GPU path and its twin take them
-/// ([`super::maps_gpu::MapsRunner::frame_maps`],
-/// [`super::maps_kernel::frame_maps_twin`]).
+/// ([`gpu::MapsRunner::frame_maps`],
+/// [`kernel::frame_maps_twin`]).
 #[derive(Clone, Copy)]
 pub struct MapsJob<'a> {
     /// The motion.
@@ -366,7 +371,7 @@ impl Plan {
 /// crosses a gap in it (no motion is known there). `steps`:
 /// chords per line's exposure (`None`: about one per pixel of motion, at
 /// least 16). The readout is the frame's own, else the camera's. In f64 on
-/// the CPU (rayon); the GPU path is [`super::maps_gpu`].
+/// the CPU (rayon); the GPU path is [`gpu`].
 pub fn frame_maps(
     log: &ImuLog,
     opts: &SeriesOptions,
@@ -396,7 +401,7 @@ pub fn frame_maps(
         if stop.is_cancelled() {
             return;
         }
-        let line = super::maps_line::Line::from(plan.line(log, l));
+        let line = line::Line::from(plan.line(log, l));
         let ray = |m: usize| {
             let (i, j) = if rows { (m, l) } else { (l, m) };
             rays.rays[j * w + i]
