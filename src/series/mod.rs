@@ -9,6 +9,7 @@
 
 pub mod frames;
 pub mod gpu;
+pub mod job;
 pub mod lerp;
 pub mod maps;
 pub mod select;
