@@ -1,10 +1,10 @@
 //! The per-pixel exposure track (docs/spec.md sections 4 and 9): the image
 //! of the scene point a pixel sees at its line's exposure start, followed
 //! through the lens over that line's exposure window on a trajectory. With
-//! a rolling shutter line `l` (row or column) starts `readout_s (l + 1/2) / n`
-//! after the frame ([`crate::camera::Shutter::delay_s`] at the line's
-//! centre) and is exposed for `exposure_s`; with a global shutter every line
-//! starts at once.
+//! a rolling shutter line `l` of `n` (row or column, in readout order)
+//! starts `readout_s l / n` after the frame ([`crate::camera::Shutter::delay_s`]
+//! at the line's centre) and is exposed for `exposure_s`; with a global
+//! shutter every line starts at once.
 //!
 //! [`LineTrack`] is the one owner of a line's window and of the instants a
 //! track is sampled at (`steps + 1`, uniform, `steps` chords): the
@@ -125,8 +125,8 @@ mod tests {
     use super::*;
     use crate::model::motion::Twist;
 
-    /// A line's window starts at its centre's readout delay: row 99 of 100
-    /// under a 20 ms readout starts at 20 ms x 99.5 / 100; its poses are the
+    /// A line's window starts at its readout delay: row 99 of 100 under a
+    /// 20 ms readout starts at 20 ms x 99 / 100; its poses are the
     /// trajectory's at the window's uniform instants.
     #[test]
     fn a_lines_window_is_its_readout_delay_plus_the_exposure() {
@@ -140,7 +140,7 @@ mod tests {
         let traj = Trajectory::from_twist(Twist::new(DVec3::new(0.0, 0.0, 1.0), DVec3::ZERO), 0.03)
             .unwrap();
         let t = LineTrack::line(&traj, &shutter, &cam, 99, 0.01, 4);
-        assert!((t.t0 - 0.02 * 99.5 / 100.0).abs() < 1e-15);
+        assert!((t.t0 - 0.02 * 99.0 / 100.0).abs() < 1e-15);
         assert_eq!(t.poses.len(), 5);
         // About the optical axis at 1 rad/s: the angle turned is the time.
         let angle = |p: &Pose| p.0.to_axis_angle().1;
