@@ -3,7 +3,7 @@
 //! what `mmbm frames --maps` computes before writing each EXR), pinhole and
 //! through a wide-angle lens, on one thread and on all cores, and the
 //! throughput for a minute of 60 fps video; then the GPU path
-//! (`series::maps_gpu`, `src/series/maps.wgsl`) where an adapter exists, with
+//! (`series::maps::gpu`, `src/series/maps/maps.wgsl`) where an adapter exists, with
 //! its largest difference per pixel from its CPU twin and from the f64
 //! maps at full size. The motion is the shared
 //! running log's (`../shared/data/running_phone`, its blurriest frames) when
@@ -18,9 +18,9 @@ use mmbm::error::{Error, Result};
 use mmbm::io::frames::VideoFrame;
 use mmbm::io::gyro::{read_log, GyroOptions, GyroSample};
 use mmbm::model::log::ImuLog;
+use mmbm::series::maps::gpu::MapsRunner;
+use mmbm::series::maps::kernel::frame_maps_twin;
 use mmbm::series::maps::{frame_maps, FrameMaps, MapRays, MapsJob};
-use mmbm::series::maps_gpu::MapsRunner;
-use mmbm::series::maps_kernel::frame_maps_twin;
 use mmbm::series::SeriesOptions;
 use mmbm::{Method, Scene};
 use std::path::PathBuf;

@@ -22,9 +22,9 @@ use mmbm::camera::{Distortion, Readout, Shutter};
 use mmbm::gpu::Backend;
 use mmbm::io::frames::VideoFrame;
 use mmbm::model::log::ImuLog;
+use mmbm::series::maps::gpu::{resolve, MapsRunner};
+use mmbm::series::maps::kernel::frame_maps_twin;
 use mmbm::series::maps::{frame_maps, FrameMaps, MapRays, MapsJob};
-use mmbm::series::maps_gpu::{resolve, MapsRunner};
-use mmbm::series::maps_kernel::frame_maps_twin;
 use mmbm::series::SeriesOptions;
 use mmbm::{Camera, Plane};
 

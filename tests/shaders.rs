@@ -27,7 +27,7 @@ fn validate(path: &Path) -> Result<(), String> {
 fn joined() -> [(&'static str, &'static str); 4] {
     [
         ("field (lens + field.wgsl)", mmbm::field::FIELD_WGSL),
-        ("maps (lens + maps.wgsl)", mmbm::series::maps_gpu::MAPS_WGSL),
+        ("maps (lens + maps.wgsl)", mmbm::series::maps::gpu::MAPS_WGSL),
         ("render (prelude + render.wgsl)", mmbm::render::RENDER_WGSL),
         (
             "texture (prelude + texture.wgsl)",
@@ -94,7 +94,7 @@ fn shared_modules_are_joined_not_copied() {
     let (lens, prelude) = (read("gpu/lens.wgsl"), read("render/prelude.wgsl"));
     for (joined, module, own) in [
         (mmbm::field::FIELD_WGSL, &lens, "field/field.wgsl"),
-        (mmbm::series::maps_gpu::MAPS_WGSL, &lens, "series/maps.wgsl"),
+        (mmbm::series::maps::gpu::MAPS_WGSL, &lens, "series/maps/maps.wgsl"),
         (mmbm::render::RENDER_WGSL, &prelude, "render/render.wgsl"),
         (mmbm::render::TEXTURE_WGSL, &prelude, "render/texture.wgsl"),
     ] {
@@ -106,7 +106,7 @@ fn shared_modules_are_joined_not_copied() {
             &["fn distort(", "fn jacobian(", "fn atan_poly("][..],
         ),
         (
-            "series/maps.wgsl",
+            "series/maps/maps.wgsl",
             &["fn distort(", "fn jacobian(", "fn atan_poly("][..],
         ),
         (
@@ -161,8 +161,8 @@ fn host_structs_match_the_joined_shaders() {
             size_of::<mmbm::field::FlowParams>(),
         ),
         (
-            mmbm::series::maps_gpu::MAPS_WGSL,
-            size_of::<mmbm::series::maps_kernel::MapsParams>(),
+            mmbm::series::maps::gpu::MAPS_WGSL,
+            size_of::<mmbm::series::maps::kernel::MapsParams>(),
         ),
     ] {
         assert_eq!(struct_size(src, "Lens"), lens);

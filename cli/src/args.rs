@@ -152,7 +152,8 @@ pub fn report_log_readout(session: &mmbm::trigger::Session, gyro: &Path) {
     }
 }
 
-fn print_log_readout(camera: &Camera, gyro: &Path) {
+/// Says on stderr that `camera` took the rolling shutter of the log `gyro`.
+pub fn print_log_readout(camera: &Camera, gyro: &Path) {
     eprintln!(
         "rolling shutter from {}: readout {} s, {:?}",
         gyro.display(),

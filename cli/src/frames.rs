@@ -5,11 +5,10 @@ use super::series::GyroArgs;
 use clap::Args;
 use mmbm::error::{Error, Result};
 use mmbm::io::frames::read_frame_table;
-use mmbm::series::frames::frame_mmbm;
-use mmbm::series::maps_write::{is_map_name, parse_channels, stage_maps, MapsFormat, MapsOutput};
+use mmbm::series::job::{FramesConfig, FramesJob};
+use mmbm::series::maps::write::{is_map_name, parse_channels, stage_maps, MapsFormat, MapsOutput};
 use mmbm::series::select::clock::{check_clock, Spans};
-use mmbm::series::SeriesOptions;
-use mmbm::{AnyMethod, Scene};
+use mmbm::AnyMethod;
 use std::io::Write;
 use std::path::PathBuf;
 
@@ -166,22 +165,26 @@ pub fn run(a: FramesArgs) -> Result<()> {
         telemetry.gyro.time_offset = s.offset_s;
     }
     let samples = mmbm::telemetry::read_gyro(&a.gyro, &telemetry)?;
-    let camera = super::args::with_log_readout(camera, samples.readout(), &a.gyro)?;
-    let camera = match (&synced, &a.sync) {
-        (Some(s), Some(path)) => {
-            super::sync::synced_readout(camera, s, path, a.camera.rolling_readout.is_some())
-        }
-        _ => camera,
-    };
-    let opts = SeriesOptions {
-        scene: Scene {
-            camera,
-            plane: a.scene.plane()?,
-        },
+    // The job: the camera with the log's readout applied once, then the
+    // sync file's where neither the camera nor the log gave one.
+    let cfg = FramesConfig {
+        camera,
+        plane: a.scene.plane()?,
         method,
         use_velocity: a.use_velocity,
     };
-    let (rows, outside) = frame_mmbm(&samples, &opts, &frames)?;
+    let job = FramesJob::new(cfg, samples.readout())?;
+    if job.readout_from_log() {
+        super::args::print_log_readout(job.camera(), &a.gyro);
+    }
+    let job = match (&synced, &a.sync) {
+        (Some(s), Some(path)) => job.map_camera(|c| {
+            super::sync::synced_readout(c, s, path, a.camera.rolling_readout.is_some())
+        })?,
+        _ => job,
+    };
+    let camera = *job.camera();
+    let (rows, outside) = job.mmbm(&samples, &frames)?;
     let log_t: Vec<f64> = samples.samples().iter().map(|s| s.t).collect();
     let spans = Spans::of(&rows, &log_t);
     let offset = a.gyro_opts.time_offset;
@@ -236,13 +239,19 @@ pub fn run(a: FramesArgs) -> Result<()> {
     // together once all were written, or none does.
     let staged = match &a.maps {
         Some(dir) => Some(stage_maps(
-            &samples, &opts, &frames, keep, dir, a.backend, &maps_out,
+            &samples,
+            job.series(),
+            &frames,
+            keep,
+            dir,
+            a.backend,
+            &maps_out,
         )?),
         None => None,
     };
     let extracted = match (&a.choice.extract, &a.choice.video) {
         (Some(dir), Some(video)) => {
-            let mut staged = mmbm::series::maps_write::StagedMaps::empty(dir)?;
+            let mut staged = mmbm::series::maps::write::StagedMaps::empty(dir)?;
             let names = mmbm::series::select::video::extract(
                 video,
                 keep,

@@ -46,7 +46,7 @@ fn motion(
             let g = gyro.ok_or_else(|| PyValueError::new_err("motion 'log': give gyro"))?;
             let at = at.ok_or_else(|| PyValueError::new_err("motion 'log': give at (s)"))?;
             Motion::Log {
-                samples: crate::dict_samples(&g)?,
+                samples: crate::args::dict_samples(&g)?,
                 at,
             }
         }

@@ -2,8 +2,12 @@
 //! takes contiguous float64 NumPy arrays whose shapes the Python half
 //! (`mmbm/__init__.py`) has already checked and broadcast, calls the mmbm
 //! library with the GIL released, and returns NumPy arrays. Library errors
-//! become `OSError` (files) or `ValueError` (everything else).
+//! become `OSError` (files) or `ValueError` (everything else). The
+//! arguments every function shares (camera, plane, log, frame table,
+//! method) are turned into the library's types in one place, [`args`]; the
+//! jobs are the library's (`series::job::FramesJob`, `RenderJob::for_motion`).
 
+mod args;
 mod augment;
 mod camera;
 mod dataset;
@@ -13,12 +17,11 @@ mod telemetry;
 use camera::{camera, camera_json};
 use glam::DVec3;
 use mmbm::camera::Camera;
-use mmbm::gpu::Backend;
 use mmbm::io::gyro::{parse_rotation, GyroOptions, GyroSample};
-use mmbm::metric::{AnyMethod, Scene};
+use mmbm::metric::AnyMethod;
 use mmbm::model::log::ImuLog;
-use mmbm::model::motion::{Plane, Twist};
-use mmbm::render::{FrameMotion, Integrator, Quality, RenderJob, Target};
+use mmbm::model::motion::Twist;
+use mmbm::render::{Integrator, Quality, RenderJob, Target};
 use mmbm::trigger::CameraTiming;
 use numpy::ndarray::{Array1, Array2, Array3};
 use numpy::{IntoPyArray, PyReadonlyArray1, PyReadonlyArray2};
@@ -35,29 +38,6 @@ fn err(e: mmbm::Error) -> PyErr {
         mmbm::Error::Io { .. } => PyOSError::new_err(e.to_string()),
         _ => PyValueError::new_err(e.to_string()),
     }
-}
-
-fn plane(p: Option<PyReadonlyArray1<f64>>) -> PyResult<Option<Plane>> {
-    let Some(p) = p else { return Ok(None) };
-    let v = p.as_slice()?;
-    if v.len() != 4 {
-        return Err(PyValueError::new_err("plane: expected (nx, ny, nz, d)"));
-    }
-    Ok(Some(Plane {
-        normal: DVec3::new(v[0], v[1], v[2]),
-        d: v[3],
-    }))
-}
-
-fn rows3(a: &PyReadonlyArray2<f64>) -> PyResult<Vec<DVec3>> {
-    let v = a.as_array();
-    if v.ncols() != 3 {
-        return Err(PyValueError::new_err("expected an (N, 3) array"));
-    }
-    Ok(v.rows()
-        .into_iter()
-        .map(|r| DVec3::new(r[0], r[1], r[2]))
-        .collect())
 }
 
 /// Reads a camera file (TOML or JSON): its every key, as JSON (the fields
@@ -90,12 +70,9 @@ fn metric<'py>(
     plane_: Option<PyReadonlyArray1<'py, f64>>,
     method: &str,
 ) -> PyResult<Bound<'py, numpy::PyArray1<f64>>> {
-    let scene = Scene {
-        camera: camera(&cam)?,
-        plane: plane(plane_)?,
-    };
+    let scene = args::scene(&cam, plane_)?;
     let method: AnyMethod = method.parse().map_err(err)?;
-    let (w, v) = (rows3(&omega)?, rows3(&velocity)?);
+    let (w, v) = (args::rows3(&omega)?, args::rows3(&velocity)?);
     let long = w.len() > interrupt::SMALL_ROWS || matches!(method, AnyMethod::Gpu { .. });
     let out = interrupt::interruptible_if(py, err, long, || {
         w.iter()
@@ -114,19 +91,6 @@ fn metric<'py>(
             .collect::<mmbm::Result<Vec<f64>>>()
     })?;
     Ok(Array1::from(out).into_pyarray(py))
-}
-
-/// Gyro samples from a log's arrays (the Python side checked the lengths).
-fn log_samples(t: &[f64], w: &[DVec3], v: Option<&[DVec3]>, d: Option<&[f64]>) -> Vec<GyroSample> {
-    t.iter()
-        .enumerate()
-        .map(|(k, &t)| GyroSample {
-            t,
-            omega: w[k],
-            velocity: v.map(|v| v[k]),
-            depth: d.map(|d| d[k]),
-        })
-        .collect()
 }
 
 /// Exposure MMBM (mm/s, each line over its own rolling-shutter window) and
@@ -150,28 +114,10 @@ fn frames<'py>(
     Bound<'py, numpy::PyArray1<f64>>,
     Bound<'py, numpy::PyArray1<f64>>,
 )> {
-    let samples = log_samples(t.as_slice()?, &rows3(&omega)?, None, None);
-    let (ts, es) = (t_start.as_slice()?, exposure_s.as_slice()?);
-    let rs = readout_s.as_ref().map(|r| r.as_slice()).transpose()?;
-    let video: Vec<mmbm::io::frames::VideoFrame> = (0..ts.len())
-        .map(|k| mmbm::io::frames::VideoFrame {
-            t_start: ts[k],
-            exposure_s: es[k],
-            readout_s: rs.map(|r| r[k]),
-        })
-        .collect();
-    let cam = camera(&cam)?;
-    let opts = mmbm::series::SeriesOptions {
-        scene: Scene {
-            camera: cam,
-            plane: None,
-        },
-        method: method.parse().map_err(err)?,
-        use_velocity: false,
-    };
-    let (rows, _) = interruptible(py, err, || {
-        mmbm::series::frames::frame_mmbm(&samples, &opts, &video)
-    })?;
+    let samples = args::samples(&t, &omega, None, None)?;
+    let video = args::video_frames(&t_start, &exposure_s, readout_s.as_ref())?;
+    let job = args::frames_job(&cam, Some(method))?;
+    let (rows, _) = interruptible(py, err, || job.mmbm(&samples, &video))?;
     let e: Vec<f64> = rows
         .iter()
         .map(|r| r.exposure_mm_s.unwrap_or(f64::NAN))
@@ -208,35 +154,11 @@ fn frame_maps<'py>(
     exposure_s: PyReadonlyArray1<'py, f64>,
     readout_s: Option<PyReadonlyArray1<'py, f64>>,
 ) -> PyResult<Vec<Option<Bound<'py, numpy::PyArray3<f32>>>>> {
-    let samples = log_samples(t.as_slice()?, &rows3(&omega)?, None, None);
-    let (ts, es) = (t_start.as_slice()?, exposure_s.as_slice()?);
-    let rs = readout_s.as_ref().map(|r| r.as_slice()).transpose()?;
-    let video: Vec<mmbm::io::frames::VideoFrame> = (0..ts.len())
-        .map(|k| mmbm::io::frames::VideoFrame {
-            t_start: ts[k],
-            exposure_s: es[k],
-            readout_s: rs.map(|r| r[k]),
-        })
-        .collect();
-    let cam = camera(&cam)?;
-    let opts = mmbm::series::SeriesOptions {
-        scene: Scene {
-            camera: cam,
-            plane: None,
-        },
-        method: mmbm::Method::Riemann { nu: 8, nv: 6 },
-        use_velocity: false,
-    };
-    let maps = interruptible(py, err, || {
-        let log = mmbm::model::log::ImuLog::new(samples)?;
-        let rays = mmbm::series::maps::MapRays::new(&cam)?;
-        video
-            .iter()
-            .enumerate()
-            .map(|(k, f)| mmbm::series::maps::frame_maps(&log, &opts, &rays, k, f, None))
-            .collect::<mmbm::Result<Vec<_>>>()
-    })?;
-    let (w, h) = (cam.width as usize, cam.height as usize);
+    let samples = args::samples(&t, &omega, None, None)?;
+    let video = args::video_frames(&t_start, &exposure_s, readout_s.as_ref())?;
+    let job = args::frames_job(&cam, None)?;
+    let maps = interruptible(py, err, || job.maps(&ImuLog::new(samples)?, &video, None))?;
+    let (w, h) = (job.camera().width as usize, job.camera().height as usize);
     maps.into_iter()
         .map(|m| {
             m.map(|m| {
@@ -268,20 +190,11 @@ fn series<'py>(
     plane_: Option<PyReadonlyArray1<'py, f64>>,
     method: &str,
 ) -> PyResult<Bound<'py, numpy::PyArray1<f64>>> {
-    let w = rows3(&omega)?;
-    let v = velocity.as_ref().map(rows3).transpose()?;
-    let d = depth
-        .as_ref()
-        .map(|d| d.as_slice().map(|s| s.to_vec()))
-        .transpose()?;
-    let samples = log_samples(t.as_slice()?, &w, v.as_deref(), d.as_deref());
+    let samples = args::samples(&t, &omega, velocity.as_ref(), depth.as_ref())?;
     let opts = mmbm::series::SeriesOptions {
-        scene: Scene {
-            camera: camera(&cam)?,
-            plane: plane(plane_)?,
-        },
-        method: method.parse().map_err(err)?,
-        use_velocity: v.is_some(),
+        scene: args::scene(&cam, plane_)?,
+        method: args::method(method)?,
+        use_velocity: velocity.is_some(),
     };
     let out = interruptible(py, err, || mmbm::series::mmbm_series_with(&samples, &opts))?;
     Ok(Array1::from(out).into_pyarray(py))
@@ -348,10 +261,6 @@ fn samples_dict<'py>(py: Python<'py>, s: &[GyroSample]) -> PyResult<Bound<'py, P
     Ok(d)
 }
 
-fn backend(b: &str) -> PyResult<Backend> {
-    b.parse::<Backend>().map_err(err)
-}
-
 /// The flow field (px/s) at every pixel centre: `(H, W, 2)` float32.
 #[pyfunction]
 #[pyo3(signature = (cam, omega, velocity, plane_, backend_))]
@@ -363,12 +272,9 @@ fn flow_field<'py>(
     plane_: Option<PyReadonlyArray1<'py, f64>>,
     backend_: &str,
 ) -> PyResult<Bound<'py, numpy::PyArray3<f32>>> {
-    let scene = Scene {
-        camera: camera(&cam)?,
-        plane: plane(plane_)?,
-    };
+    let scene = args::scene(&cam, plane_)?;
     let tw = Twist::new(DVec3::from(omega), DVec3::from(velocity));
-    let b = backend(backend_)?;
+    let b = args::backend(backend_)?;
     let f = interruptible(py, err, || mmbm::field::flow_field(&scene, &tw, 0, 0, b))?;
     let (w, h) = (f.width as usize, f.height as usize);
     let a = Array3::from_shape_fn((h, w, 2), |(y, x, c)| {
@@ -414,28 +320,13 @@ fn render<'py>(
     if let Some(b) = background {
         t.background = [b[0] as f32, b[1] as f32, b[2] as f32];
     }
-    let log = match (&omega, &gyro) {
-        (None, Some(g)) => Some(ImuLog::new(dict_samples(g)?).map_err(err)?),
-        _ => None,
-    };
-    let motion = match (omega, &log) {
-        (Some(w), None) => FrameMotion::Twist(Twist::new(DVec3::from(w), DVec3::from(velocity))),
-        (None, Some(log)) => FrameMotion::Log {
-            log,
-            at_s: at.ok_or_else(|| PyValueError::new_err("at: required with gyro"))?,
-            use_velocity,
-        },
-        _ => {
-            return Err(PyValueError::new_err(
-                "motion: give either omega or gyro (with at)",
-            ))
-        }
-    };
+    let log = args::render_log(omega, gyro.as_ref())?;
+    let motion = args::motion(omega, velocity, log.as_ref(), at, use_velocity)?;
     // The motion spans the camera's busy time (readout plus exposure), as in
     // `mmbm render`.
     let mut job = RenderJob::for_motion(camera, exposure, motion, t).map_err(err)?;
     job.quality = quality.parse::<Quality>().map_err(err)?;
-    job.backend = backend(backend_)?;
+    job.backend = args::backend(backend_)?;
     job.seed = seed;
     job.integrator = integrator.parse::<Integrator>().map_err(err)?;
     job.with_maps = maps;
@@ -468,24 +359,6 @@ fn render<'py>(
         None => py.None().into_bound(py),
     };
     Ok((img, m))
-}
-
-/// Samples from a `{t, omega[, velocity][, depth]}` dict of arrays.
-pub(crate) fn dict_samples(g: &Bound<'_, PyDict>) -> PyResult<Vec<GyroSample>> {
-    let get = |k: &str| g.get_item(k);
-    let t: Vec<f64> = get("t")?
-        .ok_or_else(|| PyValueError::new_err("gyro: missing 't'"))?
-        .extract()?;
-    let w: Vec<[f64; 3]> = get("omega")?
-        .ok_or_else(|| PyValueError::new_err("gyro: missing 'omega'"))?
-        .extract()?;
-    let v: Option<Vec<[f64; 3]>> = get("velocity")?.map(|x| x.extract()).transpose()?;
-    if w.len() != t.len() || v.as_ref().is_some_and(|v| v.len() != t.len()) {
-        return Err(PyValueError::new_err("gyro: arrays of different lengths"));
-    }
-    let w: Vec<DVec3> = w.into_iter().map(DVec3::from).collect();
-    let v: Option<Vec<DVec3>> = v.map(|v| v.into_iter().map(DVec3::from).collect());
-    Ok(log_samples(&t, &w, v.as_deref(), None))
 }
 
 /// A simulated gait log: `{t, omega, velocity}`.

@@ -1,6 +1,6 @@
 //! The kernels' one lens: `lens.wgsl` (joined at build in front of the
 //! field and maps kernels, `crate::field::gpu::FIELD_WGSL`,
-//! `crate::series::maps_gpu::MAPS_WGSL`), its host struct [`LensGpu`]
+//! `crate::series::maps::gpu::MAPS_WGSL`), its host struct [`LensGpu`]
 //! (every kernel's `Params` holds one) and the CPU twin of each of its
 //! functions, with the same names and f32 operations.
 //!
@@ -10,7 +10,7 @@
 //! host computes the lens with the library's f64 camera code and the kernel
 //! reads its table (the field kernel's per grid sample,
 //! `crate::field::table`; the maps kernel's over the undistorted plane,
-//! `crate::series::maps_table`).
+//! `crate::series::maps::table`).
 
 use bytemuck::{Pod, Zeroable};
 

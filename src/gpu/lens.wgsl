@@ -12,7 +12,7 @@
 // evaluates with the same operations. Every other model is table mode
 // (model 3): the host computes the lens's values with the library's f64
 // camera code and the kernel reads them (each kernel's table is its own:
-// src/field/table.rs, src/series/maps_table.rs).
+// src/field/table.rs, src/series/maps/table.rs).
 
 // The lens of a kernel's Params. Must match `LensGpu` (32 bytes).
 struct Lens {

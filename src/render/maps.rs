@@ -5,9 +5,12 @@
 //! the "exposure MMBM". Pixels whose scene point is missing (ray misses the
 //! target, or the point goes behind the camera, or the pixel lies beyond the
 //! lens's radial distortion limit) are NaN and left out of the means.
+//! The track itself (each line's window and poses, the projection through
+//! the lens, the chords) is [`crate::model::track`]'s.
 
 use super::target::Target;
 use crate::camera::Camera;
+use crate::model::track::{self, LineTrack};
 use crate::model::trajectory::{Pose, Trajectory};
 use glam::{DMat3, DVec3};
 use rayon::prelude::*;
@@ -89,23 +92,10 @@ impl BlurMaps {
 /// A pixel without a track: path, displacement (px) and path (mm) NaN.
 const NO_TRACK: (f32, f32, f64) = (f32::NAN, f32::NAN, f64::NAN);
 
-/// Poses at `steps + 1` uniform times, as (world-to-camera rotation, centre).
+/// Poses at `steps + 1` uniform times over the whole trajectory, as
+/// (world-to-camera rotation, centre) ([`LineTrack::whole`]).
 fn inv_poses(traj: &Trajectory, steps: usize) -> Vec<(DMat3, DVec3)> {
-    traj.table(steps)
-        .iter()
-        .map(|(q, c)| (DMat3::from_quat(q.inverse()), *c))
-        .collect()
-}
-
-fn proj(cam: &Camera, p: &(DMat3, DVec3), x: DVec3) -> Option<(f64, f64)> {
-    let pc = p.0 * (x - p.1);
-    (pc.z > 1e-12).then(|| {
-        if cam.distortion.is_none() {
-            cam.mm_to_pixel(cam.focal_mm * pc.x / pc.z, cam.focal_mm * pc.y / pc.z)
-        } else {
-            cam.ray_to_pixel(pc.x / pc.z, pc.y / pc.z)
-        }
-    })
+    LineTrack::whole(traj, steps).world_to_camera()
 }
 
 /// Image track (pixel coordinates) of the scene point seen at `(x, y)` at
@@ -136,6 +126,15 @@ pub fn tracks(
         .collect()
 }
 
+/// The scene point seen at pixel position `(x, y)` from pose `start`:
+/// `None` beyond the lens's radial limit or where the ray misses the target.
+fn scene_point(cam: &Camera, target: &Target, start: &Pose, x: f64, y: f64) -> Option<DVec3> {
+    if masked(cam, x, y) {
+        return None;
+    }
+    target.intersect(cam, start, x, y)
+}
+
 fn track_from(
     cam: &Camera,
     target: &Target,
@@ -143,12 +142,8 @@ fn track_from(
     x: f64,
     y: f64,
 ) -> Option<Vec<(f64, f64)>> {
-    if masked(cam, x, y) {
-        return None;
-    }
     let id: Pose = (glam::DQuat::IDENTITY, DVec3::ZERO);
-    let p0 = target.intersect(cam, &id, x, y)?;
-    poses.iter().map(|p| proj(cam, p, p0)).collect()
+    track::track(cam, poses, scene_point(cam, target, &id, x, y)?)
 }
 
 /// Path length and end-to-start displacement (px) and path length on the
@@ -164,7 +159,8 @@ fn path_disp(
     path_disp_from(cam, target, &id, poses, x, y)
 }
 
-/// [`path_disp`] for the scene point seen at `(x, y)` from pose `start`.
+/// [`path_disp`] for the scene point seen at `(x, y)` from pose `start`
+/// ([`track::path`]).
 fn path_disp_from(
     cam: &Camera,
     target: &Target,
@@ -173,25 +169,7 @@ fn path_disp_from(
     x: f64,
     y: f64,
 ) -> Option<(f64, f64, f64)> {
-    if masked(cam, x, y) {
-        return None;
-    }
-    let p0 = target.intersect(cam, start, x, y)?;
-    let first = proj(cam, &poses[0], p0)?;
-    let mut prev = first;
-    let (mut len, mut len_mm) = (0.0, 0.0);
-    for p in &poses[1..] {
-        let q = proj(cam, p, p0)?;
-        len += ((q.0 - prev.0).powi(2) + (q.1 - prev.1).powi(2)).sqrt();
-        let (a, b) = (cam.pixel_to_mm(q.0, q.1), cam.pixel_to_mm(prev.0, prev.1));
-        len_mm += (a.0 - b.0).hypot(a.1 - b.1);
-        prev = q;
-    }
-    Some((
-        len,
-        ((prev.0 - first.0).powi(2) + (prev.1 - first.1).powi(2)).sqrt(),
-        len_mm,
-    ))
+    track::path(cam, poses, scene_point(cam, target, start, x, y)?)
 }
 
 /// True for a pixel position beyond the lens's radial distortion limit: no ray.
@@ -297,15 +275,9 @@ fn blur_maps_rolling(
             if stop.is_cancelled() {
                 return vec![NO_TRACK; len];
             }
-            let c = l as f64 + 0.5;
-            let t0 = cam.shutter.delay_s(c, c, cam.width, cam.height);
-            let start = traj.pose_at(t0);
-            let poses: Vec<(DMat3, DVec3)> = (0..=steps)
-                .map(|k| {
-                    let (q, c) = traj.pose_at(t0 + te * k as f64 / steps as f64);
-                    (DMat3::from_quat(q.inverse()), c)
-                })
-                .collect();
+            // The line's window and poses: the one per-pixel track's.
+            let line = LineTrack::line(traj, &cam.shutter, cam, l, te, steps);
+            let (start, poses) = (line.start, line.world_to_camera());
             (0..len)
                 .map(|m| {
                     let (i, j) = if rows { (m, l) } else { (l, m) };

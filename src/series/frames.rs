@@ -18,6 +18,7 @@
 //! line). `exact` (adaptive cubature of the window-averaged speed) is for
 //! global shutters only: with a readout the integrand jumps at every line.
 
+use super::job::FrameWindow;
 use super::lerp::{instant_speed, window_speed};
 use super::{sample_scene, SeriesOptions};
 use crate::camera::{Camera, Shutter};
@@ -54,6 +55,16 @@ impl FrameMmbm {
     /// Blur length over the exposure, px: the exposure MMBM in px/s x `t_e`.
     pub fn blur_px(&self) -> Option<f64> {
         self.exposure_px_s.map(|p| p * self.exposure_s)
+    }
+
+    /// The last line's exposure end, s: `t_start` plus the shutter's busy
+    /// time ([`FrameWindow::end_s`]).
+    pub fn end_s(&self) -> f64 {
+        let shutter = Shutter {
+            readout_s: self.readout_s,
+            ..Shutter::global()
+        };
+        self.t_start + shutter.busy_s(self.exposure_s)
     }
 }
 
@@ -156,7 +167,7 @@ fn check_frame_times(samples: &[GyroSample], frames: &[VideoFrame]) -> Result<()
 
 /// Exposure MMBM (and the instantaneous MMBM at the start) of every frame.
 /// A frame's readout is its own (`readout_s` of the table) or else the
-/// camera's. Frames whose window `[t_start, t_start + t_r + t_e]` is not
+/// camera's. Frames whose window ([`FrameWindow`]: `[t_start, t_start + t_e + t_r]`) is not
 /// inside the log get `None` values; their indices are returned as well.
 /// Every frame is checked first ([`VideoFrame::check`]).
 pub fn frame_mmbm(
@@ -190,9 +201,10 @@ pub fn frame_mmbm(
     let mut outside = Vec::new();
     for (k, f) in frames.iter().enumerate() {
         crate::cancel::check()?;
-        f.check()
-            .map_err(|(column, message)| Error::invalid(format!("frame {k}: {column}"), message))?;
-        let readout = f.readout_s.unwrap_or(cam.shutter.readout_s);
+        // The frame's window: its own readout, else the camera's; the span
+        // is the shutter's busy time (super::job).
+        let win = FrameWindow::of(&cam, k, f)?;
+        let readout = win.readout_s();
         if readout > 0.0 && groups.is_none() {
             return Err(Error::invalid(
                 "method",
@@ -205,7 +217,7 @@ pub fn frame_mmbm(
                 ),
             ));
         }
-        let (a, b) = (f.t_start, f.t_start + readout + f.exposure_s);
+        let (a, b) = (win.t_start, win.end_s());
         let mut r = FrameMmbm {
             frame: k,
             t_start: f.t_start,
@@ -253,10 +265,7 @@ pub fn frame_mmbm(
                 let Method::Exact { tol } = opts.method else {
                     unreachable!()
                 };
-                let shutter = Shutter {
-                    readout_s: readout,
-                    direction: cam.shutter.direction,
-                };
+                let shutter = win.shutter;
                 // Beyond the lens's radial distortion limit no ray: 0 there,
                 // and the mean over the unmasked share (as `exact` does).
                 let valid = cam.valid_fraction();

@@ -9,13 +9,9 @@
 
 pub mod frames;
 pub mod gpu;
+pub mod job;
 pub mod lerp;
 pub mod maps;
-pub mod maps_gpu;
-pub mod maps_kernel;
-mod maps_line;
-pub mod maps_table;
-pub mod maps_write;
 pub mod select;
 
 use crate::error::{Error, Result};

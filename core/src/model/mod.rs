@@ -8,6 +8,7 @@
 pub mod flow;
 pub mod log;
 pub mod motion;
+pub mod track;
 pub mod trajectory;
 
 pub use crate::camera::Camera;

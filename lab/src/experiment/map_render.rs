@@ -88,16 +88,15 @@ pub fn judge_at_lights(
     lights: &[Light],
 ) -> Result<Vec<Judged>> {
     let cam = Camera { noise: None, ..cam };
-    let rolling = cam.shutter.readout_s;
     let exposure = frame.exposure_s();
-    let (distance, traj) = frame_motion(walk, frame, rolling)?;
+    let (distance, traj) = frame_motion(walk, frame, &cam)?;
     let mut target = Target::parse(target, distance)?;
     target.surround = surround;
     let mut job = bulk_job(cam, exposure, &traj, &target, quality, seed);
     job.with_maps = false;
     let out = render::render_frame(&job)?;
     // True blob centres at mid-exposure, as the experiment's measure.
-    let mid = traj.pose_at(0.5 * (exposure + rolling));
+    let mid = traj.pose_at(0.5 * cam.shutter.busy_s(exposure));
     let expected: Vec<(f64, f64)> = target
         .blob_centres()
         .unwrap_or_default()

@@ -7,7 +7,7 @@ use super::walk::Walk;
 use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::io::images::to_rgb8;
-use crate::render::{self, Backend, Quality, RenderJob, Target, Trajectory};
+use crate::render::{self, Backend, FrameMotion, Quality, RenderJob, Target, Trajectory};
 
 use crate::trigger::Frame;
 use std::time::Instant;
@@ -228,24 +228,20 @@ pub struct Rendered {
 
 /// The walk at `frame`: the distance to the target at exposure start (m)
 /// and the camera's trajectory from the log. A rolling shutter exposes each
-/// line over its own window, so the motion spans `readout_s` plus the
-/// exposure.
-pub(crate) fn frame_motion(
-    walk: &Walk,
-    frame: &Frame,
-    readout_s: f64,
-) -> Result<(f64, Trajectory)> {
+/// line over its own window, so the motion spans `cam`'s busy time
+/// ([`FrameMotion::trajectory`]: the exposure plus the readout).
+pub(crate) fn frame_motion(walk: &Walk, frame: &Frame, cam: &Camera) -> Result<(f64, Trajectory)> {
     let i = walk
         .samples
         .partition_point(|s| s.t < frame.exposure_start)
         .min(walk.samples.len() - 1);
     let use_velocity = walk.samples[i].velocity.is_some();
-    let traj = Trajectory::from_imu_log(
-        &walk.samples,
-        frame.exposure_start,
-        frame.exposure_s() + readout_s,
+    let motion = FrameMotion::Log {
+        log: &walk.samples,
+        at_s: frame.exposure_start,
         use_velocity,
-    )?;
+    };
+    let traj = motion.trajectory(cam, frame.exposure_s())?;
     Ok((walk.distance[i], traj))
 }
 
@@ -275,9 +271,8 @@ pub fn render_and_measure(
     quality: Quality,
     seed: u32,
 ) -> Result<Rendered> {
-    let rolling = cam.shutter.readout_s;
     let exposure = frame.exposure_s();
-    let (distance, traj) = frame_motion(walk, frame, rolling)?;
+    let (distance, traj) = frame_motion(walk, frame, &cam)?;
     // Exposure control raised the gain: the system gain K scales with it
     // (the same DN from fewer electrons).
     let mut cam = cam;
@@ -300,7 +295,7 @@ pub fn render_and_measure(
     let rgb8 = to_rgb8(cam.width, cam.height, &out.rgb)?;
     // True blob centres at mid-exposure (the centroid of a smear).
     // (Rolling shutter: the middle line's mid-exposure.)
-    let mid = traj.pose_at(0.5 * (exposure + rolling));
+    let mid = traj.pose_at(0.5 * cam.shutter.busy_s(exposure));
     let frame_pl = target.frame();
     let (board, expected): (Vec<Point2>, Vec<Point2>) = target
         .blob_centres()

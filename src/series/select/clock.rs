@@ -19,10 +19,7 @@ impl Spans {
     /// when either is empty).
     pub fn of(frames: &[FrameMmbm], log_t: &[f64]) -> Option<Spans> {
         let v0 = frames.iter().map(|f| f.t_start).reduce(f64::min)?;
-        let v1 = frames
-            .iter()
-            .map(|f| f.t_start + f.exposure_s + f.readout_s)
-            .reduce(f64::max)?;
+        let v1 = frames.iter().map(|f| f.end_s()).reduce(f64::max)?;
         let g0 = log_t.iter().copied().reduce(f64::min)?;
         let g1 = log_t.iter().copied().reduce(f64::max)?;
         Some(Spans {

@@ -1,6 +1,6 @@
 //! Writing the maps of many frames (`mmbm frames --maps DIR`): one EXR per
-//! frame, computed on the backend chosen ([`super::maps_gpu::resolve`]: the
-//! GPU kernel, or the f64 path of [`super::maps`]).
+//! frame, computed on the backend chosen ([`super::gpu::resolve`]: the
+//! GPU kernel, or the f64 path of [`super`]).
 //!
 //! All or nothing: [`stage_maps`] writes every map into a hidden staging
 //! folder (`.mmbm-maps-PID-N`: inside DIR when it exists, else in its
@@ -10,13 +10,13 @@
 //! of the command was written. A failure or an interrupt before then leaves
 //! DIR as it was.
 
-use super::maps::{frame_maps, MapRays, MapsJob, CHANNELS};
-use super::select::FrameName;
-use super::SeriesOptions;
+use super::{frame_maps, MapRays, MapsJob, CHANNELS};
 use crate::error::{Error, Result};
 use crate::io::atomic::PendingDir;
 use crate::io::frames::VideoFrame;
 use crate::model::log::ImuLog;
+use crate::series::select::FrameName;
+use crate::series::SeriesOptions;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
@@ -114,12 +114,12 @@ pub struct MapsWritten {
 }
 
 /// Writes the maps of the frames `which` (rows of `frames`) to `dir`
-/// (created if missing; a camera over [`super::maps::MAX_MAP_PIXELS`] is
+/// (created if missing; a camera over [`super::MAX_MAP_PIXELS`] is
 /// refused first), one EXR each ([`file_name`]), all or none
 /// ([`stage_maps`], then [`StagedMaps::publish`]); a frame whose span leaves
 /// the log or crosses a gap in it gets none (listed in
 /// [`MapsWritten::skipped`]). `backend`: where the maps are computed
-/// ([`super::maps_gpu::resolve`]: the GPU kernel or the f64 path).
+/// ([`super::gpu::resolve`]: the GPU kernel or the f64 path).
 pub fn write_maps(
     log: &ImuLog,
     opts: &SeriesOptions,
@@ -188,11 +188,11 @@ pub fn stage_maps(
             "the maps are named after it: give a name without a folder with --maps",
         ));
     }
-    super::maps::check_size(&opts.scene.camera)?;
+    super::check_size(&opts.scene.camera)?;
     let mut staged = StagedMaps::empty(dir)?;
     let root = staged.root().to_path_buf();
     let rays = MapRays::new(&opts.scene.camera)?;
-    let mut gpu = super::maps_gpu::resolve(backend, &opts.scene.camera)?;
+    let mut gpu = super::gpu::resolve(backend, &opts.scene.camera)?;
     staged.written.adapter = gpu.as_ref().map(|g| g.adapter().to_string());
     for &k in which {
         crate::cancel::check()?;

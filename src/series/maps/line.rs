@@ -1,13 +1,15 @@
 //! One line of a frame's maps: its motion over its exposure ([`LineMotion`],
-//! which the GPU path packs) and its track in f64, the CPU path of
-//! [`super::maps::frame_maps`] (the motion as matrices, each pixel
+//! which the GPU path packs: the poses of the line's window, the one
+//! per-pixel track's [`LineTrack`], relative to the line's start) and its
+//! track in f64, the CPU path of
+//! [`super::frame_maps`] (the motion as matrices, each pixel
 //! projected through them).
 
 use crate::camera::Camera;
 use crate::model::flow::FlowPoly;
 use crate::model::log::ImuLog;
 use crate::model::motion::{Plane, Twist};
-use crate::model::trajectory::Trajectory;
+use crate::model::track::LineTrack;
 use glam::{DMat3, DQuat, DVec3};
 
 /// One line's motion over its exposure, as rotations (the GPU path uploads
@@ -26,24 +28,22 @@ pub(crate) struct LineMotion {
 }
 
 impl LineMotion {
-    /// The motion of the line whose exposure starts `t0` after the frame's
-    /// start `t_frame` (log clock), over `te` in `steps` chords, on `traj`
-    /// (which starts at the frame's start).
-    #[allow(clippy::too_many_arguments)]
+    /// The motion of the line whose window and poses are `track` (the one
+    /// per-pixel track's, [`LineTrack::line`], on a trajectory starting at
+    /// the frame's start `t_frame`, log clock), relative to its start.
     pub fn new(
         log: &ImuLog,
-        traj: &Trajectory,
+        track: &LineTrack,
         plane: Option<&Plane>,
         cam: &Camera,
         t_frame: f64,
-        t0: f64,
-        te: f64,
-        steps: usize,
     ) -> Self {
-        let (qs, cs) = traj.pose_at(t0);
-        let steps_v = (0..=steps)
-            .map(|k| {
-                let (q, c) = traj.pose_at(t0 + te * k as f64 / steps as f64);
+        let (qs, cs) = track.start;
+        let t0 = track.t0;
+        let steps_v = track
+            .poses
+            .iter()
+            .map(|&(q, c)| {
                 let inv = q.inverse();
                 (inv * qs, inv * (cs - c))
             })

@@ -21,15 +21,23 @@
 //! point is lost (behind the camera or off the plane) are NaN in every
 //! channel.
 
-use super::maps_line::LineMotion;
-use super::SeriesOptions;
+pub mod gpu;
+pub mod kernel;
+pub mod table;
+mod line;
+pub mod write;
+
 use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::io::frames::VideoFrame;
 pub use crate::limits::MAX_MAP_PIXELS;
 use crate::model::log::ImuLog;
 use crate::model::motion::Plane;
+use crate::model::track::LineTrack;
 use crate::model::trajectory::Trajectory;
+use crate::series::job::FrameWindow;
+use crate::series::SeriesOptions;
+use line::LineMotion;
 use rayon::prelude::*;
 
 /// Channels of a frame's maps, in the EXR's order of [`FrameMaps::channels`].
@@ -240,8 +248,8 @@ pub(crate) struct Plan {
 
 /// One frame's maps to compute: the arguments of [`frame_maps`], as the
 /// GPU path and its twin take them
-/// ([`super::maps_gpu::MapsRunner::frame_maps`],
-/// [`super::maps_kernel::frame_maps_twin`]).
+/// ([`gpu::MapsRunner::frame_maps`],
+/// [`kernel::frame_maps_twin`]).
 #[derive(Clone, Copy)]
 pub struct MapsJob<'a> {
     /// The motion.
@@ -269,19 +277,14 @@ pub(crate) fn plan(job: &MapsJob) -> Result<Option<Plan>> {
             "the rays were built for another camera than the options'",
         ));
     }
-    frame
-        .check()
-        .map_err(|(column, message)| Error::invalid(format!("frame {index}: {column}"), message))?;
-    let (te, readout) = (
-        frame.exposure_s,
-        frame.readout_s.unwrap_or(cam.shutter.readout_s),
-    );
-    let (a, b) = (frame.t_start, frame.t_start + readout + te);
+    let win = FrameWindow::of(&cam, index, frame)?;
+    let (te, readout) = (win.exposure_s, win.readout_s());
+    let (a, b) = (win.t_start, win.end_s());
     if !covers(log, a, b) {
         return Ok(None);
     }
     let at = |e: Error| Error::invalid(format!("frame {index} (t_start = {a} s)"), e.to_string());
-    let traj = Trajectory::from_imu_log(log, a, readout + te, opts.use_velocity).map_err(at)?;
+    let traj = Trajectory::from_imu_log(log, a, win.span_s(), opts.use_velocity).map_err(at)?;
     let plane = world_plane(log, opts, a)?;
     if let Some(p) = &plane {
         p.validate_for(&cam).map_err(at)?;
@@ -326,18 +329,16 @@ impl Plan {
             readout_s: self.readout_s,
             direction: self.cam.shutter.direction,
         };
-        let c = l as f64 + 0.5;
-        let t0 = shutter.delay_s(c, c, self.cam.width, self.cam.height);
-        LineMotion::new(
-            log,
+        // The line's window and poses: the one per-pixel track's.
+        let track = LineTrack::line(
             &self.traj,
-            self.plane.as_ref(),
+            &shutter,
             &self.cam,
-            self.t_start,
-            t0,
+            l,
             self.exposure_s,
             self.steps,
-        )
+        );
+        LineMotion::new(log, &track, self.plane.as_ref(), &self.cam, self.t_start)
     }
 
     /// The maps of frame `index` from its channels, row-major.
@@ -366,7 +367,7 @@ impl Plan {
 /// crosses a gap in it (no motion is known there). `steps`:
 /// chords per line's exposure (`None`: about one per pixel of motion, at
 /// least 16). The readout is the frame's own, else the camera's. In f64 on
-/// the CPU (rayon); the GPU path is [`super::maps_gpu`].
+/// the CPU (rayon); the GPU path is [`gpu`].
 pub fn frame_maps(
     log: &ImuLog,
     opts: &SeriesOptions,
@@ -396,7 +397,7 @@ pub fn frame_maps(
         if stop.is_cancelled() {
             return;
         }
-        let line = super::maps_line::Line::from(plan.line(log, l));
+        let line = line::Line::from(plan.line(log, l));
         let ray = |m: usize| {
             let (i, j) = if rows { (m, l) } else { (l, m) };
             rays.rays[j * w + i]

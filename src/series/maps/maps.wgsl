@@ -2,7 +2,7 @@
 // 9): each pixel's image track over its own line's exposure (rolling
 // shutter), its displacement, path length and start flow. The CPU twin of
 // every function is in src/series/maps_kernel.rs (the lens table's in
-// src/series/maps_table.rs), the f64 reference in
+// src/series/maps/table.rs), the f64 reference in
 // src/series/maps.rs, the host structs in src/series/maps_kernel.rs.
 //
 // Per pixel the host gives the undistorted ray r = (x, y, 1) (normalised;
@@ -57,7 +57,7 @@ struct Step {
 // Lens table mode (lens model 3, every model without a formula in the lens
 // module): the distortion map on a regular grid of the undistorted
 // normalised plane covering the camera's rays with a margin, computed on the
-// host (src/series/maps_table.rs, f64): per node its distorted point and
+// host (src/series/maps/table.rs, f64): per node its distorted point and
 // its derivatives, d/dx and d/dy times the spacing and d2/dxdy times its
 // square. The kernel interpolates bicubically (Hermite), continuing the
 // border cells' cubics beyond the grid. The Jacobian at each pixel's ray

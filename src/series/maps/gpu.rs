@@ -1,13 +1,13 @@
 //! The GPU path of `frames --maps`: the compiled `maps.wgsl` (joined with
 //! the lens module, `src/gpu/lens.wgsl`) and a runner that keeps the
 //! camera's rays and lens table on the device and dispatches a
-//! frame's lines. CPU twin: [`super::maps_kernel::frame_maps_twin`]; the
+//! frame's lines. CPU twin: [`super::kernel::frame_maps_twin`]; the
 //! packing and the dispatch loop are shared with it
-//! ([`super::maps_kernel`]).
+//! ([`super::kernel`]).
 
-use super::maps::{FrameMaps, MapsJob};
-use super::maps_kernel::{self as mk, LineGpu, MapsParams, StepGpu, PLANES};
-use super::maps_table::NodeGpu;
+use super::{FrameMaps, MapsJob};
+use super::kernel::{self as mk, LineGpu, MapsParams, StepGpu, PLANES};
+use super::table::NodeGpu;
 use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::gpu::compute::{
@@ -20,7 +20,7 @@ use std::sync::OnceLock;
 
 /// The WGSL source of the maps kernel: the shared lens module
 /// ([`crate::gpu::lens::LENS_WGSL`]) joined with `maps.wgsl`.
-pub const MAPS_WGSL: &str = concat!(include_str!("../gpu/lens.wgsl"), include_str!("maps.wgsl"));
+pub const MAPS_WGSL: &str = concat!(include_str!("../../gpu/lens.wgsl"), include_str!("maps.wgsl"));
 
 struct Kernel {
     bgl: wgpu::BindGroupLayout,
@@ -127,7 +127,7 @@ impl MapsRunner {
         Ok(())
     }
 
-    /// The maps of a frame on the GPU, as [`super::maps::frame_maps`]
+    /// The maps of a frame on the GPU, as [`super::frame_maps`]
     /// (f32 throughout; lenses without a formula in the lens module through
     /// the lens table, [`mk::lens_table`]).
     pub fn frame_maps(&mut self, job: &MapsJob) -> Result<Option<FrameMaps>> {

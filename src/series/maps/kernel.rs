@@ -3,14 +3,14 @@
 //! frame's [`Plan`], the dispatch loop both backends share, and the CPU twin
 //! of the kernel: the same f32 operations, function by function (the lens
 //! module's are twinned in [`crate::gpu::lens`], the lens table's in
-//! [`super::maps_table`]).
+//! [`super::table`]).
 //!
-//! The f64 reference is [`super::maps::frame_maps`]; the twin and the kernel
+//! The f64 reference is [`super::frame_maps`]; the twin and the kernel
 //! agree with it to f32 rounding of the track (see `tests/maps_gpu.rs`).
 
-use super::maps::{plan, FrameMaps, MapRays, MapsJob, Plan};
-use super::maps_line::LineMotion;
-pub use super::maps_table::MapsTable;
+use super::{plan, FrameMaps, MapRays, MapsJob, Plan};
+use super::line::LineMotion;
+pub use super::table::MapsTable;
 use crate::error::{Error, Result};
 use crate::gpu::lens::{self, LensGpu, MODEL_NONE, MODEL_TABLE};
 use bytemuck::{Pod, Zeroable};
@@ -194,7 +194,7 @@ fn pack_line(m: &LineMotion, steps: &mut [StepGpu]) -> LineGpu {
 
 /// Runs `dispatch(params, lines, steps)` over the job's frame's lines
 /// (split so a dispatch's motion samples stay under `step_bytes`) and
-/// returns the plan; `None` as [`super::maps::frame_maps`]. `table`: the
+/// returns the plan; `None` as [`super::frame_maps`]. `table`: the
 /// camera's [`lens_table`].
 /// `params.groups_x` is for a 1-D grid of `n_lines * line_len` threads in
 /// up to [`MAX_DISPATCH`] columns.
@@ -247,7 +247,7 @@ pub(crate) fn unpack(plan: &Plan, index: usize, out: &[f32]) -> FrameMaps {
 }
 
 /// The blur fields of a job's frame by the CPU twin of `maps.wgsl`
-/// (f32, rayon), in the kernel's dispatches; as [`super::maps::frame_maps`].
+/// (f32, rayon), in the kernel's dispatches; as [`super::frame_maps`].
 pub fn frame_maps_twin(job: &MapsJob) -> Result<Option<FrameMaps>> {
     let cam = &job.opts.scene.camera;
     let n = cam.width as usize * cam.height as usize;
@@ -423,7 +423,7 @@ mod tests {
 
     #[test]
     fn shader_constants_and_struct_sizes_match_host() {
-        let m = naga::front::wgsl::parse_str(super::super::maps_gpu::MAPS_WGSL).expect("parses");
+        let m = naga::front::wgsl::parse_str(super::super::gpu::MAPS_WGSL).expect("parses");
         assert_eq!(shader_const(&m, "UNDISTORT_STEPS"), lens::UNDISTORT_STEPS);
         assert_eq!(shader_const(&m, "WG"), WG);
         assert_eq!(m.entry_points.len(), 1);
@@ -437,7 +437,7 @@ mod tests {
             ("Step", std::mem::size_of::<StepGpu>()),
             (
                 "Node",
-                std::mem::size_of::<super::super::maps_table::NodeGpu>(),
+                std::mem::size_of::<super::super::table::NodeGpu>(),
             ),
             ("Lens", std::mem::size_of::<LensGpu>()),
         ] {

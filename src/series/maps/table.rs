@@ -25,7 +25,7 @@
 //! at the sample only), the maps kernel evaluates the lens along each
 //! pixel's moving track, hence a table over the plane.
 
-use super::maps::MapRays;
+use super::MapRays;
 use crate::camera::Camera;
 use crate::error::{Error, Result};
 use bytemuck::{Pod, Zeroable};
