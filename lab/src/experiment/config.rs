@@ -415,7 +415,7 @@ impl ExperimentConfig {
         let text = crate::io::input::read_text(path)?;
         let cfg: Self = toml::from_str(&text).map_err(|e| Error::Config {
             path: path.into(),
-            message: e.to_string(),
+            message: super::config_policies::one_line(&e, &text),
         })?;
         cfg.validate().map_err(|e| Error::Config {
             path: path.into(),

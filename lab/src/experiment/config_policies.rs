@@ -2,7 +2,8 @@
 //! `[map] policies`), read as typed [`PolicySpec`]s: each string is parsed
 //! once, while the file is read, and a bad one is refused there naming its
 //! key and the entry; a list over [`MAX_LIST_ENTRIES`] is refused, naming its
-//! key and length, before any entry is parsed.
+//! key and length, before any entry is parsed. The reader's errors are
+//! given on one line ([`one_line`]), where it would show a snippet.
 
 use crate::error::Error;
 use crate::limits::{check_len, MAX_LIST_ENTRIES};
@@ -29,6 +30,23 @@ fn specs<'de, D: Deserializer<'de>>(d: D, key: &str) -> Result<Vec<PolicySpec>, 
             PolicySpec::parse(s).map_err(|e| D::Error::custom(Error::invalid(key, e.to_string())))
         })
         .collect()
+}
+
+/// The TOML reader's error on one line: its position (line and column,
+/// from 1, as the reader counts them) and its message, without the snippet
+/// of the source it shows over several lines.
+pub(super) fn one_line(e: &toml::de::Error, text: &str) -> String {
+    match e.span().and_then(|s| text.get(..s.start)) {
+        Some(before) => {
+            let line = before.matches('\n').count() + 1;
+            let column = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+            format!(
+                "TOML parse error at line {line}, column {column}: {}",
+                e.message().trim_end()
+            )
+        }
+        None => format!("TOML parse error: {}", e.message().trim_end()),
+    }
 }
 
 /// A built-in list of policy strings (the defaults and the demo's), parsed.
