@@ -141,7 +141,7 @@ fn tiny() -> ExperimentConfig {
     ExperimentConfig {
         walks: vec!["moderate".into()],
         duration_s: Some(2.0),
-        policies: vec!["fixed:5".into()],
+        policies: vec!["fixed:5".parse().unwrap()],
         quality: "fast".into(),
         sweep_exposures_s: Vec::new(),
         background: "poster".into(),
@@ -157,9 +157,9 @@ fn tiny() -> ExperimentConfig {
             boards: vec!["blobs:0.5".into()],
             seeds: vec![1, 2],
             policies: vec![
-                "deadline:5".into(),
-                "fixed:5+exp:2:0.02".into(),
-                "ae-blur:5:1".into(),
+                "deadline:5".parse().unwrap(),
+                "fixed:5+exp:2:0.02".parse().unwrap(),
+                "ae-blur:5:1".parse().unwrap(),
             ],
             grid_ms: vec![70.0],
             ..MapSection::default()
@@ -246,10 +246,7 @@ fn each_cell_says_whether_timing_pays() {
 #[test]
 fn the_demo_maps_hold_the_bar_for_timing() {
     let fams = |m: &MapSection| -> Vec<PolicyFamily> {
-        m.policies
-            .iter()
-            .map(|s| PolicySpec::parse(s).unwrap().policy_family())
-            .collect()
+        m.policies.iter().map(|s| s.policy_family()).collect()
     };
     let (reduced, full) = (MapSection::reduced(), MapSection::full());
     for m in [&reduced, &full] {
@@ -261,7 +258,10 @@ fn the_demo_maps_hold_the_bar_for_timing() {
         ] {
             assert!(f.contains(&want), "{want}: {:?}", m.policies);
         }
-        assert!(m.policies.iter().any(|p| p.starts_with("ae-blur:")));
+        assert!(m
+            .policies
+            .iter()
+            .any(|p| p.as_str().starts_with("ae-blur:")));
     }
     for p in ["ae-blur:5:1", "ae-imu:5", "ae-grad:5:cap=10ms"] {
         assert!(full.policies.iter().any(|q| q == p), "{p}");

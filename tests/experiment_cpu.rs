@@ -16,7 +16,7 @@ fn experiment_without_adapter_uses_cpu_twins() {
     let d = tempfile::tempdir().unwrap();
     let cfg = ExperimentConfig {
         duration_s: Some(2.0),
-        policies: vec!["fixed:5".into()],
+        policies: vec!["fixed:5".parse().unwrap()],
         resolution: [160, 120],
         quality: "8:2.0".into(),
         max_frames_per_policy: 2,

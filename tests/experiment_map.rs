@@ -12,7 +12,7 @@ fn tiny() -> ExperimentConfig {
     ExperimentConfig {
         walks: vec!["moderate".into()],
         duration_s: Some(2.0),
-        policies: vec!["fixed:5".into()],
+        policies: vec!["fixed:5".parse().unwrap()],
         quality: "fast".into(),
         sweep_exposures_s: Vec::new(),
         background: "poster".into(),
@@ -27,7 +27,10 @@ fn tiny() -> ExperimentConfig {
             lights_e_per_s: vec![1_000.0, 20_000.0],
             boards: vec!["blobs:0.5".into()],
             seeds: vec![1, 2],
-            policies: vec!["deadline:5+exp:3:0.02".into(), "ae:5:cap=10ms".into()],
+            policies: vec![
+                "deadline:5+exp:3:0.02".parse().unwrap(),
+                "ae:5:cap=10ms".parse().unwrap(),
+            ],
             grid_ms: vec![10.0, 70.0],
             ..MapSection::default()
         },

@@ -80,6 +80,7 @@ mod predict;
 mod rules;
 mod run;
 mod session;
+mod spec_text;
 mod stats;
 mod stream;
 mod task;

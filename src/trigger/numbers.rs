@@ -20,7 +20,18 @@ pub(crate) fn parse_num(s: &str, what: &str, spec: &str) -> Result<f64> {
 
 /// A number above 0, `what` in the specification `spec`.
 pub(crate) fn parse_pos(s: &str, what: &str, spec: &str) -> Result<f64> {
-    let x = parse_num(s, what, spec)?;
+    check_pos(parse_num(s, what, spec)?, what, spec)
+}
+
+/// Refuses a number that is not finite and above 0 (`what` in the
+/// specification `spec`), with [`parse_pos`]'s messages.
+pub(crate) fn check_pos(x: f64, what: &str, spec: &str) -> Result<f64> {
+    if !x.is_finite() {
+        return Err(Error::invalid(
+            "policy",
+            format!("'{spec}': {what} must be finite"),
+        ));
+    }
     if x <= 0.0 {
         return Err(Error::invalid(
             "policy",

@@ -14,6 +14,7 @@ use super::predict::{Forecast, Oracle};
 use super::rules::{Adaptive, Deadline, Fixed, Gate, Threshold};
 use super::task::{parse_task, Task, TaskModel};
 use crate::error::{Error, Result};
+use std::sync::Arc;
 
 pub use super::family::{Family, PolicyFamily};
 
@@ -22,7 +23,11 @@ pub const MAX_FPS: f64 = 1000.0;
 
 /// A frame rate in `(0, MAX_FPS]`.
 fn parse_fps(s: &str, what: &str, spec: &str) -> Result<f64> {
-    let fps = parse_pos(s, what, spec)?;
+    check_fps(parse_pos(s, what, spec)?, what, spec)
+}
+
+/// Refuses a frame rate above [`MAX_FPS`] (`fps` already > 0 and finite).
+pub(super) fn check_fps(fps: f64, what: &str, spec: &str) -> Result<f64> {
     if fps > MAX_FPS {
         return Err(Error::invalid(
             "policy",
@@ -115,10 +120,16 @@ pub struct ExposureControl {
 
 /// A policy string parsed once: what the experiment, the figures, the report,
 /// `live` and Python ask of a policy without re-reading its text.
+///
+/// It owns the string it was parsed from (shared: a clone is cheap), which
+/// [`Self::as_str`], `Display` and serde write back unchanged; serde reads
+/// and writes a spec as that string, refusing a bad one while deserialising.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PolicySpec {
-    text: String,
-    base: String,
+    /// The string exactly as given.
+    pub(super) text: Arc<str>,
+    /// Length of the part before `+exp` (the whole string without it).
+    pub(super) base_len: usize,
     /// The family.
     pub family: Family,
     /// The frame rate: the schedule's (`fixed`, `gate`, `gate0`, `deadline`;
@@ -175,7 +186,7 @@ impl PolicySpec {
                 Some(t) => parse_pos(t, "shortest exposure (s)", spec)?,
                 None => Exposure::MIN_EXPOSURE,
             };
-            inner.text = spec.to_string();
+            inner.text = spec.into();
             inner.exposure = Some(ExposureControl {
                 budget_px,
                 min_exposure_s,
@@ -202,8 +213,8 @@ impl PolicySpec {
             return Err(bad("unknown policy"));
         };
         let mut out = PolicySpec {
-            text: spec.to_string(),
-            base: spec.to_string(),
+            text: spec.into(),
+            base_len: spec.len(),
             family,
             rate: None,
             threshold: None,
@@ -361,7 +372,7 @@ impl PolicySpec {
     }
 
     fn build_base(&self) -> Box<dyn Policy> {
-        let spec = self.base.as_str();
+        let spec = &self.text[..self.base_len];
         let level = self.threshold.unwrap_or(Level::Abs(0.0));
         let rate = self.rate.unwrap_or(DEFAULT_GATE_RATE);
         let h = self.horizon.unwrap_or(DEFAULT_HORIZON_S);
@@ -407,19 +418,6 @@ impl PolicySpec {
                 self.task.unwrap_or(TaskModel::at_light(1.0)),
             )),
         }
-    }
-}
-
-impl std::str::FromStr for PolicySpec {
-    type Err = Error;
-    fn from_str(s: &str) -> Result<Self> {
-        PolicySpec::parse(s)
-    }
-}
-
-impl std::fmt::Display for PolicySpec {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(&self.text)
     }
 }
 

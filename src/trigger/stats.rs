@@ -13,7 +13,7 @@ pub const FRAME_HEADER: &str =
 /// frames' exposure MMBM (NaN when no frame was kept).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Summary {
-    /// The policy string (empty when there are no frames).
+    /// The frames' policy label ([`Frame::policy`]; empty when there are no frames).
     pub policy: String,
     /// Frames triggered.
     pub frames: usize,

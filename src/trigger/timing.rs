@@ -90,7 +90,13 @@ impl CameraTiming {
 /// One triggered frame.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Frame {
-    /// The policy string exactly as given to [`parse_policy`](crate::trigger::parse_policy).
+    /// The label of the policy that triggered the frame, its
+    /// [`Policy::spec`](crate::trigger::Policy::spec): for a policy built
+    /// from a [`PolicySpec`](crate::trigger::PolicySpec), the spec's text
+    /// exactly as given. The runner takes any [`Policy`](crate::trigger::Policy),
+    /// so the frame holds the label; the typed spec travels beside the
+    /// frames ([`Policies::specs`](crate::trigger::Policies::specs), in the
+    /// same order as [`Policies::run`](crate::trigger::Policies::run)'s lists).
     pub policy: String,
     /// Index of the gyro sample the decision was made on.
     pub index: usize,

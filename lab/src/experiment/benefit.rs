@@ -422,6 +422,7 @@ mod tests {
         FrameRecord {
             walk: format!("w-s{seed}"),
             seed,
+            policy: policy.parse().unwrap(),
             frame: Frame {
                 policy: policy.into(),
                 index: 0,

@@ -7,11 +7,12 @@ use super::corners::REPEAT_OK;
 use super::measure::FrameRecord;
 use super::walk::Walk;
 use crate::stats::mean;
+use crate::trigger::PolicySpec;
 
 /// One row: a policy on one walk.
 struct Row {
     walk: String,
-    policy: String,
+    policy: PolicySpec,
     rendered: usize,
     ok: usize,
     with_false: usize,
@@ -33,7 +34,7 @@ fn rows(walks: &[Walk], records: &[FrameRecord]) -> Vec<Row> {
         for (p, _) in &w.runs {
             let ms: Vec<_> = records
                 .iter()
-                .filter(|r| r.walk == w.name && r.seed == w.seed && r.frame.policy == p.as_str())
+                .filter(|r| r.walk == w.name && r.seed == w.seed && r.policy == *p)
                 .filter_map(|r| r.measure.as_ref())
                 .collect();
             let reps: Vec<f64> = ms
@@ -49,7 +50,7 @@ fn rows(walks: &[Walk], records: &[FrameRecord]) -> Vec<Row> {
             };
             out.push(Row {
                 walk: w.name.clone(),
-                policy: p.to_string(),
+                policy: p.clone(),
                 rendered: ms.len(),
                 ok: ms.iter().filter(|m| m.blobs_ok).count(),
                 with_false: ms.iter().filter(|m| m.blobs_false > 0).count(),

@@ -3,9 +3,10 @@
 //! the blob board walked towards from 6 m, the thesis policies and their
 //! successors.
 
+use super::config_policies::builtin;
 use crate::camera::{CameraFile, Noise};
 use crate::error::{Error, Result};
-use crate::trigger::CameraTiming;
+use crate::trigger::{CameraTiming, PolicySpec};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -33,8 +34,11 @@ pub struct ExperimentConfig {
     pub gyro: Option<PathBuf>,
     /// Forward speed (m/s) used for the target distance when the log has no velocity.
     pub speed_m_s: f64,
-    /// Trigger policies, as `mmbm trigger --policy` strings.
-    pub policies: Vec<String>,
+    /// Trigger policies, written as `mmbm trigger --policy` strings; each
+    /// parsed once as the file is read (a bad one refused there, naming
+    /// `policies` and the entry).
+    #[serde(deserialize_with = "super::config_policies::policies")]
+    pub policies: Vec<PolicySpec>,
     /// Exposure, s.
     pub exposure_s: f64,
     /// Trigger delay, s.
@@ -103,8 +107,10 @@ pub struct MapSection {
     /// Seeds (at least 5 for the goals); empty: the experiment's seeds.
     pub seeds: Vec<u64>,
     /// The policies besides the baselines' grid: the gyro-driven candidates
-    /// (the best `mmbm` one is taken per cell) and the auto-exposure(s).
-    pub policies: Vec<String>,
+    /// (the best `mmbm` one is taken per cell) and the auto-exposure(s);
+    /// parsed as the file is read (a bad one refused naming `map.policies`).
+    #[serde(deserialize_with = "super::config_policies::map_policies")]
+    pub policies: Vec<PolicySpec>,
     /// The frame rate of `fixed` and of the fixed-exposure grid, frames/s.
     pub fps: f64,
     /// The fixed exposures of the best fixed exposure in hindsight, ms (at
@@ -122,7 +128,7 @@ impl Default for MapSection {
             gaits: Vec::new(),
             boards: vec!["blobs:0.5".into(), "blobs".into()],
             seeds: Vec::new(),
-            policies: [
+            policies: builtin(&[
                 "deadline:5+exp:3:0.02",
                 "deadline:5+exp:1:0.003",
                 "fixed:5+exp:2:0.02",
@@ -135,9 +141,7 @@ impl Default for MapSection {
                 "ae-grad:5:cap=10ms",
                 "ae-blur:5:1",
                 "ae-imu:5",
-            ]
-            .map(String::from)
-            .to_vec(),
+            ]),
             fps: 5.0,
             grid_ms: vec![
                 1.0, 2.0, 3.0, 5.0, 7.0, 10.0, 14.0, 20.0, 28.0, 40.0, 56.0, 70.0,
@@ -170,7 +174,7 @@ impl MapSection {
             gaits: vec!["moderate".into()],
             boards: vec!["blobs:0.5".into()],
             seeds: (1..=5).collect(),
-            policies: [
+            policies: builtin(&[
                 "deadline:5",
                 "deadline:5+exp:3:0.02",
                 "task:5:light=1000",
@@ -178,9 +182,7 @@ impl MapSection {
                 "task:5:light=20000",
                 "ae-blur:5:1",
                 "ae:5:cap=10ms",
-            ]
-            .map(String::from)
-            .to_vec(),
+            ]),
             grid_ms: vec![3.0, 10.0, 20.0, 70.0],
             ..Self::default()
         }
@@ -249,9 +251,6 @@ impl MapSection {
         for g in &self.gaits {
             g.parse::<crate::sim::Gait>().map_err(|e| key("gaits", e))?;
         }
-        for p in &self.policies {
-            crate::trigger::PolicySpec::parse(p).map_err(|e| key("policies", e))?;
-        }
         let mut seeds = self.seeds.clone();
         seeds.sort_unstable();
         seeds.dedup();
@@ -309,7 +308,7 @@ impl Default for ExperimentConfig {
             seeds: Vec::new(),
             gyro: None,
             speed_m_s: 0.17,
-            policies: [
+            policies: builtin(&[
                 "fixed:5",
                 "threshold:0.8",
                 "threshold:0.4",
@@ -322,9 +321,7 @@ impl Default for ExperimentConfig {
                 "deadline:5",
                 "fixed:5+exp:2:0.02",
                 "deadline:5+exp:3:0.02",
-            ]
-            .map(String::from)
-            .to_vec(),
+            ]),
             exposure_s: CameraTiming::DEFAULT_EXPOSURE_S,
             delay_s: CameraTiming::DEFAULT_DELAY_S,
             readout_s: CameraTiming::DEFAULT_READOUT_S,
@@ -396,7 +393,7 @@ impl ExperimentConfig {
                 ..CameraFile::default()
             },
             map: MapSection::reduced(),
-            policies: DEMO_POLICIES.map(String::from).to_vec(),
+            policies: builtin(&DEMO_POLICIES),
             // The map's fixed-exposure grid replaces the exposure sweep.
             sweep_exposures_s: Vec::new(),
             // Clutter for blob extraction and corners for the second task
@@ -418,7 +415,7 @@ impl ExperimentConfig {
         let text = crate::io::input::read_text(path)?;
         let cfg: Self = toml::from_str(&text).map_err(|e| Error::Config {
             path: path.into(),
-            message: e.to_string(),
+            message: super::config_policies::one_line(&e, &text),
         })?;
         cfg.validate().map_err(|e| Error::Config {
             path: path.into(),
@@ -475,11 +472,8 @@ impl ExperimentConfig {
             return Err(Error::invalid("resolution", "must be positive"));
         }
         // The strings, parsed now so that a bad one is reported with its key
-        // before any work.
+        // before any work (the policies were parsed as they were read).
         let key = |k: &str, e: Error| Error::invalid(k.to_string(), e.to_string());
-        for p in &self.policies {
-            crate::trigger::parse_policy(p).map_err(|e| key("policies", e))?;
-        }
         if self.gyro.is_none() {
             for w in &self.walks {
                 w.parse::<crate::sim::Gait>().map_err(|e| key("walks", e))?;

@@ -87,7 +87,7 @@ impl<'a> FrameRow<'a> {
         let m = r.measure.as_ref();
         let v = |get: fn(&FrameMeasure) -> f64| Measured(m.map(get));
         FrameRow {
-            policy: &f.policy,
+            policy: r.policy.as_str(),
             trigger_t: Shown(f.trigger_t),
             blur_px: v(|m| m.blur_px),
             jnbm: v(|m| m.jnbm),
@@ -118,8 +118,7 @@ impl<'a> FrameRow<'a> {
             jnbm_2d: v(|m| m.jnbm_2d),
             cpbd_2d: v(|m| m.cpbd_2d),
             gain: Shown(f.gain),
-            family: crate::trigger::PolicySpec::parse(&f.policy)
-                .map_or("", |p| p.policy_family().name()),
+            family: r.policy.policy_family().name(),
             blobs_false: m.map(|m| m.blobs_false),
             corner_repeatability: v(|m| m.corner_rep),
         }
@@ -189,12 +188,14 @@ mod tests {
             FrameRecord {
                 walk: "slow".into(),
                 seed: 3,
+                policy: "deadline:5:0.4".parse().unwrap(),
                 frame: frame.clone(),
                 measure: Some(measure),
             },
             FrameRecord {
                 walk: "fast".into(),
                 seed: u64::MAX,
+                policy: "fixed:5+exp:2:0.02".parse().unwrap(),
                 frame: Frame {
                     policy: "fixed:5+exp:2:0.02".into(),
                     trigger_t: f64::NAN,

@@ -121,22 +121,19 @@ pub struct BenefitMap {
 /// (`fixed:FPS@Tms`; the grid's `T_ref` is the fixed rate itself).
 pub fn map_policies(cfg: &ExperimentConfig) -> Result<Vec<PolicySpec>> {
     let m = &cfg.map;
-    let fixed = format!("fixed:{}", m.fps);
     let mut out: Vec<PolicySpec> = Vec::new();
-    let mut push = |s: String| -> Result<()> {
-        let p = PolicySpec::parse(&s)?;
+    let mut push = |p: PolicySpec| {
         if !out.iter().any(|q| q.as_str() == p.as_str()) {
             out.push(p);
         }
-        Ok(())
     };
-    push(fixed.clone())?;
+    push(PolicySpec::fixed(m.fps, None)?);
     for p in &m.policies {
-        push(p.clone())?;
+        push(p.clone());
     }
     for &t in &m.grid_ms {
         if (t * 1e-3 - cfg.exposure_s).abs() > 1e-9 {
-            push(format!("{fixed}@{t}ms"))?;
+            push(PolicySpec::fixed(m.fps, Some(t))?);
         }
     }
     Ok(out)
@@ -214,7 +211,7 @@ pub fn benefit_map(
         plane: None,
     };
     let mcfg = ExperimentConfig {
-        policies: policies.iter().map(|p| p.as_str().to_string()).collect(),
+        policies: policies.clone(),
         gyro: None,
         ..cfg.clone()
     };

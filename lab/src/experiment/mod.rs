@@ -14,6 +14,7 @@
 pub(crate) mod benefit;
 pub(crate) mod clutter_report;
 pub(crate) mod config;
+mod config_policies;
 mod corners;
 mod crop;
 pub(crate) mod figures;

@@ -150,8 +150,9 @@ mod tests {
         FrameRecord {
             walk: "w".into(),
             seed: 1,
+            policy: "fixed:5".parse().unwrap(),
             frame: Frame {
-                policy: "p".into(),
+                policy: "fixed:5".into(),
                 index: 0,
                 trigger_t: 0.0,
                 exposure_start: 0.0,

@@ -67,11 +67,7 @@ pub fn make_walk(
         }
         distance.push(d);
     }
-    let specs = cfg
-        .policies
-        .iter()
-        .map(|p| PolicySpec::parse(p))
-        .collect::<Result<Vec<_>>>()?;
+    let specs = cfg.policies.clone();
     let frames = Policies::new(specs.clone(), timing(cfg))?.run(&samples, &mmbm)?;
     let runs: Vec<(PolicySpec, Vec<Frame>)> = specs.into_iter().zip(frames).collect();
     let seed = if cfg.gyro.is_some() { 0 } else { seed };
