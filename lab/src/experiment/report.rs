@@ -233,7 +233,7 @@ pub struct Outcome {
     /// Where the frames were rendered (`gpu: <adapter>` or `cpu (N threads)`).
     pub backend: String,
     /// The benefit map (when `[map]` has lights).
-    pub map: Option<super::map::BenefitMap>,
+    pub map: Option<super::benefit_map::BenefitMap>,
 }
 
 impl Outcome {
@@ -242,7 +242,7 @@ impl Outcome {
     /// fixed rate) with their intervals, and where the report is.
     pub fn answer(&self, report: &std::path::Path) -> String {
         if let Some(m) = &self.map {
-            return super::map_report::answer(m, report).join("\n");
+            return super::benefit_map::report::answer(m, report).join("\n");
         }
         let policies: Vec<PolicySpec> = self
             .walks
@@ -419,7 +419,7 @@ pub fn report_md(
             s += &format!("- {line}\n");
         }
         s += "\n";
-        s += &super::map_report::map_md(
+        s += &super::benefit_map::report::map_md(
             m,
             figs.iter()
                 .find(|f| f.as_str() == MAP_FIGURE)

@@ -137,7 +137,7 @@ pub fn run(cfg: &ExperimentConfig, out: &Path, progress: bool) -> Result<Outcome
     }
     drop(bar);
     let sweep = super::sweep::exposure_sweep(cfg, &walks, quality)?;
-    let map = super::map::benefit_map(cfg, quality, progress)?;
+    let map = super::benefit_map::benefit_map(cfg, quality, progress)?;
 
     let mut records = Vec::new();
     for (wi, w) in walks.iter().enumerate() {
@@ -166,7 +166,7 @@ pub fn run(cfg: &ExperimentConfig, out: &Path, progress: bool) -> Result<Outcome
 
         let mut figs = figures::write_all(out, cfg, &walks, &records, &extremes)?;
         if let Some(m) = &map {
-            super::map_report::heat_map_png(&out.join(super::report::MAP_FIGURE), m)?;
+            super::benefit_map::report::heat_map_png(&out.join(super::report::MAP_FIGURE), m)?;
             figs.push(super::report::MAP_FIGURE.to_string());
         }
         let outcome = Outcome {

@@ -9,7 +9,7 @@
 //! **loses** when one lies below 1, and it **ties** otherwise.
 
 use super::benefit::Estimate;
-use super::map::{BenefitMap, Cell};
+use super::benefit_map::{BenefitMap, Cell};
 
 /// A cell's verdict.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -112,7 +112,7 @@ fn board_name(b: &str) -> &str {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::experiment::map::CellPolicy;
+    use crate::experiment::benefit_map::CellPolicy;
     use crate::trigger::PolicySpec;
 
     fn cell(h: (f64, f64), g: (f64, f64)) -> Cell {

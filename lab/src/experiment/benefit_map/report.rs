@@ -3,10 +3,10 @@
 //! with their reasons (all computed from the map), a heat map, and the few
 //! lines the terminal ends with.
 
-use super::benefit::{Estimate, BLOCK_S, BOOTSTRAP_SEED, RESAMPLES};
-use super::corners::{FAST_THRESHOLD, MATCH_PX, NMS_RADIUS, REPEAT_OK};
-use super::map::{BenefitMap, Cell};
-use super::verdict::column;
+use super::super::benefit::{Estimate, BLOCK_S, BOOTSTRAP_SEED, RESAMPLES};
+use super::super::corners::{FAST_THRESHOLD, MATCH_PX, NMS_RADIUS, REPEAT_OK};
+use super::super::verdict::column;
+use super::{BenefitMap, Cell};
 use crate::error::Result;
 use crate::io::atomic::write_atomic_path;
 use crate::plot::{ensure_font, plot_error};
@@ -230,7 +230,7 @@ fn reason(c: &Cell) -> String {
     let Some(b) = c.best_mmbm.map(|i| &c.policies[i]) else {
         return "no `mmbm` policy was run".into();
     };
-    let share = |p: &super::map::CellPolicy| 100.0 * p.sharp as f64 / p.frames.max(1) as f64;
+    let share = |p: &super::CellPolicy| 100.0 * p.sharp as f64 / p.frames.max(1) as f64;
     format!(
         "`{}` gets {:.2} sharp/s ({:.0} % of {} frames sharp, mean exposure {:.1} ms, {} frames gain-capped) against \
          `{}`'s {:.2} ({:.0} % of {}, mean exposure {:.1} ms, {} gain-capped)",
@@ -273,7 +273,7 @@ pub fn goals_md(m: &BenefitMap) -> String {
     let mut s = String::from("Goals (issue 27), computed from the map:\n\n");
     let met = |b: bool| if b { "met" } else { "not met" };
     // 1. Half board, the demo's light, moderate walk: >= 1.5x fixed, CI above 1.
-    let demo = super::config::ExperimentConfig::DEMO_LIGHT_E_PER_S;
+    let demo = super::super::config::ExperimentConfig::DEMO_LIGHT_E_PER_S;
     match m
         .cells
         .iter()
@@ -350,9 +350,9 @@ pub fn goals_md(m: &BenefitMap) -> String {
 }
 
 /// The few lines the terminal ends with: the three lines of
-/// [`super::verdict::three_lines`], the map's ratios and where the report is.
+/// [`super::super::verdict::three_lines`], the map's ratios and where the report is.
 pub fn answer(m: &BenefitMap, report: &Path) -> Vec<String> {
-    let mut out: Vec<String> = super::verdict::three_lines(m).into();
+    let mut out: Vec<String> = super::super::verdict::three_lines(m).into();
     let won = m.cells.iter().filter(|c| !lost(c)).count();
     out.push(format!(
         "Benefit map ({} cells, seeds {:?}): gyro-driven capture is below neither the best fixed exposure in hindsight \
@@ -503,7 +503,7 @@ pub fn heat_labels(c: &Cell) -> Vec<String> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::experiment::map::CellPolicy;
+    use crate::experiment::benefit_map::CellPolicy;
     use crate::trigger::PolicySpec;
 
     #[test]

@@ -12,12 +12,14 @@
 //! auto-exposure predicts its level from the scene, see
 //! [`crate::trigger::AutoExposure`]), so each frame is rendered once without
 //! noise and judged at every light with that light's noise and gain
-//! ([`super::map_render`]). The best policies of a cell are chosen on all
+//! ([`render`]). The best policies of a cell are chosen on all
 //! its blocks (point estimates) and then held fixed in the resamples.
+
+pub(crate) mod render;
+pub(crate) mod report;
 
 use super::benefit::{bootstrap_indices, Estimate, WalkBlocks};
 use super::config::ExperimentConfig;
-use super::map_render::{judge_at_lights, Judged, Light};
 use super::walk::{make_walk, Walk};
 use crate::camera::Noise;
 use crate::error::Result;
@@ -26,6 +28,7 @@ use crate::render::Quality;
 use crate::stats::percentile;
 use crate::trigger::{Frame, PolicyFamily, PolicySpec};
 use rayon::prelude::*;
+use render::{judge_at_lights, Judged, Light};
 
 /// One policy in one cell.
 #[derive(Debug, Clone, PartialEq)]
