@@ -426,10 +426,34 @@ pub fn report_md(
                 .map(String::as_str),
         );
     }
-    s += &super::benefit::headline_md(
-        &super::benefit::headlines(walks, records, &policies),
-        &policies,
-    );
+    let own = super::benefit::headlines(walks, records, &policies);
+    match o
+        .map
+        .as_ref()
+        .and_then(|m| super::headline_view::headline_view_md(cfg, m))
+    {
+        // With a map the headline is the map's cell; the experiment's own
+        // frames keep their table, labelled as the different sample they are.
+        Some(view) => {
+            s += &view;
+            let mut seeds: Vec<u64> = walks.iter().map(|w| w.seed).collect();
+            seeds.sort_unstable();
+            seeds.dedup();
+            s += &super::benefit::headline_md_titled(
+                &own,
+                &policies,
+                "The experiment's own frames (a different sample from the headline)",
+                &format!(
+                    "Frames judged here: the experiment's walks (seeds {seeds:?}), each kept frame rendered whole and \
+                     judged over the whole frame (board, poster and all): a different sample from the headline and the \
+                     map, which judge seeds {:?} in a window around the board. Its rates are not the headline's; \
+                     this table is kept for the ground-truth blur, which only these renders measure.",
+                    o.map.as_ref().map(|m| m.seeds.clone()).unwrap_or_default()
+                ),
+            );
+        }
+        None => s += &super::benefit::headline_md(&own, &policies),
+    }
     s += &super::clutter_report::clutter_md(&cfg.background, walks, records);
     s += &findings(stats);
     s += "\n## Table 5.1: instantaneous MMBM at the trigger vs the exposure average\n\n";

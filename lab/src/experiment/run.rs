@@ -122,6 +122,9 @@ pub fn run(cfg: &ExperimentConfig, out: &Path, progress: bool) -> Result<Outcome
                 blobs_expected: r.expected_px.len(),
                 blobs_false: m.blobs_false,
                 ok: m.blobs_ok,
+                startup: frame.trigger_t
+                    < walks[wi].samples.first().map_or(0.0, |s| s.t)
+                        + crate::trigger::DEFAULT_HORIZON_S,
                 expected_px: r.expected_px.clone(),
                 rgb: r.rgb.clone(),
             };

@@ -119,6 +119,12 @@ mod tests {
         let p = |s: &str| CellPolicy {
             policy: PolicySpec::parse(s).unwrap(),
             sharp_fps: 1.0,
+            sharp_ci: Estimate {
+                value: 1.0,
+                lo: f64::NAN,
+                hi: f64::NAN,
+            },
+            vs_fixed: None,
             frames: 10,
             sharp: 5,
             mean_exposure_s: 0.01,
@@ -147,6 +153,8 @@ mod tests {
             vs_fixed: None,
             vs_gyro: Some(e(g)),
             winner: 1,
+            vo_winner: 1,
+            vo_vs_baseline: None,
             blocks: 8,
         }
     }
