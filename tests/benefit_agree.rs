@@ -64,6 +64,18 @@ fn run(
             )
         })
         .collect();
+    // The headline's rows are the cell's numbers, exactly.
+    let hc = experiment::headline_cell(&cfg, m).expect("the headline's cell");
+    assert!(std::ptr::eq(hc, c));
+    let hs = experiment::headlines_of(m, c);
+    assert_eq!(hs.len(), c.policies.len());
+    for (h, p) in hs.iter().zip(&c.policies) {
+        assert_eq!(h.policy, p.policy);
+        assert_eq!(h.sharp_fps.value.to_bits(), p.sharp_fps.to_bits());
+        assert_eq!(h.sharp_fps, p.sharp_ci);
+        assert_eq!(h.ratio, p.vs_fixed);
+        assert_eq!((h.seeds.as_slice(), h.blocks), (seeds, c.blocks));
+    }
     let (sec, rows) = headline(&md);
     (sec, rows, cell)
 }

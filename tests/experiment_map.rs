@@ -77,7 +77,10 @@ fn the_map_leads_the_report_and_holds_together() {
         md.contains("| light (e-/s) | moderate, half board |"),
         "{md}"
     );
-    assert!(md.contains("Seeds [1, 2]") && md.contains("bootstrap seed 20261123"));
+    assert!(
+        md.contains("every kept frame of seeds [1, 2]") && md.contains("bootstrap seed 20261123")
+    );
+    assert!(md.contains("each judged in a window around the board"));
     assert!(md.contains("Goals (docs/experiment.md, the benefit map), computed from the map:"));
     for c in &m.cells {
         if let Some(r) = c
