@@ -318,7 +318,7 @@ pub fn headline_md_titled(
             h.policy,
             h.policy.policy_family(),
             ci(&h.sharp_fps, 2),
-            h.ratio.as_ref().map_or("-".into(), |r| ratio_ci(r)),
+            h.ratio.as_ref().map_or("-".into(), ratio_ci),
             ci(&h.blur_px, 2),
             h.rendered,
             h.kept
