@@ -21,7 +21,7 @@ fn config(seeds: &[u64]) -> ExperimentConfig {
 
 /// The headline section of a report and its table rows: policy -> (sharp
 /// frames/s cell, ratio cell).
-fn headline(md: &str) -> (String, Vec<(String, String, String)>) {
+fn headline(md: &str) -> (String, Rows) {
     let at = md.find("## Headline").expect("a headline section");
     let end = md[at + 3..].find("\n## ").map_or(md.len(), |e| at + 3 + e);
     let sec = md[at..end].to_string();
@@ -36,15 +36,12 @@ fn headline(md: &str) -> (String, Vec<(String, String, String)>) {
     (sec, rows)
 }
 
-/// Runs the small experiment; returns the headline rows and the map's
-/// (policy, sharp frames/s, ratio to `fixed:5`) of its one cell.
-fn run(
-    seeds: &[u64],
-) -> (
-    String,
-    Vec<(String, String, String)>,
-    Vec<(String, f64, f64)>,
-) {
+/// A headline table's rows: (policy, sharp frames/s cell, ratio cell).
+type Rows = Vec<(String, String, String)>;
+
+/// Runs the small experiment; returns the headline section, its rows and
+/// the map's (policy, sharp frames/s, ratio to `fixed:5`) of its one cell.
+fn run(seeds: &[u64]) -> (String, Rows, Vec<(String, f64, f64)>) {
     let d = tempfile::tempdir().unwrap();
     let cfg = config(seeds);
     let o = experiment::run(&cfg, d.path(), false).unwrap();
