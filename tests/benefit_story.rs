@@ -4,8 +4,8 @@
 //! timing pay?" (the best `mmbm` policy over the best `gyro-exposure` one).
 
 mod common;
+mod tiny_map;
 
-use mmbm::camera::{CameraFile, Noise};
 use mmbm::trigger::{run, CameraTiming, Frame, PolicyFamily, PolicySpec};
 use mmbm_lab::experiment::{self, ExperimentConfig, MapSection};
 
@@ -138,34 +138,11 @@ fn families_split_exposure_from_timing() {
 /// A 2 x 2-s map at one light: `deadline:5` (timing) against two
 /// `gyro-exposure` policies.
 fn tiny() -> ExperimentConfig {
-    ExperimentConfig {
-        walks: vec!["moderate".into()],
-        duration_s: Some(2.0),
-        policies: vec!["fixed:5".parse().unwrap()],
-        quality: "fast".into(),
-        sweep_exposures_s: Vec::new(),
-        background: "poster".into(),
-        camera: CameraFile {
-            noise: Some(Noise {
-                seed: 1,
-                ..Noise::at_light(20_000.0)
-            }),
-            ..Default::default()
-        },
-        map: MapSection {
-            lights_e_per_s: vec![4_000.0],
-            boards: vec!["blobs:0.5".into()],
-            seeds: vec![1, 2],
-            policies: vec![
-                "deadline:5".parse().unwrap(),
-                "fixed:5+exp:2:0.02".parse().unwrap(),
-                "ae-blur:5:1".parse().unwrap(),
-            ],
-            grid_ms: vec![70.0],
-            ..MapSection::default()
-        },
-        ..ExperimentConfig::default()
-    }
+    tiny_map::config(
+        &[4_000.0],
+        &["deadline:5", "fixed:5+exp:2:0.02", "ae-blur:5:1"],
+        &[70.0],
+    )
 }
 
 #[test]

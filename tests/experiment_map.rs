@@ -3,39 +3,17 @@
 //! hindsight choice, families), the heat map is written, and a bad `[map]`
 //! is refused naming its key.
 
-use mmbm::camera::CameraFile;
-use mmbm::camera::Noise;
 use mmbm::trigger::PolicyFamily;
-use mmbm_lab::experiment::{self, ExperimentConfig, MapSection};
+use mmbm_lab::experiment::{self, ExperimentConfig};
+
+mod tiny_map;
 
 fn tiny() -> ExperimentConfig {
-    ExperimentConfig {
-        walks: vec!["moderate".into()],
-        duration_s: Some(2.0),
-        policies: vec!["fixed:5".parse().unwrap()],
-        quality: "fast".into(),
-        sweep_exposures_s: Vec::new(),
-        background: "poster".into(),
-        camera: CameraFile {
-            noise: Some(Noise {
-                seed: 1,
-                ..Noise::at_light(20_000.0)
-            }),
-            ..Default::default()
-        },
-        map: MapSection {
-            lights_e_per_s: vec![1_000.0, 20_000.0],
-            boards: vec!["blobs:0.5".into()],
-            seeds: vec![1, 2],
-            policies: vec![
-                "deadline:5+exp:3:0.02".parse().unwrap(),
-                "ae:5:cap=10ms".parse().unwrap(),
-            ],
-            grid_ms: vec![10.0, 70.0],
-            ..MapSection::default()
-        },
-        ..ExperimentConfig::default()
-    }
+    tiny_map::config(
+        &[1_000.0, 20_000.0],
+        &["deadline:5+exp:3:0.02", "ae:5:cap=10ms"],
+        &[10.0, 70.0],
+    )
 }
 
 #[test]
@@ -99,8 +77,11 @@ fn the_map_leads_the_report_and_holds_together() {
         md.contains("| light (e-/s) | moderate, half board |"),
         "{md}"
     );
-    assert!(md.contains("Seeds [1, 2]") && md.contains("bootstrap seed 20261123"));
-    assert!(md.contains("Goals (issue 27), computed from the map:"));
+    assert!(
+        md.contains("every kept frame of seeds [1, 2]") && md.contains("bootstrap seed 20261123")
+    );
+    assert!(md.contains("each judged in a window around the board"));
+    assert!(md.contains("Goals (docs/experiment.md, the benefit map), computed from the map:"));
     for c in &m.cells {
         if let Some(r) = c
             .vs_hindsight

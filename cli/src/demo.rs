@@ -14,8 +14,10 @@ use std::path::PathBuf;
     after_help = "A simulated 16 s moderate walk (the half-size board of thesis Table 6.2), every policy (the thesis's, the learned phase
 predictor, exposure control), every kept frame rendered with the thesis camera and sensor noise
 at 20,000 e-/s, the board in front of a textured poster (clutter and corners). The report leads with the
-benefit map (light x gait x board against the best fixed exposure and auto-exposure), then sharp frames per second per policy against fixed:5, with
-95 % bootstrap intervals over 2-s blocks of the walk; --full pools seeds 1-5 over the slow (35 s), moderate (16 s) and fast (5 s)
+benefit map (light x gait x board against the best fixed exposure, auto-exposure and gyro-aware exposure; sharp
+frames/s by the blob verdict and VO frames/s), then the headline: sharp frames per second per policy against fixed:5,
+read from the map's cell at 20,000 e-/s (the same frames, seeds, window and verdict), with 95 % bootstrap intervals
+over 2-s blocks of the walks; then the experiment's own frames (its seed, judged whole: a different sample); --full pools seeds 1-5 over the slow (35 s), moderate (16 s) and fast (5 s)
 walks.
 
 Examples:

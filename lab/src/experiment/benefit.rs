@@ -242,17 +242,45 @@ pub fn headlines(
 }
 
 fn ci(e: &Estimate, digits: usize) -> String {
-    if e.lo.is_finite() {
+    if !e.value.is_finite() {
+        "-".into()
+    } else if e.lo.is_finite() {
         format!("{:.d$} [{:.d$}, {:.d$}]", e.value, e.lo, e.hi, d = digits)
     } else {
         format!("{:.d$}", e.value, d = digits)
     }
 }
 
+/// A ratio as `1.23x [1.01, 1.50]` (`-` when undefined).
+fn ratio_ci(e: &Estimate) -> String {
+    match ci(e, 2).split_once(' ') {
+        Some((v, rest)) => format!("{v}x {rest}"),
+        None if e.value.is_finite() => format!("{}x", ci(e, 2)),
+        None => "-".into(),
+    }
+}
+
 /// The headline section of the report (its numbers and its sentences both
-/// computed from `hs`).
+/// computed from `hs`), for an experiment without a map: the frames judged
+/// are the experiment's own.
 pub fn headline_md(hs: &[Headline], policies: &[PolicySpec]) -> String {
-    let mut s = String::from("## Headline: sharp frames per second\n\n");
+    headline_md_titled(
+        hs,
+        policies,
+        "Headline: sharp frames per second",
+        "Frames judged: the experiment's walks, each kept frame rendered whole and judged over the whole frame.",
+    )
+}
+
+/// [`headline_md`] under the section title `title`, opening with `judged`
+/// (the sentence that says which frames the table judged).
+pub fn headline_md_titled(
+    hs: &[Headline],
+    policies: &[PolicySpec],
+    title: &str,
+    judged: &str,
+) -> String {
+    let mut s = format!("## {title}\n\n{judged}\n\n");
     let Some(first) = hs.first() else {
         return s + "No frames.\n\n";
     };
@@ -290,9 +318,7 @@ pub fn headline_md(hs: &[Headline], policies: &[PolicySpec]) -> String {
             h.policy,
             h.policy.policy_family(),
             ci(&h.sharp_fps, 2),
-            h.ratio
-                .as_ref()
-                .map_or("-".into(), |r| format!("{}x", ci(r, 2))),
+            h.ratio.as_ref().map_or("-".into(), ratio_ci),
             ci(&h.blur_px, 2),
             h.rendered,
             h.kept

@@ -1,5 +1,5 @@
 //! Report figures: the MMBM trace with trigger instants and shaded exposures
-//! (thesis Figs. 5.2 and 5.6), blur histograms per policy, and each policy's
+//! (thesis Figs. 5.2 and 5.6), the blur ECDF per policy, and each policy's
 //! sharpest and most blurred frame, labelled (`frame_figure`).
 
 use super::config::ExperimentConfig;
@@ -18,7 +18,7 @@ use std::path::Path;
 pub use super::frame_figure::Extremes;
 
 /// Writes every figure of the report into `out`: per walk the MMBM traces of
-/// the main policies, the blur histograms, the sharpest/most blurred frame
+/// the main policies, the blur ECDF, the sharpest/most blurred frame
 /// figure (from `extremes`, keyed by `(walk, policy)` index) and a flow
 /// quiver at the sample of highest MMBM. Returns the file names.
 pub fn write_all(
@@ -58,8 +58,11 @@ pub fn write_all(
             mmbm_trace(
                 &out.join(&name),
                 &format!(
-                    "{} walk, {p}: MMBM, triggers (x), exposures (shaded)",
-                    w.name
+                    "{} walk, {p}: MMBM, triggers (x), exposures (shaded); t = {:.0}-{:.0} s of a {:.0} s walk",
+                    w.name,
+                    window.0 - t0,
+                    window.1 - t0,
+                    t.last().copied().unwrap_or(t0) - t0
                 ),
                 &t,
                 &w.mmbm,
@@ -82,7 +85,7 @@ pub fn write_all(
             })
             .collect();
         let name = format!("blur_hist_{}.png", w.name);
-        blur_histograms(&out.join(&name), &series)?;
+        blur_ecdf(&out.join(&name), &series)?;
         figs.push(name);
         // Sharpest and most blurred frame per policy, labelled, cropped to the board.
         let rows: Vec<(String, &Extremes)> = w
@@ -202,8 +205,11 @@ pub fn mmbm_trace(
     })
 }
 
-/// Overlaid histograms of per-frame blur (px), one colour per series.
-pub fn blur_histograms(path: &Path, series: &[(String, Vec<f64>)]) -> Result<()> {
+/// The empirical cumulative distribution (ECDF) of per-frame blur (px), one
+/// step line per series: at blur `x`, the share of the series' rendered
+/// frames with blur at most `x` (a curve further left is sharper; no bins,
+/// and the lines do not hide each other as overlaid histograms do).
+pub fn blur_ecdf(path: &Path, series: &[(String, Vec<f64>)]) -> Result<()> {
     ensure_font()?;
     write_atomic_path(path, |tmp| {
         let e = plot_error(path);
@@ -212,45 +218,30 @@ pub fn blur_histograms(path: &Path, series: &[(String, Vec<f64>)]) -> Result<()>
         let xmax = series
             .iter()
             .flat_map(|s| s.1.iter().copied())
+            .filter(|x| x.is_finite())
             .fold(1.0, f64::max)
             * 1.05;
-        let nb = 30usize;
-        let bw = xmax / nb as f64;
-        let hist = |v: &[f64]| {
-            let mut h = vec![0.0; nb];
-            for &x in v {
-                h[((x / bw) as usize).min(nb - 1)] += 1.0 / v.len().max(1) as f64;
-            }
-            h
-        };
-        let hs: Vec<Vec<f64>> = series.iter().map(|s| hist(&s.1)).collect();
-        let ymax = hs.iter().flatten().copied().fold(0.05, f64::max) * 1.1;
         let mut chart = ChartBuilder::on(&root)
             .caption(
-                "Ground-truth blur per frame (mean path length, px)",
+                "Ground-truth blur per frame: ECDF (share of frames with blur <= x)",
                 ("sans-serif", 20),
             )
             .margin(10)
             .x_label_area_size(40)
             .y_label_area_size(55)
-            .build_cartesian_2d(0.0..xmax, 0.0..ymax)
+            .build_cartesian_2d(0.0..xmax, 0.0..1.02)
             .map_err(&e)?;
         chart
             .configure_mesh()
             .x_desc("blur (px)")
-            .y_desc("share of frames")
+            .y_desc("share of frames with blur <= x")
             .label_style(("sans-serif", 13))
             .draw()
             .map_err(&e)?;
-        for (k, ((name, _), h)) in series.iter().zip(&hs).enumerate() {
+        for (k, (name, v)) in series.iter().enumerate() {
             let c = Palette99::pick(k).to_rgba();
-            let pts: Vec<(f64, f64)> = h
-                .iter()
-                .enumerate()
-                .flat_map(|(i, &y)| [(i as f64 * bw, y), ((i + 1) as f64 * bw, y)])
-                .collect();
             chart
-                .draw_series(LineSeries::new(pts, c.stroke_width(2)))
+                .draw_series(LineSeries::new(ecdf_steps(v, xmax), c.stroke_width(2)))
                 .map_err(&e)?
                 .label(name.clone())
                 .legend(move |(x, y)| {
@@ -259,6 +250,7 @@ pub fn blur_histograms(path: &Path, series: &[(String, Vec<f64>)]) -> Result<()>
         }
         chart
             .configure_series_labels()
+            .position(SeriesLabelPosition::LowerRight)
             .background_style(WHITE.mix(0.8))
             .border_style(BLACK)
             .label_font(("sans-serif", 14))
@@ -267,4 +259,46 @@ pub fn blur_histograms(path: &Path, series: &[(String, Vec<f64>)]) -> Result<()>
         root.present().map_err(&e)?;
         Ok(())
     })
+}
+
+/// The ECDF of `v` as the corners of its step line from 0 to `xmax`: at each
+/// sorted value `x_i` (the `i`-th of `n`, from 1) the share rises from
+/// `(i - 1) / n` to `i / n`; non-finite values are left out.
+pub fn ecdf_steps(v: &[f64], xmax: f64) -> Vec<(f64, f64)> {
+    let mut xs: Vec<f64> = v.iter().copied().filter(|x| x.is_finite()).collect();
+    xs.sort_by(f64::total_cmp);
+    let n = xs.len().max(1) as f64;
+    let mut pts = vec![(0.0, 0.0)];
+    for (i, &x) in xs.iter().enumerate() {
+        pts.push((x, i as f64 / n));
+        pts.push((x, (i + 1) as f64 / n));
+    }
+    let last = pts.last().map_or(0.0, |p| p.1);
+    pts.push((xmax, last));
+    pts
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ecdf_rises_by_one_over_n_at_each_value() {
+        let p = ecdf_steps(&[3.0, 1.0, f64::NAN, 2.0, 2.0], 5.0);
+        assert_eq!(
+            p,
+            [
+                (0.0, 0.0),
+                (1.0, 0.0),
+                (1.0, 0.25),
+                (2.0, 0.25),
+                (2.0, 0.5),
+                (2.0, 0.5),
+                (2.0, 0.75),
+                (3.0, 0.75),
+                (3.0, 1.0),
+                (5.0, 1.0)
+            ]
+        );
+    }
 }

@@ -28,6 +28,11 @@ pub struct Shot {
     pub blobs_false: usize,
     /// All places found, no other blob.
     pub ok: bool,
+    /// A start-up trigger: before the walk's first full decision horizon
+    /// ([`crate::trigger::DEFAULT_HORIZON_S`] after its first sample), when
+    /// no policy has seen the motion yet; never the "most blurred" pick while
+    /// another frame is there, and marked in its label.
+    pub startup: bool,
     /// The blob centres at mid-exposure, px (the crop is around them).
     pub expected_px: Vec<(f64, f64)>,
     /// Linear RGB, interleaved, the camera's size.
@@ -52,12 +57,15 @@ impl Extremes {
         }
     }
 
-    /// Keeps `s` where it is sharper than the sharpest or more blurred than the blurriest.
+    /// Keeps `s` where it is sharper than the sharpest or more blurred than
+    /// the blurriest; a start-up trigger is the blurriest only while no
+    /// other frame was offered.
     pub fn offer(&mut self, s: Shot) {
         if s.blur_px < self.sharpest.blur_px {
             self.sharpest = s.clone();
         }
-        if s.blur_px > self.blurriest.blur_px {
+        let b = &self.blurriest;
+        if (b.startup && !s.startup) || (b.startup == s.startup && s.blur_px > b.blur_px) {
             self.blurriest = s;
         }
     }
@@ -82,8 +90,9 @@ pub fn label(policy: &str, which: &str, s: &Shot) -> [String; 2] {
     [
         format!("{policy}: {which}"),
         format!(
-            "t = {:.2} s, blur {:.1} px, {}",
+            "t = {:.2} s{}, blur {:.1} px, {}",
             s.trigger_t,
+            if s.startup { " (start-up trigger)" } else { "" },
             s.blur_px,
             verdict(s)
         ),
@@ -254,6 +263,7 @@ mod tests {
             blobs_expected: 16,
             blobs_false: false_alarms,
             ok,
+            startup: false,
             expected_px: vec![(30.0, 22.0), (34.0, 22.0), (30.0, 26.0), (34.0, 26.0)],
             rgb,
         }
@@ -286,6 +296,21 @@ mod tests {
         });
         assert_eq!(e.blurriest.blobs_matched, 3);
         assert_eq!(e.sharpest.blobs_matched, 16);
+        // A blurrier start-up trigger is not the most blurred pick; alone it
+        // is, marked in its label.
+        let early = Shot {
+            blur_px: 20.0,
+            trigger_t: 0.003,
+            startup: true,
+            ..shot(false, 1, 0)
+        };
+        let mut f = e.clone();
+        f.offer(early.clone());
+        assert_eq!(f.blurriest.blobs_matched, 3);
+        let mut g = Extremes::new(early);
+        assert!(label("p", "most blurred", &g.blurriest)[1].contains("(start-up trigger)"));
+        g.offer(shot(true, 16, 0));
+        assert_eq!(g.blurriest.blobs_matched, 16);
         frames_png(&p, 64, 48, &[("a".into(), &e), ("b".into(), &e)]).unwrap();
         let img = image::open(&p).unwrap().to_rgb8();
         assert_eq!(img.width(), 2 * (PANEL_W + GUTTER) + GUTTER);

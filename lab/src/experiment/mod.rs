@@ -12,6 +12,7 @@
 //! of the truth), and the board's distance follows the log's forward velocity.
 
 pub(crate) mod benefit;
+pub(crate) mod benefit_map;
 pub(crate) mod clutter_report;
 pub(crate) mod config;
 mod config_policies;
@@ -20,9 +21,7 @@ mod crop;
 pub(crate) mod figures;
 mod frame_figure;
 mod frames_csv;
-pub(crate) mod map;
-mod map_render;
-pub(crate) mod map_report;
+pub(crate) mod headline_view;
 pub(crate) mod measure;
 pub(crate) mod report;
 pub(crate) mod run;
@@ -31,9 +30,10 @@ pub(crate) mod truth;
 pub(crate) mod verdict;
 pub(crate) mod walk;
 
+pub use benefit_map::report::{answer as map_answer, timing_verdict};
+pub use benefit_map::{BenefitMap, Cell, CellPolicy};
 pub use config::{ExperimentConfig, MapSection, WalkTimes, DEMO_POLICIES};
-pub use map::{BenefitMap, Cell, CellPolicy};
-pub use map_report::{answer as map_answer, timing_verdict};
+pub use headline_view::{headline_cell, headlines_of};
 pub use report::{table_6, Outcome};
 pub use run::{run, writes};
 pub use verdict::{cell_verdict, three_lines, Verdict};

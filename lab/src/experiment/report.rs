@@ -233,7 +233,7 @@ pub struct Outcome {
     /// Where the frames were rendered (`gpu: <adapter>` or `cpu (N threads)`).
     pub backend: String,
     /// The benefit map (when `[map]` has lights).
-    pub map: Option<super::map::BenefitMap>,
+    pub map: Option<super::benefit_map::BenefitMap>,
 }
 
 impl Outcome {
@@ -242,7 +242,7 @@ impl Outcome {
     /// fixed rate) with their intervals, and where the report is.
     pub fn answer(&self, report: &std::path::Path) -> String {
         if let Some(m) = &self.map {
-            return super::map_report::answer(m, report).join("\n");
+            return super::benefit_map::report::answer(m, report).join("\n");
         }
         let policies: Vec<PolicySpec> = self
             .walks
@@ -419,17 +419,41 @@ pub fn report_md(
             s += &format!("- {line}\n");
         }
         s += "\n";
-        s += &super::map_report::map_md(
+        s += &super::benefit_map::report::map_md(
             m,
             figs.iter()
                 .find(|f| f.as_str() == MAP_FIGURE)
                 .map(String::as_str),
         );
     }
-    s += &super::benefit::headline_md(
-        &super::benefit::headlines(walks, records, &policies),
-        &policies,
-    );
+    let own = super::benefit::headlines(walks, records, &policies);
+    match o
+        .map
+        .as_ref()
+        .and_then(|m| super::headline_view::headline_view_md(cfg, m))
+    {
+        // With a map the headline is the map's cell; the experiment's own
+        // frames keep their table, labelled as the different sample they are.
+        Some(view) => {
+            s += &view;
+            let mut seeds: Vec<u64> = walks.iter().map(|w| w.seed).collect();
+            seeds.sort_unstable();
+            seeds.dedup();
+            s += &super::benefit::headline_md_titled(
+                &own,
+                &policies,
+                "The experiment's own frames (a different sample from the headline)",
+                &format!(
+                    "Frames judged here: the experiment's walks (seeds {seeds:?}), each kept frame rendered whole and \
+                     judged over the whole frame (board, poster and all): a different sample from the headline and the \
+                     map, which judge seeds {:?} in a window around the board. Its rates are not the headline's; \
+                     this table is kept for the ground-truth blur, which only these renders measure.",
+                    o.map.as_ref().map(|m| m.seeds.clone()).unwrap_or_default()
+                ),
+            );
+        }
+        None => s += &super::benefit::headline_md(&own, &policies),
+    }
     s += &super::clutter_report::clutter_md(&cfg.background, walks, records);
     s += &findings(stats);
     s += "\n## Table 5.1: instantaneous MMBM at the trigger vs the exposure average\n\n";

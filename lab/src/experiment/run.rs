@@ -122,6 +122,9 @@ pub fn run(cfg: &ExperimentConfig, out: &Path, progress: bool) -> Result<Outcome
                 blobs_expected: r.expected_px.len(),
                 blobs_false: m.blobs_false,
                 ok: m.blobs_ok,
+                startup: frame.trigger_t
+                    < walks[wi].samples.first().map_or(0.0, |s| s.t)
+                        + crate::trigger::DEFAULT_HORIZON_S,
                 expected_px: r.expected_px.clone(),
                 rgb: r.rgb.clone(),
             };
@@ -137,7 +140,7 @@ pub fn run(cfg: &ExperimentConfig, out: &Path, progress: bool) -> Result<Outcome
     }
     drop(bar);
     let sweep = super::sweep::exposure_sweep(cfg, &walks, quality)?;
-    let map = super::map::benefit_map(cfg, quality, progress)?;
+    let map = super::benefit_map::benefit_map(cfg, quality, progress)?;
 
     let mut records = Vec::new();
     for (wi, w) in walks.iter().enumerate() {
@@ -167,7 +170,7 @@ pub fn run(cfg: &ExperimentConfig, out: &Path, progress: bool) -> Result<Outcome
 
         let mut figs = figures::write_all(out, cfg, &walks, &records, &extremes)?;
         if let Some(m) = &map {
-            super::map_report::heat_map_png(&out.join(super::report::MAP_FIGURE), m)?;
+            super::benefit_map::report::heat_map_png(&out.join(super::report::MAP_FIGURE), m)?;
             figs.push(super::report::MAP_FIGURE.to_string());
         }
         let outcome = Outcome {

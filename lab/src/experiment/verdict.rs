@@ -9,7 +9,7 @@
 //! **loses** when one lies below 1, and it **ties** otherwise.
 
 use super::benefit::Estimate;
-use super::map::{BenefitMap, Cell};
+use super::benefit_map::{BenefitMap, Cell};
 
 /// A cell's verdict.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -112,13 +112,19 @@ fn board_name(b: &str) -> &str {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::experiment::map::CellPolicy;
+    use crate::experiment::benefit_map::CellPolicy;
     use crate::trigger::PolicySpec;
 
     fn cell(h: (f64, f64), g: (f64, f64)) -> Cell {
         let p = |s: &str| CellPolicy {
             policy: PolicySpec::parse(s).unwrap(),
             sharp_fps: 1.0,
+            sharp_ci: Estimate {
+                value: 1.0,
+                lo: f64::NAN,
+                hi: f64::NAN,
+            },
+            vs_fixed: None,
             frames: 10,
             sharp: 5,
             mean_exposure_s: 0.01,
@@ -147,6 +153,8 @@ mod tests {
             vs_fixed: None,
             vs_gyro: Some(e(g)),
             winner: 1,
+            vo_winner: 1,
+            vo_vs_baseline: None,
             blocks: 8,
         }
     }

@@ -3,14 +3,11 @@
 //! with their reasons (all computed from the map), a heat map, and the few
 //! lines the terminal ends with.
 
-use super::benefit::{Estimate, BLOCK_S, BOOTSTRAP_SEED, RESAMPLES};
-use super::corners::{FAST_THRESHOLD, MATCH_PX, NMS_RADIUS, REPEAT_OK};
-use super::map::{BenefitMap, Cell};
-use super::verdict::column;
-use crate::error::Result;
-use crate::io::atomic::write_atomic_path;
-use crate::plot::{ensure_font, plot_error};
-use plotters::prelude::*;
+use super::super::benefit::{Estimate, BLOCK_S, BOOTSTRAP_SEED, RESAMPLES};
+use super::super::corners::{FAST_THRESHOLD, MATCH_PX, NMS_RADIUS, REPEAT_OK};
+use super::super::verdict::column;
+pub use super::heat::heat_map_png;
+use super::{BenefitMap, Cell};
 use std::path::Path;
 
 /// Light below which a cell is dim (the goals' "<= 1,000 e-/s"), e-/s.
@@ -61,14 +58,16 @@ pub fn map_md(m: &BenefitMap, figure: Option<&str>) -> String {
          policy (family `mmbm`) over the best fixed exposure in hindsight (family `oracle`: the fixed exposure of the \
          grid {:?} ms with the most sharp frames in the cell), over auto-exposure (`auto-exposure`) and, to ask whether \
          the trigger's *timing* pays, over the best gyro-aware exposure at the fixed rate (`gyro-exposure`: \
-         `ae-blur`, `ae-imu`, `fixed:FPS+exp`; docs/spec.md section 11). Seeds {:?}, \
-         {:.0}-s blocks ({} per cell), 95 % percentile bootstrap over {} resamplings of the blocks (bootstrap seed {}), \
+         `ae-blur`, `ae-imu`, `fixed:FPS+exp`; docs/spec.md section 11). Frames judged: every kept frame of seeds {:?}, \
+         each judged in a window around the board (the blob grid padded by {} blob pitches); the headline below reads \
+         this table's cell. {:.0}-s blocks ({} per cell), 95 % percentile bootstrap over {} resamplings of the blocks (bootstrap seed {}), \
          paired block by block; the best policies are chosen on all blocks, then held fixed. Light = electrons per \
          second in a white pixel; gain `K_ref = {} / (light x {:.0} ms)` (white fills the range at the reference \
          exposure), raised by each policy to keep the brightness and capped at {}x the full-well gain ({:.3} DN/e-); \
          read noise {} e-, full well {} e-, {} bits.\n\n",
         m.grid_ms,
         m.seeds,
+        super::render::WINDOW_PITCHES,
         BLOCK_S,
         first.map_or(0, |c| c.blocks),
         RESAMPLES,
@@ -103,7 +102,7 @@ pub fn map_md(m: &BenefitMap, figure: Option<&str>) -> String {
             };
             let w = &c.policies[c.winner];
             s += &format!(
-                " {}vs best fixed {}; vs AE {}; timing vs gyro-exposure {} ({}); won: `{}`{} |",
+                " {}vs best fixed {}; vs AE {}; timing vs gyro-exposure {} ({}); won: `{}`{}; VO won: `{}` |",
                 if lost(c) { "**lost** " } else { "" },
                 opt(&c.vs_hindsight),
                 opt(&c.vs_ae),
@@ -114,7 +113,8 @@ pub fn map_md(m: &BenefitMap, figure: Option<&str>) -> String {
                     " (best fixed in hindsight)"
                 } else {
                     ""
-                }
+                },
+                c.policies[c.vo_winner].policy
             );
         }
         s += "\n";
@@ -151,6 +151,7 @@ pub fn map_md(m: &BenefitMap, figure: Option<&str>) -> String {
         );
     }
     s += "\n";
+    s += &timing_md(m);
     s += &second_metric_md(m);
     s += &goals_md(m);
     s += &format!(
@@ -178,8 +179,8 @@ pub fn second_metric_md(m: &BenefitMap) -> String {
          repeatability, false alarms per frame (blobs found away from every board place).\n\n",
         FAST_THRESHOLD, NMS_RADIUS, MATCH_PX, REPEAT_OK
     );
-    s += "| light | gait, board | best `mmbm` | best fixed in hindsight | auto-exposure | most VO frames/s |\n";
-    s += "|---|---|---|---|---|---|\n";
+    s += "| light | gait, board | best `mmbm` | best fixed in hindsight | auto-exposure | most VO frames/s | VO: best `mmbm` over the strongest baseline |\n";
+    s += "|---|---|---|---|---|---|---|\n";
     let show = |c: &Cell, i: Option<usize>| {
         i.map_or("-".into(), |i| {
             let p = &c.policies[i];
@@ -196,17 +197,17 @@ pub fn second_metric_md(m: &BenefitMap) -> String {
     for c in &m.cells {
         let vo = c
             .policies
-            .iter()
-            .max_by(|a, b| a.vo_fps.total_cmp(&b.vo_fps))
+            .get(c.vo_winner)
             .map_or("-".into(), |p| format!("`{}` {:.2}", p.policy, p.vo_fps));
         s += &format!(
-            "| {} | {} | {} | {} | {} | {} |\n",
+            "| {} | {} | {} | {} | {} | {} | {} |\n",
             c.light,
             column(c),
             show(c, c.best_mmbm),
             show(c, c.hindsight),
             show(c, c.ae),
-            vo
+            vo,
+            vo_ratio(c)
         );
     }
     // Where the best `mmbm` policy leads on odometry frames too.
@@ -230,7 +231,7 @@ fn reason(c: &Cell) -> String {
     let Some(b) = c.best_mmbm.map(|i| &c.policies[i]) else {
         return "no `mmbm` policy was run".into();
     };
-    let share = |p: &super::map::CellPolicy| 100.0 * p.sharp as f64 / p.frames.max(1) as f64;
+    let share = |p: &super::CellPolicy| 100.0 * p.sharp as f64 / p.frames.max(1) as f64;
     format!(
         "`{}` gets {:.2} sharp/s ({:.0} % of {} frames sharp, mean exposure {:.1} ms, {} frames gain-capped) against \
          `{}`'s {:.2} ({:.0} % of {}, mean exposure {:.1} ms, {} gain-capped)",
@@ -268,12 +269,14 @@ fn ceiling(m: &BenefitMap, c: &Cell, base: Option<usize>) -> String {
     }
 }
 
-/// The goals of issue 27, checked against the map (met or not, with the numbers).
+/// The benefit map's goals (docs/experiment.md, "The benefit map"), checked
+/// against the map (met or not, with the numbers).
 pub fn goals_md(m: &BenefitMap) -> String {
-    let mut s = String::from("Goals (issue 27), computed from the map:\n\n");
+    let mut s =
+        String::from("Goals (docs/experiment.md, the benefit map), computed from the map:\n\n");
     let met = |b: bool| if b { "met" } else { "not met" };
     // 1. Half board, the demo's light, moderate walk: >= 1.5x fixed, CI above 1.
-    let demo = super::config::ExperimentConfig::DEMO_LIGHT_E_PER_S;
+    let demo = super::super::config::ExperimentConfig::DEMO_LIGHT_E_PER_S;
     match m
         .cells
         .iter()
@@ -343,16 +346,93 @@ pub fn goals_md(m: &BenefitMap) -> String {
             ))
             .collect::<String>()
     );
+    // 4. Dim cells, second task: >= 1.5x the strongest baseline's VO frames/s, CI above 1.
+    let vo_ok = dim
+        .iter()
+        .filter(|c| {
+            c.vo_vs_baseline
+                .is_some_and(|(r, ..)| r.value >= 1.5 && r.lo > 1.0)
+        })
+        .count();
+    s += &format!(
+        "- Dim cells (<= {DIM_LIGHT} e-/s), odometry task: {vo_ok} of {} reach 1.5x the VO frames per second of the \
+         strongest baseline (hindsight grid, auto-exposure, `gyro-exposure`) with the CI above 1 (goal: all, {}){}.\n",
+        dim.len(),
+        met(!dim.is_empty() && vo_ok == dim.len()),
+        dim.iter()
+            .map(|c| format!("; {} {}: {}", c.light, column(c), vo_ratio(c)))
+            .collect::<String>()
+    );
     for c in m.cells.iter().filter(|c| lost(c)) {
         s += &format!("- Lost: {} e-/s, {}: {}.\n", c.light, column(c), reason(c));
     }
     s
 }
 
+/// The odometry task's ratio of cell `c`: `1.20x [1.01, 1.40] (`a` over `b`)`.
+pub fn vo_ratio(c: &Cell) -> String {
+    match c.vo_vs_baseline {
+        Some((r, a, b)) => format!(
+            "{} (`{}` over `{}`)",
+            ci(&r),
+            c.policies[a].policy,
+            c.policies[b].policy
+        ),
+        None => "-".into(),
+    }
+}
+
+/// Timing against gyro-aware exposure, per cell, with the numbers that
+/// explain it: for the best `mmbm` policy and the best `gyro-exposure`
+/// policy, the share of sharp frames, the mean exposure, the frames whose
+/// gain the sensor's maximum capped, and the gain headroom at that light
+/// (the maximum gain over the reference gain `K_ref`): an exposure shorter
+/// than `T_ref / headroom` cannot be brought back to full brightness, so a
+/// policy that shortens the exposure for blur (as `gyro-exposure` does at a
+/// fixed rate) gets darker, noisier frames in dim light.
+pub fn timing_md(m: &BenefitMap) -> String {
+    let mut s = String::from(
+        "### Timing against gyro-aware exposure, per cell\n\nWhy the best `mmbm` policy (trigger timing from \
+         the gyro) and the best `gyro-exposure` policy (fixed rate, exposure from the gyro) differ, from the map's \
+         frames (all seeds pooled):\n\n",
+    );
+    for c in &m.cells {
+        let (Some(a), Some(g)) = (c.best_mmbm, c.gyro) else {
+            continue;
+        };
+        let light = super::render::Light::new(&m.sensor, c.light, m.t_ref_s, m.max_gain_x);
+        let headroom = light.max_gain_dn_per_e / light.noise.gain();
+        let one = |p: &super::CellPolicy| {
+            format!(
+                "`{}` {:.0} % of {} frames sharp, mean exposure {:.1} ms, {} gain-capped",
+                p.policy,
+                100.0 * p.sharp as f64 / p.frames.max(1) as f64,
+                p.frames,
+                p.mean_exposure_s * 1e3,
+                p.gain_capped
+            )
+        };
+        s += &format!(
+            "- {} e-/s, {}: timing vs gyro-exposure {} ({}); {} against {}; gain headroom {:.2}x, so exposures under \
+             {:.1} ms are darker than meant.\n",
+            c.light,
+            column(c),
+            opt(&c.vs_gyro),
+            timing_verdict(c),
+            one(&c.policies[a]),
+            one(&c.policies[g]),
+            headroom,
+            m.t_ref_s / headroom * 1e3
+        );
+    }
+    s.push('\n');
+    s
+}
+
 /// The few lines the terminal ends with: the three lines of
-/// [`super::verdict::three_lines`], the map's ratios and where the report is.
+/// [`super::super::verdict::three_lines`], the map's ratios and where the report is.
 pub fn answer(m: &BenefitMap, report: &Path) -> Vec<String> {
-    let mut out: Vec<String> = super::verdict::three_lines(m).into();
+    let mut out: Vec<String> = super::super::verdict::three_lines(m).into();
     let won = m.cells.iter().filter(|c| !lost(c)).count();
     out.push(format!(
         "Benefit map ({} cells, seeds {:?}): gyro-driven capture is below neither the best fixed exposure in hindsight \
@@ -374,136 +454,11 @@ pub fn answer(m: &BenefitMap, report: &Path) -> Vec<String> {
     out
 }
 
-/// The map as a heat map: rows light, columns gait x board, colour the best
-/// `mmbm` policy's ratio to the best fixed exposure in hindsight (log scale,
-/// red below 1, blue above), each cell labelled ([`heat_labels`]) with that
-/// ratio and its 95 % interval, the ratio to auto-exposure, and the winner.
-pub fn heat_map_png(path: &Path, m: &BenefitMap) -> Result<()> {
-    ensure_font()?;
-    let mut cols: Vec<String> = Vec::new();
-    for c in &m.cells {
-        if !cols.contains(&column(c)) {
-            cols.push(column(c));
-        }
-    }
-    let (nc, nr) = (cols.len().max(1), m.lights.len().max(1));
-    write_atomic_path(path, |tmp| {
-        let e = plot_error(path);
-        let root = BitMapBackend::new(tmp, (200 + 330 * nc as u32, 110 + 96 * nr as u32))
-            .into_drawing_area();
-        root.fill(&WHITE).map_err(&e)?;
-        let mut chart = ChartBuilder::on(&root)
-            .caption(
-                "best mmbm / best fixed exposure in hindsight (sharp frames/s)",
-                ("sans-serif", 18),
-            )
-            .margin(10)
-            .x_label_area_size(40)
-            .y_label_area_size(110)
-            .build_cartesian_2d(-0.5..nc as f64 - 0.5, -0.5..nr as f64 - 0.5)
-            .map_err(&e)?;
-        let lights = m.lights.clone();
-        let colnames = cols.clone();
-        chart
-            .configure_mesh()
-            .disable_mesh()
-            .x_labels(nc)
-            .y_labels(nr)
-            .x_label_formatter(&|x| {
-                colnames
-                    .get(x.round().max(0.0) as usize)
-                    .filter(|_| (x - x.round()).abs() < 0.01)
-                    .cloned()
-                    .unwrap_or_default()
-            })
-            .y_label_formatter(&|y| {
-                lights
-                    .get(y.round().max(0.0) as usize)
-                    .filter(|_| (y - y.round()).abs() < 0.01)
-                    .map(|l| format!("{l} e-/s"))
-                    .unwrap_or_default()
-            })
-            .draw()
-            .map_err(&e)?;
-        for c in &m.cells {
-            let (Some(ci), Some(ri)) = (
-                cols.iter().position(|x| *x == column(c)),
-                m.lights.iter().position(|&l| l == c.light),
-            ) else {
-                continue;
-            };
-            let r = c.vs_hindsight.map_or(f64::NAN, |r| r.value);
-            // log2 ratio in [-1, 1] -> red .. white .. blue.
-            let t = if r.is_finite() && r > 0.0 {
-                r.log2().clamp(-1.0, 1.0)
-            } else {
-                0.0
-            };
-            let colour = if t >= 0.0 {
-                let v = (255.0 * (1.0 - t)) as u8;
-                RGBColor(v, v, 255)
-            } else {
-                let v = (255.0 * (1.0 + t)) as u8;
-                RGBColor(255, v, v)
-            };
-            let (x, y) = (ci as f64, ri as f64);
-            chart
-                .draw_series(std::iter::once(Rectangle::new(
-                    [(x - 0.5, y - 0.5), (x + 0.5, y + 0.5)],
-                    colour.filled(),
-                )))
-                .map_err(&e)?;
-            for (k, line) in heat_labels(c).iter().enumerate() {
-                chart
-                    .draw_series(std::iter::once(Text::new(
-                        line.clone(),
-                        (x - 0.46, y + 0.40 - 0.22 * k as f64),
-                        ("sans-serif", if k == 0 { 17 } else { 13 }),
-                    )))
-                    .map_err(&e)?;
-            }
-        }
-        root.present().map_err(&e)?;
-        Ok(())
-    })
-}
-
-/// The lines a heat-map cell is labelled with: the best `mmbm` policy over
-/// the best fixed exposure in hindsight with its 95 % interval (and `lost`
-/// where [`lost`]), over auto-exposure, over the best `gyro-exposure` policy
-/// with [`timing_verdict`], and the policy with the most sharp frames per
-/// second with that rate.
-pub fn heat_labels(c: &Cell) -> Vec<String> {
-    let short = |e: &Option<Estimate>| match e {
-        Some(e) if e.value.is_finite() && e.lo.is_finite() => {
-            format!("{:.2}x [{:.2}, {:.2}]", e.value, e.lo, e.hi)
-        }
-        Some(e) if e.value.is_finite() => format!("{:.2}x", e.value),
-        _ => "n/a".into(),
-    };
-    let mut first = format!("vs hindsight {}", short(&c.vs_hindsight));
-    if lost(c) {
-        first += " lost";
-    }
-    let mut out = vec![
-        first,
-        format!("vs auto-exposure {}", short(&c.vs_ae)),
-        format!(
-            "timing vs gyro-exposure {} {}",
-            short(&c.vs_gyro),
-            timing_verdict(c)
-        ),
-    ];
-    if let Some(w) = c.policies.get(c.winner) {
-        out.push(format!("won by {} ({:.2} /s)", w.policy, w.sharp_fps));
-    }
-    out
-}
-
 #[cfg(test)]
 mod tests {
+    use super::super::heat::heat_labels;
     use super::*;
-    use crate::experiment::map::CellPolicy;
+    use crate::experiment::benefit_map::CellPolicy;
     use crate::trigger::PolicySpec;
 
     #[test]
@@ -511,6 +466,12 @@ mod tests {
         let p = |s: &str, fps: f64| CellPolicy {
             policy: PolicySpec::parse(s).unwrap(),
             sharp_fps: fps,
+            sharp_ci: Estimate {
+                value: fps,
+                lo: f64::NAN,
+                hi: f64::NAN,
+            },
+            vs_fixed: None,
             frames: 10,
             sharp: 5,
             mean_exposure_s: 0.01,
@@ -538,6 +499,8 @@ mod tests {
             vs_ae: None,
             vs_fixed: None,
             winner: 1,
+            vo_winner: 1,
+            vo_vs_baseline: None,
             blocks: 8,
         };
         assert_eq!(

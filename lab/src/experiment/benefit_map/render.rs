@@ -2,9 +2,9 @@
 //! judged (blob extraction) at every light level with the sensor noise of
 //! that light and the gain a camera would set there (docs/spec.md section 10).
 
-use super::corners;
-use super::measure::{blob_metrics, bulk_job, frame_motion};
-use super::walk::Walk;
+use super::super::corners;
+use super::super::measure::{blob_metrics, bulk_job, frame_motion};
+use super::super::walk::Walk;
 use crate::camera::{Camera, Noise};
 use crate::error::Result;
 use crate::io::images::to_rgb8;
@@ -107,7 +107,7 @@ pub fn judge_at_lights(
     // grid padded by WINDOW_PITCHES pitches), not the whole frame: the noise
     // is most of the cost.
     let (w, h) = (cam.width as usize, cam.height as usize);
-    let pad = WINDOW_PITCHES * super::crop::pitch_px(&expected);
+    let pad = WINDOW_PITCHES * super::super::crop::pitch_px(&expected);
     let lo = |v: f64| (v - pad).floor().max(0.0) as usize;
     let (xs, ys) = (expected.iter().map(|p| p.0), expected.iter().map(|p| p.1));
     let x0 = lo(xs.clone().fold(f64::INFINITY, f64::min)).min(w - 1);
