@@ -79,8 +79,27 @@ fn bilinear(u_in: f32, v_in: f32) -> vec4<f32> {
     let fy = v - y0;
     let x = i32(x0);
     let y = i32(y0);
-    let top = lerp4(texel(x, y), texel(x + 1, y), fx);
-    let bot = lerp4(texel(x, y + 1), texel(x + 1, y + 1), fx);
+    let w = i32(params.dims.x);
+    let h = i32(params.dims.y);
+    var t00: vec4<f32>;
+    var t10: vec4<f32>;
+    var t01: vec4<f32>;
+    var t11: vec4<f32>;
+    if (x >= 0 && y >= 0 && x + 1 < w && y + 1 < h) {
+        // Inside: the four texels directly (what texel() gives there).
+        let a = y * w + x;
+        t00 = img[a];
+        t10 = img[a + 1];
+        t01 = img[a + w];
+        t11 = img[a + w + 1];
+    } else {
+        t00 = texel(x, y);
+        t10 = texel(x + 1, y);
+        t01 = texel(x, y + 1);
+        t11 = texel(x + 1, y + 1);
+    }
+    let top = lerp4(t00, t10, fx);
+    let bot = lerp4(t01, t11, fx);
     return lerp4(top, bot, fy);
 }
 
@@ -101,8 +120,9 @@ fn pixel(i: u32, j: u32) -> vec4<f32> {
         if (z <= 0.0) {
             acc = acc + params.fill;
         } else {
-            let u = (g.r0.x * x + g.r0.y * y + g.r0.z) / z - 0.5;
-            let v = (g.r1.x * x + g.r1.y * y + g.r1.z) / z - 0.5;
+            let r = 1.0 / z;
+            let u = (g.r0.x * x + g.r0.y * y + g.r0.z) * r - 0.5;
+            let v = (g.r1.x * x + g.r1.y * y + g.r1.z) * r - 0.5;
             acc = acc + bilinear(u, v);
         }
     }

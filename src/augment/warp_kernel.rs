@@ -154,8 +154,22 @@ pub fn bilinear(img: &[[f32; 4]], p: &WarpParams, u: f32, v: f32) -> [f32; 4] {
     let (x0, y0) = (u.floor(), v.floor());
     let (fx, fy) = (u - x0, v - y0);
     let (x, y) = (x0 as i32, y0 as i32);
-    let top = lerp4(texel(img, p, x, y), texel(img, p, x + 1, y), fx);
-    let bot = lerp4(texel(img, p, x, y + 1), texel(img, p, x + 1, y + 1), fx);
+    let (w, h) = (p.dims[0] as i32, p.dims[1] as i32);
+    let [t00, t10, t01, t11] = if x >= 0 && y >= 0 && x + 1 < w && y + 1 < h {
+        // Inside: the four texels directly (what `texel` gives there).
+        let a = (y * w + x) as usize;
+        let w = w as usize;
+        [img[a], img[a + 1], img[a + w], img[a + w + 1]]
+    } else {
+        [
+            texel(img, p, x, y),
+            texel(img, p, x + 1, y),
+            texel(img, p, x, y + 1),
+            texel(img, p, x + 1, y + 1),
+        ]
+    };
+    let top = lerp4(t00, t10, fx);
+    let bot = lerp4(t01, t11, fx);
     lerp4(top, bot, fy)
 }
 
@@ -176,8 +190,9 @@ pub fn pixel(img: &[[f32; 4]], p: &WarpParams, maps: &[WarpMap], i: u32, j: u32)
         let s = if z <= 0.0 {
             p.fill
         } else {
-            let u = (g.r0[0] * x + g.r0[1] * y + g.r0[2]) / z - 0.5;
-            let v = (g.r1[0] * x + g.r1[1] * y + g.r1[2]) / z - 0.5;
+            let r = 1.0 / z;
+            let u = (g.r0[0] * x + g.r0[1] * y + g.r0[2]) * r - 0.5;
+            let v = (g.r1[0] * x + g.r1[1] * y + g.r1[2]) * r - 0.5;
             bilinear(img, p, u, v)
         };
         for c in 0..4 {
