@@ -8,7 +8,8 @@ Rows: mmbm augment (default: ``integrator="fast"``), mmbm exact, a 30-warp
 average (OpenCV ``warpPerspective`` at 30 evenly spaced instants of the same
 rotation, reflected border: the gyro-driven generators' method), and
 albumentations' ``MotionBlur`` (a 21-tap line kernel, horizontal, centred:
-one 2-D kernel for the whole image). ``augment_batch`` of 16 is timed too. The blur maps are not asked for
+one 2-D kernel for the whole image). mmbm's fast integrator is also timed on
+the GPU (``backend="gpu"``, when an adapter exists). ``augment_batch`` of 16 is timed too. The blur maps are not asked for
 (``return_maps=False``, the default): they are a measure, not the image.
 
 Needs ``opencv-python-headless`` and ``albumentations`` (measurement only;
@@ -78,6 +79,14 @@ def main():
     ref = exact["image"]
     rows.append(("mmbm augment (fast)", t_fast, *err(fast["image"], ref), f"{fast['samples']} warps"))
     rows.append(("mmbm exact", t_exact, 0.0, 0.0, f"{exact['samples']} warps"))
+    # The GPU kernel (backend="gpu"; on a machine without a hardware GPU a
+    # software adapter such as Mesa lavapipe, slower than the CPU there).
+    try:
+        mmbm.augment(img, backend="gpu", **common)  # compiles the kernel
+        t_gpu, gpu = timed(lambda: mmbm.augment(img, backend="gpu", **common), 7)
+        rows.append(("mmbm augment (fast, backend gpu)", t_gpu, *err(gpu["image"], ref), f"{gpu['samples']} warps"))
+    except Exception as e:  # no adapter
+        rows.append(("mmbm augment (fast, backend gpu)", float("nan"), float("nan"), float("nan"), f"no adapter: {e}"))
     # The 30-warp rotation must be the same motion: its mid homography is mmbm's.
     try:
         t_w, w30 = timed(lambda: warp30(img), 3)

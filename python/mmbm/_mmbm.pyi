@@ -114,6 +114,7 @@ def augment(
     blur_px: Optional[float],
     fields: bool,
     maps: bool,
+    backend: str = "bulk",
 ) -> Tuple[Any, Optional[Dict[str, F32]], F64, Optional[F32], List[str], List[int]]: ...
 
 AUGMENT_MAX_PIXELS: int

@@ -104,10 +104,12 @@ fn run<'py, T: Element + Copy + Send + Sync>(
 /// `gyro`, `at`). Returns (images, maps (N, H, W) each or None without
 /// `maps`, homographies
 /// (N, 3, 3, 3), fields (N, 3, H, W, 2) or None, motions drawn, warp
-/// instants per image).
+/// instants per image). `backend`: where the warp integrators run (`bulk`,
+/// `auto`, `gpu` or `cpu`; [`Augment::backend`]).
 #[pyfunction]
 #[pyo3(signature = (images, seeds, motion, omega, velocity, gyro, at, exposure, cam, distance, zoom,
-    sharp, quality, background, use_velocity, srgb, integrator, border, blur_px, fields, maps))]
+    sharp, quality, background, use_velocity, srgb, integrator, border, blur_px, fields, maps,
+    backend="bulk"))]
 #[allow(clippy::too_many_arguments)]
 pub fn augment<'py>(
     py: Python<'py>,
@@ -132,6 +134,7 @@ pub fn augment<'py>(
     blur_px: Option<f64>,
     fields: bool,
     maps: bool,
+    backend: &str,
 ) -> PyResult<Out<'py>> {
     let mut job = Augment::new(self::motion(motion, omega, velocity, gyro, at)?, exposure);
     job.camera = cam.map(|c| camera(&c)).transpose()?;
@@ -146,6 +149,7 @@ pub fn augment<'py>(
     job.blur_px = blur_px;
     job.fields = fields;
     job.maps = maps;
+    job.backend = backend.parse().map_err(err)?;
     let jobs: Vec<Augment> = seeds
         .iter()
         .map(|&s| Augment {

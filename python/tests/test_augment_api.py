@@ -5,6 +5,7 @@ borders, fields, ``read_exr`` from bytes, ``BlurDataset(transform=)``, and the
 pixel cap refused from the shape before any copy."""
 
 import io
+import os
 import tarfile
 from pathlib import Path
 
@@ -194,3 +195,23 @@ def test_maps_only_when_asked_for():
     b = mmbm.augment_batch(np.stack([img, img]), seed=2, motion=YAW, return_maps=True)
     assert b["maps"]["path_px"].shape == (2, 48, 64)
     assert "maps" not in mmbm.augment_batch(np.stack([img, img]), seed=2, motion=YAW)
+
+
+def test_backend_choice_and_a_bad_value():
+    # bulk (default) is a hardware GPU or the CPU; gpu is any adapter: both
+    # compute the CPU's formula (within 1e-4 linear, tests/augment_gpu.rs).
+    img = noise((48, 64, 3), np.float32)
+    cpu = mmbm.augment(img, motion=YAW, seed=1, backend="cpu")["image"]
+    bulk = mmbm.augment(img, motion=YAW, seed=1)["image"]
+    np.testing.assert_allclose(bulk, cpu, atol=1e-4, rtol=0)
+    batch = mmbm.augment_batch(img[None], seed=1, motion=YAW, backend="cpu")["image"][0]
+    np.testing.assert_array_equal(batch, cpu)
+    with pytest.raises(ValueError, match="backend"):
+        mmbm.augment(img, motion=YAW, seed=1, backend="cuda")
+    try:
+        gpu = mmbm.augment(img, motion=YAW, seed=1, backend="gpu")["image"]
+    except Exception as e:  # no adapter here
+        if os.environ.get("MMBM_REQUIRE_GPU") == "1":
+            raise
+        pytest.skip(f"no GPU adapter: {e}")
+    np.testing.assert_allclose(gpu, cpu, atol=1e-4, rtol=0)

@@ -21,7 +21,9 @@
 //! (exact: within 0.02/255) apart along the longest path ([`bound`],
 //! [`warp`]); `render` is the renderer (each pixel the
 //! exact integral of the interpolant over its area and the exposure, so a
-//! still image is the (1/8, 3/4, 1/8) filter of the input). Without motion
+//! still image is the (1/8, 3/4, 1/8) filter of the input). The warp
+//! integrators run on the CPU or, with [`Augment::backend`], on the GPU
+//! ([`gpu`], `warp.wgsl`; its CPU twin [`warp_kernel`]). Without motion
 //! every integrator returns the input bit for bit. The blur maps are
 //! computed only when asked for ([`Augment::maps`]): they cost more than
 //! the fast blur itself.
@@ -33,9 +35,12 @@
 //! refused with one since the map is not a homography then).
 
 pub mod bound;
+pub mod gpu;
 pub mod motion;
 pub mod pixels;
+mod rendered;
 pub mod warp;
+pub mod warp_kernel;
 
 pub use pixels::{Image, PixelBuf, Pixels};
 pub use warp::Border;
@@ -45,9 +50,7 @@ use crate::error::{Error, Result};
 use crate::io::gyro::GyroSample;
 use crate::limits::{AUGMENT_MAX_PIXEL_SAMPLES, AUGMENT_MAX_WARP_SAMPLES};
 use crate::model::motion::Twist;
-use crate::render::{
-    self, Backend, BlurMaps, Pose, Quality, RenderJob, SharpAt, Target, Trajectory,
-};
+use crate::render::{self, Backend, BlurMaps, Pose, Quality, SharpAt, Target};
 use crate::sim::Gait;
 use glam::{DMat3, DVec3};
 use rayon::prelude::*;
@@ -170,13 +173,18 @@ pub struct Augment {
     /// Warp instants per pixel; `None` (default): from the longest path and
     /// the integrator's spacing ([`Integrator::spacing_px`]).
     pub warps: Option<usize>,
+    /// Where the warp integrators run: `Bulk` (default: a hardware GPU,
+    /// else the CPU; a software adapter such as lavapipe is slower than
+    /// the CPU), `Auto` (any adapter, else the CPU), `Gpu` (an adapter or
+    /// an error), `Cpu`. `render` always runs on the CPU.
+    pub backend: Backend,
 }
 
 impl Augment {
     /// Defaults: `exposure_s` of the given motion, thesis camera, 2 m, zoom
     /// 1, exposure start as reference, seed 0, `fast` integrator, reflected
     /// border, black background, translation used, no blur target, no
-    /// fields, no maps, warp instants from the path.
+    /// fields, no maps, warp instants from the path, backend `bulk`.
     pub fn new(motion: Motion, exposure_s: f64) -> Self {
         Augment {
             motion,
@@ -195,6 +203,7 @@ impl Augment {
             fields: false,
             maps: false,
             warps: None,
+            backend: Backend::Bulk,
         }
     }
 }
@@ -344,6 +353,27 @@ fn camera(a: &Augment, w: u32, h: u32) -> Result<Camera> {
 
 /// Blurs `img` as [`Augment`] says; the result has its size, channels and dtype.
 pub fn augment_image(img: &Image, a: &Augment) -> Result<AugmentedImage> {
+    augment_with(
+        img,
+        a,
+        &|src, maps| match gpu::device(a.backend, src.w, src.h, maps.m.len())? {
+            Some(ctx) => gpu::integrate(ctx, src, maps),
+            None => Ok(warp::integrate(src, maps)),
+        },
+    )
+}
+
+/// [`augment_image`] with the warp integrators run by the GPU kernel's CPU
+/// twin ([`warp_kernel`]; `backend` unused): the reference the GPU path is
+/// checked against (`tests/augment_gpu.rs`).
+pub fn augment_twin(img: &Image, a: &Augment) -> Result<AugmentedImage> {
+    augment_with(img, a, &|src, maps| Ok(warp_kernel::twin(src, maps)))
+}
+
+/// The warp integrator's run: the warp average of a linear image over maps.
+type WarpFn<'a> = &'a dyn Fn(&warp::Src, &warp::Maps) -> Result<Vec<f32>>;
+
+fn augment_with(img: &Image, a: &Augment, warp_fn: WarpFn) -> Result<AugmentedImage> {
     crate::check::positive("exposure (s)", a.exposure_s)?;
     crate::check::positive("distance (m)", a.distance_m)?;
     crate::check::positive("zoom", a.zoom)?;
@@ -368,7 +398,7 @@ pub fn augment_image(img: &Image, a: &Augment) -> Result<AugmentedImage> {
     let texture = render::texture::MipTexture::from_linear(2, 2, vec![0.0; 12])?;
     let mut target = Target::from_texture(texture, width_m, a.distance_m);
     target.background = a.background;
-    let span = a.exposure_s + cam.shutter.readout_s;
+    let span = cam.shutter.busy_s(a.exposure_s);
     let (traj, what) = motion::trajectory(a, span)?;
     let traj = match a.blur_px {
         Some(b) if b > 0.0 => motion::fit_blur(&cam, &target, &traj, b)?,
@@ -474,7 +504,10 @@ pub fn augment_image(img: &Image, a: &Augment) -> Result<AugmentedImage> {
     let (pixels, samples) = if still {
         (img.pixels.to_buf(), 0)
     } else if a.integrator == Integrator::Render {
-        (img.encode(rendered(img, a, &cam, traj, width_m)?), 1)
+        (
+            img.encode(rendered::rendered(img, a, &cam, traj, width_m)?),
+            1,
+        )
     } else {
         let lin = img.to_linear();
         let c = img.channels as usize;
@@ -496,7 +529,7 @@ pub fn augment_image(img: &Image, a: &Augment) -> Result<AugmentedImage> {
             n,
             mode,
         };
-        (img.encode(warp::integrate(&src, &maps)), n)
+        (img.encode(warp_fn(&src, &maps)?), n)
     };
     crate::cancel::check()?;
     Ok(AugmentedImage {
@@ -507,58 +540,6 @@ pub fn augment_image(img: &Image, a: &Augment) -> Result<AugmentedImage> {
         motion: what,
         samples,
     })
-}
-
-/// The renderer's frame of `img` (linear, its channels), three channels a
-/// render; only a constant border (the renderer's background).
-fn rendered(
-    img: &Image,
-    a: &Augment,
-    cam: &Camera,
-    traj: Trajectory,
-    width_m: f64,
-) -> Result<Vec<f32>> {
-    if a.border != Border::Constant {
-        return Err(Error::invalid(
-            "border",
-            "integrator 'render' shows the background beyond the image: use border 'constant'",
-        ));
-    }
-    let (w, h, c) = (
-        img.width as usize,
-        img.height as usize,
-        img.channels as usize,
-    );
-    let lin = img.to_linear();
-    let mut out = vec![0.0f32; w * h * c];
-    for g in 0..c.div_ceil(3) {
-        let chans: Vec<usize> = (g * 3..(g * 3 + 3).min(c)).collect();
-        let mut rgb = vec![0.0f32; w * h * 3];
-        for p in 0..w * h {
-            for (k, &ch) in chans.iter().enumerate() {
-                rgb[p * 3 + k] = lin[p * c + ch];
-            }
-        }
-        let texture = render::texture::MipTexture::from_linear(w as u32, h as u32, rgb)?;
-        let mut target = Target::from_texture(texture, width_m, a.distance_m);
-        target.background = match c {
-            3 => a.background,
-            1 => [a.background[0]; 3],
-            _ => [0.0; 3],
-        };
-        let mut job = RenderJob::new(*cam, a.exposure_s, traj.clone(), target);
-        job.quality = a.quality;
-        job.backend = Backend::Cpu { threads: None };
-        job.seed = a.seed as u32;
-        job.with_maps = false;
-        let frame = render::render_frame(&job)?;
-        for p in 0..w * h {
-            for (k, &ch) in chans.iter().enumerate() {
-                out[p * c + ch] = frame.rgb[p * 3 + k];
-            }
-        }
-    }
-    Ok(out)
 }
 
 #[cfg(test)]
