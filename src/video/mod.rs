@@ -1,0 +1,3 @@
+//! The video through FFmpeg run as a subprocess.
+
+pub mod decode;
