@@ -18,7 +18,7 @@
 use super::Quality;
 use crate::camera::Camera;
 use crate::error::{Error, Result};
-use crate::limits::MAX_IMAGE_PIXELS;
+use crate::limits::{MAX_IMAGE_PIXELS, MAX_PIXEL_SAMPLES};
 use crate::model::trajectory::Trajectory;
 use glam::{DQuat, DVec3};
 use rayon::prelude::*;
@@ -147,6 +147,16 @@ pub fn render(
 ) -> Result<(Vec<f32>, u32)> {
     let n = quality.samples_for(max_path_px(cam, traj))?;
     let (w, h) = (cam.width as usize, cam.height as usize);
+    let pixel_samples = (w as u64) * (h as u64) * n as u64;
+    if pixel_samples > MAX_PIXEL_SAMPLES {
+        return Err(Error::invalid(
+            "resolution",
+            format!(
+                "{w}x{h} pixels x {n} samples: the panorama takes at most {MAX_PIXEL_SAMPLES} \
+                 pixel-samples per frame; shorten the exposure or lower the resolution"
+            ),
+        ));
+    }
     // Rank-1 lattice generators over (x, y, t): Korobov-style, a = 1, g, g^2 mod n.
     let g = ((n as f64 * 0.618_033_988_7) as u64).max(1) | 1;
     let gen = [1u64, g % n as u64, (g * g) % n as u64];
