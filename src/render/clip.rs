@@ -235,8 +235,7 @@ impl Clip<'_> {
         let traj = self.frame_trajectory(k, orientation)?;
         let (rgb, maps) = match &self.target {
             ClipTarget::Plane(target) => {
-                let mut job =
-                    RenderJob::new(self.camera.clone(), self.exposure_s, traj, target.clone());
+                let mut job = RenderJob::new(self.camera, self.exposure_s, traj, target.clone());
                 job.quality = self.quality;
                 job.backend = self.backend;
                 job.seed = k as u32;
@@ -349,7 +348,7 @@ mod tests {
             frames: 10,
             target: ClipTarget::Plane(Target::checker(0.1, 2.0)),
             quality: Quality::Fast,
-            backend: Backend::Cpu,
+            backend: Backend::Cpu { threads: None },
         }
     }
 
