@@ -27,7 +27,7 @@
 //! | 1 | core | [`camera`], [`model`], [`io`] | the camera (intrinsics, distortion, shutter, noise, lens); motion, flow, the trajectory over an exposure; files |
 //! | 1 | library | [`gpu`] | the wgpu device and compute plumbing |
 //! | 2 | core | [`metric`], [`sim`] | MMBM rules; gait simulation |
-//! | 2 | library | [`board`], [`assess`], [`telemetry`] | the thesis board, blobs, pose; image blur metrics; the gyro from a camera's own files (GoPro MP4, Gyroflow projects, phone apps) |
+//! | 2 | library | [`board`], [`assess`], [`telemetry`], [`video`] | the thesis board, blobs, pose; image blur metrics; the gyro from a camera's own files (GoPro MP4, Gyroflow projects, phone apps); video decoding, probing and encoding through ffmpeg |
 //! | 2 | lab | `plot` | figures |
 //! | 3 | library | [`field`] | the flow-field kernel (GPU + CPU twin) |
 //! | 3 | lab | `tables` | thesis tables |
@@ -51,6 +51,7 @@ pub mod series;
 pub mod sync;
 pub mod telemetry;
 pub mod trigger;
+pub mod video;
 
 // The core's modules at the paths they had in this crate (`crate::camera::X`
 // inside the library, `mmbm::camera::X` outside).

@@ -40,6 +40,7 @@ const LAYERS: &[(&str, u32, &str)] = &[
     ("sim", 2, "core"),
     ("assess", 2, "library"),
     ("telemetry", 2, "library"),
+    ("video", 2, "library"),
     ("field", 3, "library"),
     ("tables", 3, "lab"),
     ("series", 4, "library"),

@@ -8,6 +8,7 @@ mod args;
 mod assess;
 mod blobs;
 mod choose;
+mod clip;
 mod dataset;
 mod demo;
 mod eval;
@@ -66,6 +67,8 @@ enum Command {
     Sync(sync::SyncArgs),
     /// Render a ground-truth motion-blurred image of a planar target.
     Render(render::RenderArgs),
+    /// Render a gyro log as a video (MP4 through ffmpeg), with each frame's true blur.
+    Clip(clip::ClipArgs),
     /// Simulate a legged gait: a seeded gyro log.
     Simulate(simulate::SimulateArgs),
     /// Run a trigger policy on a gyro log.
@@ -130,6 +133,7 @@ fn run() -> i32 {
         Command::Info => info::run(),
         Command::Flow(a) => flow::run(a),
         Command::Render(a) => render::run(a),
+        Command::Clip(a) => clip::run(a),
         Command::Sync(a) => sync::run(a),
         Command::Simulate(a) => simulate::run(a),
         Command::Trigger(a) => trigger::run(a),

@@ -190,6 +190,20 @@ pub const SYNC_MAX_WIDTH_PX: u32 = 480;
 /// search's work grows with it (one score per 2 ms).
 pub const SYNC_MAX_SEARCH_S: f64 = 60.0;
 
+// == clip (mmbm clip: a gyro log rendered as a video) ==
+
+/// Most frames `mmbm clip` renders into one video, frames: checked from
+/// --duration x --fps before any work (about 55 minutes at 30 fps; each
+/// frame is rendered, encoded and forgotten, so memory is one frame).
+pub const CLIP_MAX_FRAMES: usize = 100_000;
+
+/// Highest `mmbm clip --fps`, frames/s.
+pub const CLIP_MAX_FPS: f64 = 1000.0;
+
+/// Most pixels of one `mmbm clip` frame, px (4096 x 4096: a 4K frame fits;
+/// about 200 MB of linear RGB and blur maps in memory per frame).
+pub const CLIP_MAX_PIXELS: u64 = 1 << 24;
+
 // == video frames (frames --image-metric, --extract) ==
 
 /// Widest a decoded frame is scored at by `frames --image-metric`, px:

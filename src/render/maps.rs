@@ -142,8 +142,7 @@ fn track_from(
     x: f64,
     y: f64,
 ) -> Option<Vec<(f64, f64)>> {
-    let id: Pose = (glam::DQuat::IDENTITY, DVec3::ZERO);
-    track::track(cam, poses, scene_point(cam, target, &id, x, y)?)
+    track::track(cam, poses, scene_point(cam, target, &start_pose(poses), x, y)?)
 }
 
 /// Path length and end-to-start displacement (px) and path length on the
@@ -155,8 +154,18 @@ fn path_disp(
     x: f64,
     y: f64,
 ) -> Option<(f64, f64, f64)> {
-    let id: Pose = (glam::DQuat::IDENTITY, DVec3::ZERO);
-    path_disp_from(cam, target, &id, poses, x, y)
+    path_disp_from(cam, target, &start_pose(poses), poses, x, y)
+}
+
+/// The pose at exposure start of a table of [`inv_poses`]: the identity for
+/// a trajectory that starts at the world frame (every one but a clip's,
+/// whose frames start where the camera had turned to,
+/// [`super::clip`]).
+fn start_pose(poses: &[(DMat3, DVec3)]) -> Pose {
+    match poses.first() {
+        Some((r, c)) => (glam::DQuat::from_mat3(r).inverse(), *c),
+        None => (glam::DQuat::IDENTITY, DVec3::ZERO),
+    }
 }
 
 /// [`path_disp`] for the scene point seen at `(x, y)` from pose `start`

@@ -18,6 +18,8 @@
 //! per-pixel blur ground truth (path length, displacement, speed), `psf` the
 //! point-spread function at a pixel.
 
+pub mod clip;
+pub mod clip_panorama;
 pub(crate) mod cpu;
 pub(crate) mod exact;
 pub(crate) mod gpu;

@@ -12,7 +12,7 @@
 //! Sign: video time = gyro time + `offset_s`, the value `frames
 //! --time-offset` takes (it is added to the gyro's times).
 
-pub mod decode;
+pub use crate::video::decode;
 pub mod report;
 pub mod search;
 pub mod track;

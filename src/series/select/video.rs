@@ -11,15 +11,12 @@
 use super::names::{ffmpeg_select, FrameName};
 use crate::error::{Error, Result};
 use crate::limits::{MAX_SELECT_EXPR_BYTES, SCORE_MAX_WIDTH};
+use crate::video::decode::{decode_raw, Pixels, RawDecode};
+use crate::video::run_tool;
 use image::GrayImage;
-use std::io::Read;
 use std::path::Path;
-use std::process::{Command, Stdio};
 
-/// How to get ffmpeg, for the error when it is missing.
-pub const INSTALL_FFMPEG: &str = "install ffmpeg (it brings ffprobe): Debian/Ubuntu \
-     'apt install ffmpeg', Fedora 'dnf install ffmpeg', macOS 'brew install ffmpeg', Windows \
-     'winget install ffmpeg', or https://ffmpeg.org/download.html; then put it on PATH";
+pub use crate::video::{count_frames, probe_size, read_frame, INSTALL_FFMPEG};
 
 /// An image metric of the decoded frames, as a sharpness (higher is sharper).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -67,79 +64,6 @@ impl ImageMetric {
     }
 }
 
-/// `tool` (ffmpeg or ffprobe) run with `args`: its stdout, or an error
-/// naming the tool (missing: how to install it; failed: its stderr's last
-/// line).
-fn run_tool(tool: &str, args: &[&std::ffi::OsStr]) -> Result<Vec<u8>> {
-    let out = Command::new(tool)
-        .args(args)
-        .stdin(Stdio::null())
-        .output()
-        .map_err(|e| spawn_error(tool, e))?;
-    if !out.status.success() {
-        return Err(failed(tool, &out.stderr));
-    }
-    Ok(out.stdout)
-}
-
-fn spawn_error(tool: &str, e: std::io::Error) -> Error {
-    if e.kind() == std::io::ErrorKind::NotFound {
-        Error::invalid(tool, format!("not found on PATH: {INSTALL_FFMPEG}"))
-    } else {
-        Error::invalid(tool, format!("could not be run: {e}"))
-    }
-}
-
-fn failed(tool: &str, stderr: &[u8]) -> Error {
-    let text = String::from_utf8_lossy(stderr);
-    let last = text
-        .lines()
-        .rev()
-        .find(|l| !l.trim().is_empty())
-        .unwrap_or("");
-    Error::invalid(tool, format!("failed: {}", last.trim()))
-}
-
-/// The video's first video stream's width and height, px (ffprobe).
-pub fn probe_size(video: &Path) -> Result<(u32, u32)> {
-    crate::io::input::open_file(video)?;
-    let out = run_tool(
-        "ffprobe",
-        &[
-            "-v".as_ref(),
-            "error".as_ref(),
-            "-select_streams".as_ref(),
-            "v:0".as_ref(),
-            "-show_entries".as_ref(),
-            "stream=width,height".as_ref(),
-            "-of".as_ref(),
-            "csv=p=0".as_ref(),
-            video.as_os_str(),
-        ],
-    )?;
-    let text = String::from_utf8_lossy(&out);
-    let bad = || {
-        Error::invalid(
-            "--video",
-            format!(
-                "{}: no video stream ffprobe can size ({})",
-                video.display(),
-                text.trim()
-            ),
-        )
-    };
-    let line = text.lines().next().ok_or_else(bad)?;
-    let (w, h) = line
-        .trim()
-        .trim_end_matches(',')
-        .split_once(',')
-        .ok_or_else(bad)?;
-    match (w.trim().parse::<u32>(), h.trim().parse::<u32>()) {
-        (Ok(w), Ok(h)) if w > 0 && h > 0 => Ok((w, h)),
-        _ => Err(bad()),
-    }
-}
-
 /// The size frames are scored at: `(w, h)` scaled to at most
 /// [`SCORE_MAX_WIDTH`] wide, the aspect kept, both even and >= 2.
 pub fn score_size(w: u32, h: u32) -> (u32, u32) {
@@ -154,85 +78,28 @@ pub fn score_size(w: u32, h: u32) -> (u32, u32) {
 pub fn score_frames(video: &Path, metric: ImageMetric, frames: usize) -> Result<Vec<f64>> {
     let (w, h) = probe_size(video)?;
     let (sw, sh) = score_size(w, h);
-    let scale = format!("scale={sw}:{sh}:flags=area,format=gray");
-    let mut child = Command::new("ffmpeg")
-        .args(["-v", "error", "-nostdin", "-i"])
-        .arg(video)
-        .args(["-map", "0:v:0", "-fps_mode", "passthrough", "-vf", &scale])
-        .args(["-f", "rawvideo", "-pix_fmt", "gray", "pipe:1"])
-        .stdin(Stdio::null())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .map_err(|e| spawn_error("ffmpeg", e))?;
-    let mut stdout = child.stdout.take().expect("piped");
-    let mut stderr = child.stderr.take().expect("piped");
-    // stderr drained aside, so that a chatty ffmpeg cannot block.
-    let errs = std::thread::spawn(move || {
-        // Read to the end (ffmpeg must never block on it), keep the tail.
-        let (mut v, mut chunk) = (Vec::new(), [0u8; 8192]);
-        while let Ok(n @ 1..) = stderr.read(&mut chunk) {
-            v.extend_from_slice(&chunk[..n]);
-            if v.len() > 1 << 16 {
-                v.drain(..v.len() - (1 << 15));
-            }
-        }
-        v
-    });
-    let mut buf = vec![0u8; sw as usize * sh as usize];
+    let o = RawDecode {
+        size: (sw, sh),
+        pixels: Pixels::Gray,
+        as_stored: false,
+        times: false,
+        // One frame more than the table is the count mismatch below.
+        max_frames: usize::MAX,
+        who: "frames",
+    };
     let mut scores = Vec::with_capacity(frames.min(1 << 20));
-    let result = (|| -> Result<()> {
-        loop {
-            crate::cancel::check()?;
-            match read_frame(&mut stdout, &mut buf) {
-                Ok(false) => return Ok(()),
-                Ok(true) => {}
-                Err(e) => return Err(Error::io(video, e)),
-            }
-            if scores.len() == frames {
-                return Err(count_mismatch(video, None, frames));
-            }
-            let img = GrayImage::from_raw(sw, sh, std::mem::take(&mut buf)).expect("sized");
-            scores.push(metric.sharpness(&img)?);
-            buf = img.into_raw();
+    decode_raw(video, &o, |k, px| {
+        if k == frames {
+            return Err(count_mismatch(video, None, frames));
         }
-    })();
-    if result.is_err() {
-        let _ = child.kill();
-    }
-    drop(stdout);
-    let status = child.wait().map_err(|e| spawn_error("ffmpeg", e))?;
-    let stderr = errs.join().unwrap_or_default();
-    result?;
-    if !status.success() {
-        return Err(failed("ffmpeg", &stderr));
-    }
+        let img = GrayImage::from_raw(sw, sh, px.to_vec()).expect("sized");
+        scores.push(metric.sharpness(&img)?);
+        Ok(())
+    })?;
     if scores.len() != frames {
         return Err(count_mismatch(video, Some(scores.len()), frames));
     }
     Ok(scores)
-}
-
-/// Reads one whole raw frame of ffmpeg's output into `buf`: false at a
-/// clean end of stream before the frame's first byte, an error when the
-/// stream ends inside it (also `mmbm sync`'s decoder).
-pub fn read_frame(r: &mut impl Read, buf: &mut [u8]) -> std::io::Result<bool> {
-    let mut got = 0;
-    while got < buf.len() {
-        match r.read(&mut buf[got..]) {
-            Ok(0) if got == 0 => return Ok(false),
-            Ok(0) => {
-                return Err(std::io::Error::new(
-                    std::io::ErrorKind::UnexpectedEof,
-                    "ffmpeg's output ended inside a frame",
-                ))
-            }
-            Ok(n) => got += n,
-            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
-            Err(e) => return Err(e),
-        }
-    }
-    Ok(true)
 }
 
 fn count_mismatch(video: &Path, got: Option<usize>, frames: usize) -> Error {
@@ -245,41 +112,6 @@ fn count_mismatch(video: &Path, got: Option<usize>, frames: usize) -> Error {
             video.display()
         ),
     )
-}
-
-/// The number of frames (packets) of the video's first video stream, as
-/// ffprobe counts them (demuxed, not decoded).
-pub fn count_frames(video: &Path) -> Result<usize> {
-    crate::io::input::open_file(video)?;
-    let out = run_tool(
-        "ffprobe",
-        &[
-            "-v".as_ref(),
-            "error".as_ref(),
-            "-select_streams".as_ref(),
-            "v:0".as_ref(),
-            "-count_packets".as_ref(),
-            "-show_entries".as_ref(),
-            "stream=nb_read_packets".as_ref(),
-            "-of".as_ref(),
-            "csv=p=0".as_ref(),
-            video.as_os_str(),
-        ],
-    )?;
-    let text = String::from_utf8_lossy(&out);
-    text.trim()
-        .trim_end_matches(',')
-        .parse::<usize>()
-        .map_err(|_| {
-            Error::invalid(
-                "--video",
-                format!(
-                    "{}: ffprobe counts no video frames ({})",
-                    video.display(),
-                    text.trim()
-                ),
-            )
-        })
 }
 
 /// Extracts the frames `chosen` (rows, in order) of `video` into the

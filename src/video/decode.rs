@@ -1,18 +1,25 @@
-//! The video through FFmpeg run as a subprocess: `ffprobe` for the stream's
-//! size and span, then `ffmpeg` decoding it to small grey frames (scaled to
-//! at most [`SYNC_MAX_WIDTH_PX`] wide) on a pipe, one at a time, with each
+//! Reading a video: `ffprobe` for the stream's size, rate, span and frame
+//! count, then `ffmpeg` decoding it to raw grey or RGB frames of a chosen
+//! size on a pipe, one at a time ([`decode_raw`]), optionally with each
 //! frame's presentation time from the `showinfo` filter on its stderr. The
 //! clip is never held: each frame is handed to the caller and dropped.
-//! The video is decoded as stored (`-noautorotate`: the sensor's own axes,
-//! those of the gyro) and frame for frame (`-fps_mode passthrough`: no frame
+//! Frames are decoded frame for frame (`-fps_mode passthrough`: no frame
 //! duplicated or dropped), so frame `k` is ffmpeg's frame `n = k`.
+//! `mmbm sync` decodes as stored (`-noautorotate`: the sensor's own axes,
+//! those of the gyro), small grey frames at most [`SYNC_MAX_WIDTH_PX`] wide
+//! ([`decode`]).
 
+use super::{read_frame, run_tool, spawn_error, tail_of};
 use crate::error::{show_path, Error, Result};
 use crate::limits::{SYNC_MAX_FRAMES, SYNC_MAX_WIDTH_PX};
-use crate::series::select::video::read_frame;
 use std::io::{BufRead, BufReader};
 use std::path::Path;
 use std::process::{Command, Stdio};
+
+/// The last meaningful lines of a tool's stderr, for an error message.
+fn tail(lines: &[String]) -> String {
+    tail_of(&lines.join("\n"), 2)
+}
 
 /// What `ffprobe` says of the first video stream.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -41,32 +48,6 @@ impl VideoInfo {
 
 /// The error for a program that could not be started: named, with how to
 /// install it when it is missing.
-fn spawn_error(program: &str, e: std::io::Error) -> Error {
-    if e.kind() == std::io::ErrorKind::NotFound {
-        Error::invalid(
-            program,
-            format!(
-                "not found on PATH: mmbm sync decodes the video with FFmpeg's {program} \
-                 (install FFmpeg: apt install ffmpeg, dnf install ffmpeg, brew install ffmpeg, \
-                 or https://ffmpeg.org/download.html)"
-            ),
-        )
-    } else {
-        Error::invalid(program, format!("could not be started: {e}"))
-    }
-}
-
-/// The last meaningful lines of a tool's stderr, for an error message.
-fn tail(lines: &[String]) -> String {
-    let kept: Vec<&str> = lines
-        .iter()
-        .map(|l| l.trim())
-        .filter(|l| !l.is_empty())
-        .collect();
-    let n = kept.len();
-    kept[n.saturating_sub(2)..].join(" / ")
-}
-
 /// A positive finite number from ffprobe's JSON (a string or a number).
 fn number(v: &serde_json::Value) -> Option<f64> {
     match v {
@@ -162,31 +143,97 @@ fn showinfo_time(line: &str) -> Option<Option<f64>> {
     Some(tok.parse::<f64>().ok().filter(|t| t.is_finite()))
 }
 
-/// Decodes `video` to grey frames of `size` (the analysis size) and calls
-/// `each(k, pixels)` for every frame in order (`pixels`: row-major, one byte
-/// each). Returns every frame's presentation time, s. A failing `each`
-/// stops ffmpeg and is returned.
+/// The layout of a raw frame.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Pixels {
+    /// One byte per pixel (`gray`).
+    Gray,
+    /// Three bytes per pixel, R, G, B (`rgb24`).
+    Rgb,
+}
+
+impl Pixels {
+    /// Bytes per pixel.
+    pub fn bytes(self) -> usize {
+        match self {
+            Pixels::Gray => 1,
+            Pixels::Rgb => 3,
+        }
+    }
+
+    /// ffmpeg's name of the pixel format.
+    pub fn ffmpeg_name(self) -> &'static str {
+        match self {
+            Pixels::Gray => "gray",
+            Pixels::Rgb => "rgb24",
+        }
+    }
+}
+
+/// How [`decode_raw`] decodes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct RawDecode<'a> {
+    /// Width and height the frames are scaled to (area filter), px.
+    pub size: (u32, u32),
+    /// Grey or RGB.
+    pub pixels: Pixels,
+    /// Decode as stored, ignoring a rotation tag (`-noautorotate`).
+    pub as_stored: bool,
+    /// Also read each frame's presentation time (the `showinfo` filter).
+    pub times: bool,
+    /// Most frames read; one more is an error naming `who`.
+    pub max_frames: usize,
+    /// Who reads, for that error (e.g. "sync").
+    pub who: &'a str,
+}
+
+/// Decodes `video` to `sync`'s grey frames of `size` (the analysis size) and
+/// calls `each(k, pixels)` for every frame in order (`pixels`: row-major,
+/// one byte each). Returns every frame's presentation time, s. A failing
+/// `each` stops ffmpeg and is returned.
 pub fn decode(
     video: &Path,
     size: (u32, u32),
+    each: impl FnMut(usize, &[u8]) -> Result<()>,
+) -> Result<Vec<f64>> {
+    let o = RawDecode {
+        size,
+        pixels: Pixels::Gray,
+        as_stored: true,
+        times: true,
+        max_frames: SYNC_MAX_FRAMES,
+        who: "sync",
+    };
+    decode_raw(video, &o, each)
+}
+
+/// Decodes `video` as `o` says and calls `each(k, pixels)` for every frame
+/// in order (`pixels`: row-major, top row first, [`Pixels::bytes`] per
+/// pixel; one frame in memory at a time). Returns every frame's
+/// presentation time, s, when `o.times` (else an empty list). A failing
+/// `each` stops ffmpeg and is returned.
+pub fn decode_raw(
+    video: &Path,
+    o: &RawDecode<'_>,
     mut each: impl FnMut(usize, &[u8]) -> Result<()>,
 ) -> Result<Vec<f64>> {
-    let (w, h) = size;
-    let mut child = Command::new("ffmpeg")
-        .args(["-hide_banner", "-nostdin", "-nostats", "-loglevel", "info"])
-        .args(["-noautorotate", "-i"])
+    let (w, h) = o.size;
+    let mut vf = format!("scale={w}:{h}:flags=area,format={}", o.pixels.ffmpeg_name());
+    if o.times {
+        vf.push_str(",showinfo");
+    }
+    let mut cmd = Command::new("ffmpeg");
+    cmd.args(["-hide_banner", "-nostdin", "-nostats", "-loglevel", "info"]);
+    if o.as_stored {
+        cmd.arg("-noautorotate");
+    }
+    let mut child = cmd
+        .arg("-i")
         .arg(video)
         .args(["-map", "0:v:0", "-an", "-sn", "-dn", "-vf"])
-        .arg(format!("scale={w}:{h}:flags=area,format=gray,showinfo"))
-        .args([
-            "-fps_mode",
-            "passthrough",
-            "-f",
-            "rawvideo",
-            "-pix_fmt",
-            "gray",
-            "pipe:1",
-        ])
+        .arg(vf)
+        .args(["-fps_mode", "passthrough", "-f", "rawvideo", "-pix_fmt"])
+        .args([o.pixels.ffmpeg_name(), "pipe:1"])
         .stdin(Stdio::null())
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
@@ -216,10 +263,14 @@ pub fn decode(
         (times, bad_times, last)
     });
     let mut stdout = child.stdout.take().expect("piped stdout");
-    let mut buf = vec![0u8; w as usize * h as usize];
+    let mut buf = vec![0u8; w as usize * h as usize * o.pixels.bytes()];
     let mut k = 0usize;
     let mut failed = None;
     loop {
+        if let Err(e) = crate::cancel::check() {
+            failed = Some(e);
+            break;
+        }
         match read_frame(&mut stdout, &mut buf) {
             Ok(true) => {}
             Ok(false) => break,
@@ -228,10 +279,11 @@ pub fn decode(
                 break;
             }
         }
-        if k >= SYNC_MAX_FRAMES {
+        if k >= o.max_frames {
+            let (n, who) = (o.max_frames, o.who);
             failed = Some(Error::invalid(
                 show_path(video),
-                format!("more than {SYNC_MAX_FRAMES} frames: sync reads at most {SYNC_MAX_FRAMES}"),
+                format!("more than {n} frames: {who} reads at most {n}"),
             ));
             break;
         }
@@ -256,6 +308,9 @@ pub fn decode(
             format!("ffmpeg could not decode it ({})", tail(&last)),
         ));
     }
+    if !o.times {
+        return Ok(Vec::new());
+    }
     if bad_times > 0 || times.len() != k {
         return Err(Error::invalid(
             show_path(video),
@@ -277,6 +332,81 @@ pub fn decode(
         ));
     }
     Ok(times)
+}
+
+/// The video's first video stream's width and height, px (ffprobe).
+pub fn probe_size(video: &Path) -> Result<(u32, u32)> {
+    crate::io::input::open_file(video)?;
+    let out = run_tool(
+        "ffprobe",
+        &[
+            "-v".as_ref(),
+            "error".as_ref(),
+            "-select_streams".as_ref(),
+            "v:0".as_ref(),
+            "-show_entries".as_ref(),
+            "stream=width,height".as_ref(),
+            "-of".as_ref(),
+            "csv=p=0".as_ref(),
+            video.as_os_str(),
+        ],
+    )?;
+    let text = String::from_utf8_lossy(&out);
+    let bad = || {
+        Error::invalid(
+            "--video",
+            format!(
+                "{}: no video stream ffprobe can size ({})",
+                video.display(),
+                text.trim()
+            ),
+        )
+    };
+    let line = text.lines().next().ok_or_else(bad)?;
+    let (w, h) = line
+        .trim()
+        .trim_end_matches(',')
+        .split_once(',')
+        .ok_or_else(bad)?;
+    match (w.trim().parse::<u32>(), h.trim().parse::<u32>()) {
+        (Ok(w), Ok(h)) if w > 0 && h > 0 => Ok((w, h)),
+        _ => Err(bad()),
+    }
+}
+
+/// The number of frames (packets) of the video's first video stream, as
+/// ffprobe counts them (demuxed, not decoded).
+pub fn count_frames(video: &Path) -> Result<usize> {
+    crate::io::input::open_file(video)?;
+    let out = run_tool(
+        "ffprobe",
+        &[
+            "-v".as_ref(),
+            "error".as_ref(),
+            "-select_streams".as_ref(),
+            "v:0".as_ref(),
+            "-count_packets".as_ref(),
+            "-show_entries".as_ref(),
+            "stream=nb_read_packets".as_ref(),
+            "-of".as_ref(),
+            "csv=p=0".as_ref(),
+            video.as_os_str(),
+        ],
+    )?;
+    let text = String::from_utf8_lossy(&out);
+    text.trim()
+        .trim_end_matches(',')
+        .parse::<usize>()
+        .map_err(|_| {
+            Error::invalid(
+                "--video",
+                format!(
+                    "{}: ffprobe counts no video frames ({})",
+                    video.display(),
+                    text.trim()
+                ),
+            )
+        })
 }
 
 #[cfg(test)]
