@@ -227,7 +227,7 @@ pub fn run(args: ClipArgs) -> Result<()> {
                 if let Some(dir) = &staging {
                     let p = dir
                         .path()
-                        .join(mmbm::series::maps_write::file_name(f.truth.frame));
+                        .join(mmbm::series::maps::write::file_name(f.truth.frame));
                     let m = &f.maps;
                     mmbm::io::images::write_exr_as(
                         &p,
