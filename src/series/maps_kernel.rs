@@ -5,7 +5,7 @@
 //! functions are `field.wgsl`'s, twinned in [`crate::field::cpu`]).
 //!
 //! The f64 reference is [`super::maps::frame_maps`]; the twin and the kernel
-//! agree with it to f32 rounding of the track (see `tests/maps_gpu.rs`).
+//! agree with it to f32 rounding of the track (see `cli/tests/frames/maps_gpu.rs`).
 
 use super::maps::{plan, FrameMaps, MapRays, MapsJob, Plan};
 use super::maps_line::LineMotion;

@@ -151,7 +151,7 @@ fn every_model_and_digital_lens_maps_and_measures_as_gyroflow() {
 
 #[test]
 fn gpu_kernel_takes_the_other_models_through_its_lens_table() {
-    // Per pixel against the twin and the CPU metric: tests/gpu_lens.rs.
+    // Per pixel against the twin and the CPU metric: cli/tests/camera/gpu_lens.rs.
     let p = profile("poly5", &[-0.05, 0.004], json!({}));
     let c = resolve(&write_tmp("g.json", &p.to_string()), None, None).unwrap();
     assert!(mmbm::field::Grid::new(&c, 0, 0).unwrap().uses_table());

@@ -3,7 +3,7 @@
 //! matches the figures printed in `../shared/data/README.md` (computed
 //! independently of this project: thesis camera, 8x6 grid, mm/s).
 
-mod common;
+use crate::common;
 
 use mmbm::io::gyro::{read_log, GyroOptions};
 use mmbm::metric::{Evaluator, Method, Scene};

@@ -1,6 +1,6 @@
 //! GPU kernel vs its CPU twin, per pixel, and the golden renders.
 
-mod common;
+use crate::common;
 
 use glam::DVec3;
 use mmbm::io::images::{read_rgb8, save_rgb8, write_png_linear_rgb};

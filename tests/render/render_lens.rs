@@ -5,7 +5,7 @@
 //! sensor noise) and NaN in the blur maps, exactly the camera's masked
 //! pixels, on both backends.
 
-mod common;
+use crate::common;
 
 use glam::DVec3;
 use mmbm::camera::Distortion;
@@ -67,7 +67,7 @@ fn masked_pixels_are_black_and_nan_in_the_maps() {
     assert!((means.valid - (1.0 - n as f64 / mask.len() as f64)).abs() < 1e-12);
 }
 
-/// GPU against its CPU twin (the tolerances of `tests/render_gpu.rs`: a few
+/// GPU against its CPU twin (the tolerances of `tests/render/render_gpu.rs`: a few
 /// lattice samples on an edge may flip) for the other models, a digital
 /// lens and the masked fisheye; masked pixels 0 on both.
 #[test]

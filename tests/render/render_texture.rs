@@ -3,7 +3,7 @@
 //! tilted image, a rolling shutter, lens distortion and a minified texture
 //! (coarser mip levels), under the renderer's contract (mean |error| <=
 //! 0.5/255, 99th percentile <= 3/255, every channel). The closed-form case
-//! (lateral translation) is in `tests/render_exact.rs`.
+//! (lateral translation) is in `tests/render/render_exact.rs`.
 
 use glam::DVec3;
 use mmbm::camera::{Distortion, Readout, Shutter};

@@ -2,7 +2,7 @@
 //! profiles) against independent computations: finite differences of the
 //! projection, brute-force sensor means, hand-computed profile values.
 
-mod common;
+use crate::common;
 
 use glam::DVec3;
 use mmbm::camera::{Distortion, Readout};
@@ -11,7 +11,7 @@ use mmbm::{mmbm, Camera, Method, Plane, Scene, Twist};
 use std::path::PathBuf;
 
 fn fixture(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+    crate::common::repo_root()
         .join("tests/fixtures/camera")
         .join(name)
 }

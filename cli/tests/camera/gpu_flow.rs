@@ -2,7 +2,7 @@
 //! integral. Tests that need an adapter skip (with a printed line) without one,
 //! unless MMBM_REQUIRE_GPU=1.
 
-mod common;
+use crate::common;
 
 use glam::DVec3;
 use mmbm::field::cpu as flow_cpu;

@@ -7,14 +7,13 @@
 //! profiles of `tests/fixtures/lens_profiles/` (digital lenses and masked
 //! ones among them), each scaled down to a small sensor.
 
-mod common;
+use crate::common;
 
 use glam::DVec3;
 use mmbm::camera::Distortion;
 use mmbm::field::cpu as flow_cpu;
 use mmbm::field::{flow_field, Backend, FlowRunner, Grid, LensTable, TwistGpu};
 use mmbm::{mmbm, Camera, Method, Plane, Scene, Twist};
-use std::path::Path;
 
 /// Gyroflow's other models on a 96 x 54 sensor (f = 60 px, 16:9), and a
 /// fisheye that turns back at 1.2 (masked beyond it).
@@ -75,7 +74,7 @@ fn model_cameras() -> Vec<(String, Camera)> {
 
 /// The 40 real profiles, each scaled to 1/40 of its size.
 fn profile_cameras() -> Vec<(String, Camera)> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/lens_profiles");
+    let dir = crate::common::repo_root().join("tests/fixtures/lens_profiles");
     let mut files: Vec<_> = std::fs::read_dir(&dir)
         .unwrap()
         .map(|e| e.unwrap().path())
@@ -293,7 +292,7 @@ fn flow_command_masks_a_real_profile() {
     }
     let dir = std::env::temp_dir().join(format!("mmbm-gpu-lens-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let prof = Path::new(env!("CARGO_MANIFEST_DIR")).join(
+    let prof = crate::common::repo_root().join(
         "tests/fixtures/lens_profiles/p26_POCO_f3_stab_off_1080p_16by9_1920x1080_29_57fps.json",
     );
     let prof = prof.to_str().unwrap();

@@ -3,7 +3,7 @@
 //! from Gyroflow's rules (`lens_profile.rs`, `distortion_models/`), each
 //! of which the previous reader got wrong (refused, or read differently).
 
-mod common;
+use crate::common;
 
 use mmbm::camera::{Distortion, Readout};
 use mmbm::model::flow::flow_distorted;
@@ -205,7 +205,7 @@ fn beyond_the_radial_limit_is_masked_not_refused() {
     );
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(v["masked_fraction"].as_f64(), Some(c.masked_fraction()));
-    // The GPU kernel masks through its lens table (tests/gpu_lens.rs).
+    // The GPU kernel masks through its lens table (cli/tests/camera/gpu_lens.rs).
     assert!(mmbm::field::Grid::new(&c, 0, 0).unwrap().uses_table());
 }
 

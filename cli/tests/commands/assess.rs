@@ -1,7 +1,7 @@
 //! Image blur metrics against scikit-image/SciPy reference values and on
 //! images with a known, growing blur.
 
-mod common;
+use crate::common;
 
 use image::{GrayImage, Luma};
 use mmbm::assess::{
@@ -10,9 +10,7 @@ use mmbm::assess::{
 use std::path::PathBuf;
 
 fn fixture(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/fixtures")
-        .join(name)
+    crate::common::repo_root().join("tests/fixtures").join(name)
 }
 
 fn values() -> serde_json::Value {

@@ -3,7 +3,7 @@
 //! families that split exposure from timing; and the map's answer to "does
 //! timing pay?" (the best `mmbm` policy over the best `gyro-exposure` one).
 
-mod common;
+use crate::common;
 
 use mmbm::camera::{CameraFile, Noise};
 use mmbm::trigger::{run, CameraTiming, Frame, PolicyFamily, PolicySpec};
@@ -271,8 +271,7 @@ fn the_demo_maps_hold_the_bar_for_timing() {
 #[test]
 fn the_docs_scene_table_is_the_codes() {
     let want = mmbm::camera::scene_table_md(mmbm::camera::TABLE_CAMERA).unwrap();
-    let doc =
-        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/docs/light.md")).unwrap();
+    let doc = std::fs::read_to_string(crate::common::repo_root().join("docs/light.md")).unwrap();
     let a = doc
         .find("<!-- scene table begin -->\n")
         .expect("begin marker")

@@ -1,7 +1,7 @@
 //! Blob extraction on synthesized images of the thesis board: sharp -> 16/16
 //! OK, heavy motion blur -> failure.
 
-mod common;
+use crate::common;
 
 use image::RgbImage;
 use mmbm::board::blobs::{evaluate, extract, BlobParams};

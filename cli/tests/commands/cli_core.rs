@@ -1,6 +1,6 @@
 //! End-to-end checks of the core CLI contract: `eval`, `series`, `tables`.
 
-mod common;
+use crate::common;
 
 use common::mmbm;
 use std::path::Path;

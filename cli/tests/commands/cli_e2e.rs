@@ -2,7 +2,7 @@
 //! `simulate`, `trigger`, `render --maps --psf --sharp`, `tables --plot`, and
 //! the blur length of `eval`/`series --exposure`.
 
-mod common;
+use crate::common;
 
 use common::mmbm_ok_in;
 

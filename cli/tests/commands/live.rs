@@ -1,7 +1,7 @@
 //! `mmbm live`: the same decisions as the offline runner (library and CLI),
 //! the policies it refuses, and its handling of bad and out-of-order input.
 
-mod common;
+use crate::common;
 
 use mmbm::io::gyro::{read_log, GyroOptions, GyroSample};
 use mmbm::metric::{Method, Scene};
@@ -362,7 +362,7 @@ fn endless_waits_never_panic_and_ctrl_c_ends_them() {
     let w = walk.to_str().unwrap();
     let h = huge.to_str().unwrap();
     let cases: Vec<Vec<&str>> = vec![
-        // The slowest speed (a tinier one is refused: tests/parsing.rs).
+        // The slowest speed (a tinier one is refused: cli/tests/refusals/parsing.rs).
         vec!["--replay", w, "--speed", "1e-3"],
         vec!["--replay", h],
         vec!["--replay", h, "--speed", "1e-3"],

@@ -4,7 +4,7 @@
 //! px/s (every CPU method) equals the flow field's mean speed, and not the
 //! mm/s over the horizontal pitch.
 
-mod common;
+use crate::common;
 
 use mmbm::field::{flow_field, Backend};
 use mmbm::{mmbm, Camera, Method, Scene, Twist};

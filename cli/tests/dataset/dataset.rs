@@ -2,7 +2,7 @@
 //! to the same bytes, manifest parameters re-render the same item, and bad
 //! inputs are clear errors that leave nothing half-written.
 
-mod common;
+use crate::common;
 
 use common::tree;
 
@@ -13,7 +13,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 fn textures() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("assets/textures")
+    crate::common::repo_root().join("assets/textures")
 }
 
 fn small(count: u64) -> DatasetConfig {

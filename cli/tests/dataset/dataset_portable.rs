@@ -5,7 +5,7 @@
 //! convention by default (`sharp = "mid"`), recorded per item and in the
 //! fingerprint.
 
-mod common;
+use crate::common;
 
 use common::{mmbm_in, tree};
 use mmbm::render::SharpAt;
@@ -15,7 +15,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 fn repo_textures() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("assets/textures")
+    crate::common::repo_root().join("assets/textures")
 }
 
 fn json(p: &Path) -> Value {

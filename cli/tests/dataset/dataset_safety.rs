@@ -5,7 +5,7 @@
 //! grows (count 6 -> 7 equals a set made at 7), no lock file left after a
 //! run, and files made under the process's umask.
 
-mod common;
+use crate::common;
 
 use common::tree;
 use mmbm_lab::dataset::{self, DatasetConfig, Shard};
@@ -17,7 +17,7 @@ fn tiny(count: u64) -> DatasetConfig {
     DatasetConfig {
         count,
         seed: 5,
-        textures: PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("assets/textures"),
+        textures: crate::common::repo_root().join("assets/textures"),
         motion: vec!["sim:moderate".to_string(), "sim:fast".to_string()],
         resolution: [24, 18],
         ..DatasetConfig::default()

@@ -4,20 +4,20 @@
 //! as input (every path confined to the directory), shard counts are capped,
 //! and one shard has one writer at a time.
 
-mod common;
+use crate::common;
 
 use common::tree;
 
 use common::mmbm_in;
 use mmbm_lab::dataset::{self, DatasetConfig, Shard, Sources};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// A config of tiny items (quick to make), `count` of them, seed `seed`.
 fn tiny(count: u64, seed: u64) -> DatasetConfig {
     DatasetConfig {
         count,
         seed,
-        textures: PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("assets/textures"),
+        textures: crate::common::repo_root().join("assets/textures"),
         motion: vec!["sim:moderate".to_string(), "sim:fast".to_string()],
         resolution: [24, 18],
         ..DatasetConfig::default()

@@ -4,18 +4,18 @@
 //! from a sharded run packed at `--merge` as from a single run, a rerun
 //! keeping complete shards, and a changed file or shard refused.
 
-mod common;
+use crate::common;
 
 use common::mmbm_in;
 use mmbm_lab::dataset::item::FILES;
 use mmbm_lab::dataset::{self, DatasetConfig, Shard};
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 fn small(count: u64) -> DatasetConfig {
     DatasetConfig {
         count,
-        textures: PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("assets/textures"),
+        textures: crate::common::repo_root().join("assets/textures"),
         motion: vec!["sim:moderate".to_string(), "sim:fast".to_string()],
         resolution: [40, 30],
         ..DatasetConfig::default()

@@ -4,7 +4,7 @@
 //! the seed-1 table of `docs/experiment.md` ("What the demo finds") must be
 //! what the demo measures.
 
-mod common;
+use crate::common;
 
 use std::collections::HashMap;
 
@@ -23,6 +23,7 @@ fn num(s: &str) -> f64 {
 }
 
 #[test]
+#[ignore = "slow tier (mmbm demo, minutes): the README's test command runs it with --ignored"]
 fn demo_report_matches_the_docs() {
     let d = tempfile::tempdir().unwrap();
     let out = d.path().join("report");
@@ -40,8 +41,7 @@ fn demo_report_matches_the_docs() {
     assert!(report[first..].starts_with("## Benefit map"), "{report}");
     assert!(report.contains("## Headline: sharp frames per second"));
     // The README's headline quotes the map's table and goals line for line.
-    let readme =
-        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/README.md")).unwrap();
+    let readme = std::fs::read_to_string(crate::common::repo_root().join("README.md")).unwrap();
     let quoted: Vec<&str> = readme
         .lines()
         .skip_while(|l| *l != "<!-- map -->")
@@ -91,8 +91,8 @@ fn demo_report_matches_the_docs() {
         .filter(|r| r.len() == header6.len())
         .map(|r| (r[1], r))
         .collect();
-    let doc = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/docs/experiment.md"))
-        .unwrap();
+    let doc =
+        std::fs::read_to_string(crate::common::repo_root().join("docs/experiment.md")).unwrap();
     let section = &doc[doc.find("## What the demo finds").unwrap()..];
     let start = section.find("| policy |").unwrap();
     let section = &section[start..start + section[start..].find("\n\n").unwrap()];

@@ -3,12 +3,12 @@
 //! `examples/twist.rs` (which cargo builds) and prints what the README says,
 //! and its command-line example prints the lines the README quotes.
 
+use crate::common;
 use mmbm::{mmbm, Method, Scene, Twist};
 use std::path::{Path, PathBuf};
-mod common;
 
 fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+    crate::common::repo_root()
 }
 
 fn read(rel: &Path) -> String {

@@ -11,7 +11,6 @@
 //! `1e12`) or either followed by `KiB`/`MiB`/`GiB` (bytes).
 
 use std::collections::BTreeMap;
-use std::path::Path;
 
 /// Caps outside `core/src/limits.rs` that the table cites: (name in the table,
 /// source file, constant).
@@ -80,8 +79,8 @@ const ELSEWHERE: &[(&str, &str, &str)] = &[
     ("error::MAX_SHOWN", "core/src/error.rs", "MAX_SHOWN"),
 ];
 
-fn root() -> &'static Path {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
+fn root() -> std::path::PathBuf {
+    crate::common::repo_root()
 }
 
 fn read(rel: &str) -> String {

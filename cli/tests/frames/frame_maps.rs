@@ -3,8 +3,8 @@
 //! independent line-by-line integration of the interpolated motion, and the
 //! frames' exposure MMBM.
 
-mod common;
-mod maps_fixture;
+use crate::common;
+use crate::maps_fixture;
 
 use glam::{DQuat, DVec3};
 use maps_fixture::*;

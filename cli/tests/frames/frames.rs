@@ -2,7 +2,7 @@
 //! independent computations: each line's window integrated directly, a
 //! closed form for a yaw ramp, and the global-shutter time average.
 
-mod common;
+use crate::common;
 
 use glam::DVec3;
 use mmbm::camera::{Readout, Shutter};
@@ -13,7 +13,7 @@ use mmbm::series::frames::frame_mmbm;
 use mmbm::series::{mmbm_series, SeriesOptions};
 use mmbm::trigger::Integral;
 use mmbm::{Camera, Method, Scene};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 fn opts(camera: Camera, method: Method) -> SeriesOptions {
     SeriesOptions {
@@ -90,7 +90,7 @@ fn shared_frames(name: &str) -> Option<(Vec<GyroSample>, Vec<VideoFrame>)> {
 }
 
 fn example_camera(name: &str) -> Camera {
-    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(format!("examples/cameras/{name}.toml"));
+    let p = crate::common::repo_root().join(format!("examples/cameras/{name}.toml"));
     Camera::load(&p).unwrap()
 }
 
@@ -304,7 +304,7 @@ fn cli_frames_select_and_errors() {
         return;
     };
     let frames = gyro.with_file_name("frames.csv");
-    let cam = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("examples/cameras/running_phone.toml");
+    let cam = crate::common::repo_root().join("examples/cameras/running_phone.toml");
     let base = [
         "frames",
         "--gyro",
@@ -403,7 +403,7 @@ fn docs_frames_table_is_current() {
         0,
         "| frame | t_start (s) | exposure MMBM (mm/s) | blur (px) | MMBM at start (mm/s) |".into(),
     );
-    let doc = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/docs/cli.md")).unwrap();
+    let doc = std::fs::read_to_string(crate::common::repo_root().join("docs/cli.md")).unwrap();
     let start = doc
         .find("<!-- frames-table")
         .expect("docs/cli.md frames table");

@@ -3,10 +3,10 @@
 //! a count with even coverage (`--count`), a blur budget (`--max-blur`),
 //! `--select` saying why it kept fewer, the clock check, the camera note,
 //! and maps named and stored as a user can keep them (the video's side:
-//! `tests/frames_video.rs`). The clip: `tests/frames_fixture`.
+//! `cli/tests/frames/frames_video.rs`). The clip: `tests/frames_fixture`.
 
-mod common;
-mod frames_fixture;
+use crate::common;
+use crate::frames_fixture;
 
 use common::mmbm_in;
 use frames_fixture::{argmin, blurs, clip, folder, listed, ok, run};

@@ -1,4 +1,4 @@
-//! The synthetic clip of `tests/frames_choose.rs` and `tests/frames_video.rs`.
+//! The synthetic clip of `cli/tests/frames/frames_choose.rs` and `cli/tests/frames/frames_video.rs`.
 //!
 //! The synthetic clip: a narrow camera (focal 100 mm, pitch 0.01 mm,
 //! 64 x 48: half a field of view of 0.0032 rad) turning about its y axis at

@@ -4,7 +4,7 @@
 //! blur column and an independent greedy choice; the expression is
 //! evaluated here frame by frame as ffmpeg would.
 
-mod common;
+use crate::common;
 
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};

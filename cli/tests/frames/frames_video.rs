@@ -3,8 +3,8 @@
 //! image list does, the hybrid with an image metric, and a clear error
 //! without ffmpeg. The clip: `tests/frames_fixture`.
 
-mod common;
-mod frames_fixture;
+use crate::common;
+use crate::frames_fixture;
 
 use common::skip;
 use frames_fixture::{argmin, blurs, clip, folder, listed, ok, run, BASE};

@@ -1,5 +1,5 @@
-//! Helpers of the frame-maps tests, shared by `tests/frame_maps.rs` and
-//! `tests/maps_gpu.rs`: the options, the example cameras and the shared
+//! Helpers of the frame-maps tests, shared by `cli/tests/frames/frame_maps.rs` and
+//! `cli/tests/frames/maps_gpu.rs`: the options, the example cameras and the shared
 //! logs with their frame tables.
 #![allow(dead_code)]
 
@@ -21,7 +21,7 @@ pub fn opts(camera: Camera, plane: Option<Plane>, use_velocity: bool) -> SeriesO
 
 /// `examples/cameras/NAME.toml`.
 pub fn example_camera(name: &str) -> Camera {
-    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(format!("examples/cameras/{name}.toml"));
+    let p = crate::common::repo_root().join(format!("examples/cameras/{name}.toml"));
     Camera::load(&p).unwrap()
 }
 
@@ -38,7 +38,7 @@ pub fn path(p: &std::path::Path) -> &str {
 
 /// The running phone's camera file.
 pub fn running_phone_camera() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("examples/cameras/running_phone.toml")
+    crate::common::repo_root().join("examples/cameras/running_phone.toml")
 }
 
 /// `mmbm frames --gyro GYRO --frames TABLE --camera CAMERA --scale-to

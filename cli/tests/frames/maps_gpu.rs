@@ -13,8 +13,8 @@
 //! same f32 operations; the GPU may fuse and reorder them; measured 6.8e-6
 //! and 0 on lavapipe).
 
-mod common;
-mod maps_fixture;
+use crate::common;
+use crate::maps_fixture;
 
 use glam::DVec3;
 use maps_fixture::*;

@@ -2,7 +2,7 @@
 //! mutations (replaced, inserted and deleted bytes) of valid files give a
 //! value or an error, never a panic; an error names the file.
 
-mod common;
+use crate::common;
 // Hostile camera files and dataset manifests (issue #23).
 #[path = "fuzz_readers/hostile.rs"]
 mod hostile;
@@ -16,7 +16,7 @@ use proptest::prelude::*;
 use std::path::{Path, PathBuf};
 
 fn fixture(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(name)
+    crate::common::repo_root().join(name)
 }
 
 const GYRO: &str = "# a comment\nt,wx,wy,wz,vx,vy,vz,depth\n0,0.1,-0.2,0.3,0,0,0.1,2\n\

@@ -4,8 +4,8 @@
 //! takes `--gyro`; malformed files are errors that name the file, the line
 //! of the `.gcsv` file and the column or header key.
 
-mod common;
-mod gcsv_fixture;
+use crate::common;
+use crate::gcsv_fixture;
 
 use common::mmbm;
 use gcsv_fixture::*;

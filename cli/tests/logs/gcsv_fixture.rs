@@ -1,11 +1,11 @@
 //! The `.gcsv` walk fixture (`tests/fixtures/gcsv/walk.gcsv`) and helpers to
-//! spoil it, shared by `tests/gcsv.rs` and `tests/gcsv_gyroflow.rs`.
+//! spoil it, shared by `cli/tests/logs/gcsv.rs` and `cli/tests/logs/gcsv_gyroflow.rs`.
 #![allow(dead_code)]
 
 use std::path::{Path, PathBuf};
 
 pub fn walk() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/gcsv/walk.gcsv")
+    crate::common::repo_root().join("tests/fixtures/gcsv/walk.gcsv")
 }
 
 pub fn walk_text() -> String {

@@ -1,9 +1,9 @@
-//! Gyroflow `.gcsv` logs as Gyroflow reads them (the rest of `tests/gcsv.rs`):
+//! Gyroflow `.gcsv` logs as Gyroflow reads them (the rest of `cli/tests/logs/gcsv.rs`):
 //! comma-free header lines, negative readouts, the stated time origin and
 //! scales, and Gyroflow's IMU rotation in its IMU frame.
 
-mod common;
-mod gcsv_fixture;
+use crate::common;
+use crate::gcsv_fixture;
 
 use common::mmbm;
 use gcsv_fixture::*;

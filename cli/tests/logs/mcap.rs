@@ -2,14 +2,14 @@
 //! (`tests/fixtures/mcap/make_imu_mcap.py`) reads as the CSV the same script
 //! printed, through the library and every command that takes `--gyro`.
 
-mod common;
+use crate::common;
 
 use common::mmbm;
 use mmbm::io::gyro::{read_log, GyroOptions};
 use std::path::PathBuf;
 
 fn fixture(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+    crate::common::repo_root()
         .join("tests/fixtures/mcap")
         .join(name)
 }

@@ -4,7 +4,7 @@
 //! the plain table), and bad rows in each (the error names the file and
 //! the line of the row that was spoiled, never a panic).
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 
@@ -109,7 +109,7 @@ fn imu_rows_give_the_samples_of_the_plain_log() {
 fn image_lists_and_ffprobe_tables_give_the_frames_of_the_plain_table() {
     let d = dir("frames");
     let (plain_log, rows) = write_logs(&d);
-    let cam = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("examples/cameras/running_phone.toml");
+    let cam = crate::common::repo_root().join("examples/cameras/running_phone.toml");
     let mut table = String::from("t_start,exposure_s\n");
     let mut list = String::from("#timestamp [ns],exposure [ns]\n");
     let (mut ff_csv, mut ff_keys, mut ff_one) = (String::new(), String::new(), String::new());
@@ -297,11 +297,10 @@ fn bad_rows_name_the_file_and_line() {
 /// sections 1-4, on the phone's files), continuation lines joined. The
 /// sections after it ("Syncing the gyro to the video", "Gyro from the
 /// camera's own files") show commands on placeholder files (a GoPro clip, a
-/// Gyroflow project): `tests/sync.rs` and `tests/telemetry.rs` run those
+/// Gyroflow project): `cli/tests/logs/sync.rs` and `cli/tests/logs/telemetry.rs` run those
 /// commands on files they make.
 fn doc_commands() -> Vec<Vec<String>> {
-    let doc =
-        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/docs/frames.md")).unwrap();
+    let doc = std::fs::read_to_string(crate::common::repo_root().join("docs/frames.md")).unwrap();
     let end = doc
         .find("\n## Syncing the gyro to the video")
         .expect("docs/frames.md has its sync section after the worked example");
@@ -341,10 +340,7 @@ fn the_worked_example_runs() {
     std::fs::write(d.join("images.csv"), list).unwrap();
     std::fs::write(d.join("probe.csv"), probe).unwrap();
     std::fs::copy(
-        concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/examples/cameras/running_phone.toml"
-        ),
+        crate::common::repo_root().join("examples/cameras/running_phone.toml"),
         d.join("camera.toml"),
     )
     .unwrap();

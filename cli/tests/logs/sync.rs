@@ -6,7 +6,7 @@
 //! offset. Also the refusals (no overlap, no ffmpeg, not a video, a short
 //! log, no texture) and `frames --sync`.
 
-mod common;
+use crate::common;
 
 use common::{ffmpeg, mmbm_cmd, mmbm_in, mmbm_ok_in};
 use glam::{DQuat, DVec3};

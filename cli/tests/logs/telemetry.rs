@@ -8,8 +8,8 @@
 //! The fixtures in `tests/fixtures/telemetry/` are what the builders below
 //! write (checked byte for byte; `MMBM_WRITE_FIXTURES=1` rewrites them).
 
-mod common;
-mod telemetry_fixture;
+use crate::common;
+use crate::telemetry_fixture;
 
 use glam::DVec3;
 use mmbm::telemetry::{read_camera_file, Format, Orientation};

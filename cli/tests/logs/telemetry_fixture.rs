@@ -1,4 +1,4 @@
-//! The builders of `tests/telemetry.rs`: one camera file per format, made
+//! The builders of `cli/tests/logs/telemetry.rs`: one camera file per format, made
 //! byte by byte from known angular velocities (so the tests know the
 //! truth), and the committed fixtures they must equal.
 
@@ -6,7 +6,7 @@
 
 use glam::DVec3;
 use mmbm::telemetry::TelemetryOptions;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 pub fn dir(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("mmbm-telemetry-{}-{name}", std::process::id()));
@@ -268,7 +268,7 @@ pub fn fixtures() -> Vec<(&'static str, Vec<u8>)> {
 }
 
 pub fn fixture(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
+    crate::common::repo_root()
         .join("tests/fixtures/telemetry")
         .join(name)
 }

@@ -5,7 +5,7 @@
 //! policy forms in `trigger --help`). Each reproducer must end quickly with
 //! a clear one-line error (exit 1) or a result, never abort or spin.
 
-mod common;
+use crate::common;
 
 use common::{mmbm_in, mmbm_within};
 use std::path::Path;

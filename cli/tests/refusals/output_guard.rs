@@ -2,8 +2,8 @@
 //! output is checked before the work, and `frames --maps` writes all or
 //! nothing. Each case runs the `mmbm` command in a folder of its own.
 
-mod common;
-mod robust;
+use crate::common;
+use crate::robust;
 
 use std::path::{Path, PathBuf};
 use std::process::Output;

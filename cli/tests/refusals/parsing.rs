@@ -4,7 +4,7 @@
 //! readouts, `--lens-focal`, policy keys, Python's integers) and messages that
 //! say what is wrong (the missing key; no run of spaces from a source line).
 
-mod common;
+use crate::common;
 
 use mmbm::camera::{CameraFile, CameraOverrides};
 use mmbm::Camera;

@@ -1,5 +1,5 @@
-//! Helpers of the bad-input suites (tests/robustness.rs, tests/robustness_round3.rs,
-//! tests/output_guard.rs):
+//! Helpers of the bad-input suites (cli/tests/refusals/robustness.rs, cli/tests/refusals/robustness_round3.rs,
+//! cli/tests/refusals/output_guard.rs):
 //! the input files every case may name, leftovers in a folder, and the runner
 //! of a table of bad inputs.
 #![allow(dead_code)]

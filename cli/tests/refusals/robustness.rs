@@ -3,8 +3,8 @@
 //! command line, as clap reports it; never 101, a panic, or 134, an abort), an `error:` line naming the file and line/column or the
 //! parameter or key, and leave no output and no temporary file behind.
 
-mod common;
-mod robust;
+use crate::common;
+use crate::robust;
 
 use common::mmbm_in;
 use robust::{files, leftovers, unclear_errors};

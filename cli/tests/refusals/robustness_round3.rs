@@ -1,11 +1,11 @@
 //! The bad-input suite, round 3 (issue #23): time bases too coarse for what
 //! is timed on them, results that are not finite numbers, outputs sharing
 //! one file, unbounded echoes, endless and gigantic inputs. Same contract as
-//! tests/robustness.rs: exit code 1 (2 for a malformed command line), an
+//! cli/tests/refusals/robustness.rs: exit code 1 (2 for a malformed command line), an
 //! `error:` line that says what and where, nothing left behind.
 
-mod common;
-mod robust;
+use crate::common;
+use crate::robust;
 
 use common::mmbm_in;
 use robust::{files, one_red_pixel_png, unclear_errors};

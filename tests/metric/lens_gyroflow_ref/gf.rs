@@ -1,4 +1,4 @@
-//! Gyroflow's pixel pipeline written again for `tests/lens_gyroflow.rs`,
+//! Gyroflow's pixel pipeline written again for `tests/metric/lens_gyroflow.rs`,
 //! from its `distortion_models/*.rs` and `lens_profile.rs` (read, not
 //! copied), in f64 and independently of the library.
 

@@ -9,7 +9,7 @@ use proptest::prelude::*;
 use std::path::{Path, PathBuf};
 
 fn fixture(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(name)
+    crate::common::repo_root().join(name)
 }
 
 fn write(dir: &Path, name: &str, bytes: &[u8]) -> PathBuf {

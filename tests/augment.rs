@@ -1,0 +1,13 @@
+//! Augmentation (library): the streak of a dot, the API, speed and accuracy.
+//!
+//! One test binary of the subject; each module is one former test file
+//! (`tests/augment/NAME.rs`, see docs/testing.md).
+
+mod common;
+
+#[path = "augment/augment.rs"]
+mod augment;
+#[path = "augment/augment_api.rs"]
+mod augment_api;
+#[path = "augment/augment_speed.rs"]
+mod augment_speed;
