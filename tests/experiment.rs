@@ -1,4 +1,6 @@
-//! The lab's experiment (library): the walk, the CPU path, the benefit map.
+//! The lab's experiment (library): the walk, the benefit map (the CPU fallback is
+//! `tests/experiment_cpu.rs`, a binary of its own: it sets the process's
+//! adapter filter before the GPU context exists).
 //!
 //! One test binary of the subject; each module is one former test file
 //! (`tests/experiment/NAME.rs`, see docs/testing.md).
@@ -7,7 +9,5 @@ mod common;
 
 #[path = "experiment/experiment.rs"]
 mod experiment;
-#[path = "experiment/experiment_cpu.rs"]
-mod experiment_cpu;
 #[path = "experiment/experiment_map.rs"]
 mod experiment_map;
