@@ -336,7 +336,7 @@ fn real_profiles_load_and_agree_with_gyroflow() {
 }
 
 /// The whole database: `MMBM_LENS_DB=DIR cargo test --release --test
-/// lens_gyroflow -- --ignored --nocapture` prints the share loaded, the
+/// metric -- --ignored --nocapture whole_database` prints the share loaded, the
 /// refusals grouped by message, and the MMBM agreement over every `step`-th
 /// loaded profile (`MMBM_LENS_STEP`, default 10).
 #[test]
