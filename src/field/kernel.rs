@@ -49,7 +49,7 @@ pub struct FlowParams {
     /// 1 to write the field (one twist), else 0.
     pub write_field: u32,
     /// Lens distortion model: 0 none, 1 OpenCV, 2 fisheye, 3 the lens table
-    /// (every other model, and masked cameras: [`super::table`]).
+    /// (every other model, and masked cameras: `super::table`).
     pub dist_model: u32,
     /// Padding (to align `dist`).
     pub pad0: u32,

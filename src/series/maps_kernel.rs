@@ -1,6 +1,6 @@
 //! Host side of `shaders/maps.wgsl` (the GPU path of `frames --maps`): the
 //! structs shared with WGSL (with layout asserts), their packing from a
-//! frame's [`Plan`], the dispatch loop both backends share, and the CPU twin
+//! frame's `Plan`, the dispatch loop both backends share, and the CPU twin
 //! of the kernel: the same f32 operations, function by function (the lens
 //! functions are `field.wgsl`'s, twinned in [`crate::field::cpu`]).
 //!
