@@ -4,7 +4,7 @@
 //! list, lengths, light. Each is checked where the value is read, before
 //! anything is sized by it, and refused with an error naming the value, the
 //! cap and where it came from. `docs/limits.md` lists every cap here, and
-//! `tests/limits_doc.rs` keeps that list true.
+//! `cli/tests/docs/limits_doc.rs` keeps that list true.
 
 use crate::error::{Error, Result};
 

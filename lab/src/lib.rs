@@ -15,16 +15,28 @@
 //! | 2 | [`plot`] | figures |
 //! | 3 | [`tables`] | thesis tables |
 //! | 6 | [`experiment`], [`dataset`] | the thesis experiment end to end; blur datasets at scale |
+//!
+//! # Features
+//!
+//! `experiment` (default; implies `plot`) builds [`experiment`]; `plot`
+//! (default) builds [`plot`] and `tables::grid_error_plot` with plotters.
+//! `--no-default-features` leaves the datasets and the tables, without
+//! plotters.
 #![deny(unsafe_code)]
 #![warn(missing_docs)]
 
 pub mod dataset;
+#[cfg(feature = "experiment")]
 pub mod experiment;
+#[cfg(feature = "plot")]
 pub mod plot;
 pub mod tables;
 
 // The library's modules at the paths the moved code uses (`crate::render::...`).
 use mmbm::{
-    assess, board, camera, cancel, check, diagnostics, error, field, gpu, io, limits, metric,
-    model, render, series, sim, stats, trigger, Result,
+    camera, cancel, check, diagnostics, error, field, io, limits, metric, model, render, sim,
+    Result,
 };
+// Those only the experiment uses.
+#[cfg(feature = "experiment")]
+use mmbm::{assess, board, gpu, series, stats, trigger};

@@ -146,7 +146,7 @@ def test_flow_field_equals_cli(tmp_path):
     e = mmbm.read_exr(out)
     f = mmbm.flow_field([0.4, -0.1, 0.2], [0.1, 0, 0], depth=2, camera=mmbm.Camera().with_resolution(80, 60))
     # The CLI runs the GPU kernel; the package the CPU twin: the twins agree
-    # to f32 rounding (tests/gpu_flow.rs).
+    # to f32 rounding (cli/tests/camera/gpu_flow.rs).
     np.testing.assert_allclose(f[..., 0], e["flow.u"], rtol=1e-5, atol=1e-3)
     np.testing.assert_allclose(f[..., 1], e["flow.v"], rtol=1e-5, atol=1e-3)
 

@@ -1,5 +1,5 @@
 """mmbm.read_gyro on a camera's own files: the fixtures of
-tests/fixtures/telemetry/ (built by tests/telemetry.rs from known rates),
+tests/fixtures/telemetry/ (built by cli/tests/logs/telemetry.rs from known rates),
 read with their metadata; bad files raise with the file and the place."""
 
 import math

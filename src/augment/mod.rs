@@ -82,7 +82,7 @@ pub enum Motion {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Integrator {
     /// Warp samples at most 1 px apart along the longest path (within the
-    /// image contract; 2 px apart is not: `tests/augment_speed.rs`).
+    /// image contract; 2 px apart is not: `tests/augment/augment_speed.rs`).
     #[default]
     Fast,
     /// Warp samples at most 1/32 px apart (the reference of `fast`).

@@ -5,7 +5,7 @@
 //! centre's path; the number of instants is chosen from the largest path so
 //! that neighbouring samples are at most `spacing` px apart
 //! ([`super::Integrator`]), which keeps the error against that integral
-//! within the image contract (mean 0.5/255, p99 3/255; `tests/augment_api.rs`).
+//! within the image contract (mean 0.5/255, p99 3/255; `tests/augment/augment_api.rs`).
 //!
 //! Without motion (every instant's map the identity) the image is returned
 //! as it is, never resampled.

@@ -53,7 +53,7 @@ pub struct FlowParams {
     pub pad: [u32; 2],
     /// The lens ([`crate::gpu::lens`]): none, OpenCV or fisheye analytic,
     /// else the lens table (every other model, and masked cameras:
-    /// [`super::table`]).
+    /// `super::table`).
     pub lens: LensGpu,
 }
 

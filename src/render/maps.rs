@@ -142,7 +142,11 @@ fn track_from(
     x: f64,
     y: f64,
 ) -> Option<Vec<(f64, f64)>> {
-    track::track(cam, poses, scene_point(cam, target, &start_pose(poses), x, y)?)
+    track::track(
+        cam,
+        poses,
+        scene_point(cam, target, &start_pose(poses), x, y)?,
+    )
 }
 
 /// Path length and end-to-start displacement (px) and path length on the

@@ -236,7 +236,7 @@ impl Iterator for Samples {
 
 /// Streams `reader` through `eval` in batches of [`BATCH`] and writes the CSV.
 /// Parsing runs on a second thread, overlapped with evaluation and
-/// formatting (shortest round-trip floats, [`push_f64`]). Returns the number of samples.
+/// formatting (shortest round-trip floats, `push_f64`). Returns the number of samples.
 /// `px` gives each sample's px/s ([`px_of`]); `blur_px` is px/s times the exposure.
 pub fn run<W: Write>(
     reader: impl Into<Samples>,

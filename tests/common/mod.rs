@@ -1,6 +1,7 @@
-//! Helpers shared by the integration tests (`mod common;` in each binary):
-//! the CLI runners, and the getters of the resources a test may lack (a GPU
-//! adapter, the real logs of `../shared/data`).
+//! Helpers shared by the integration tests (`mod common;` in each binary of
+//! `tests/`; `cli/tests/common` includes this file and adds the CLI runners):
+//! the repository's root, and the getters of the resources a test may lack (a
+//! GPU adapter, the real logs of `../shared/data`, ffmpeg).
 //!
 //! A missing resource is a failure under `MMBM_REQUIRE_GPU=1` /
 //! `MMBM_REQUIRE_DATA=1` (as in CI). Without them the test returns early and
@@ -14,108 +15,16 @@
 use mmbm::gpu::GpuContext;
 use std::io::Write;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output, Stdio};
+use std::process::{Command, Stdio};
 
-/// The `mmbm` binary under test: `MMBM_BIN` if set, else the one cargo built
-/// beside this test binary (`target/<profile>/mmbm`, from the workspace's
-/// `cli/` crate). A plain `cargo test` (the workspace's default members)
-/// builds it before any test runs; `cargo test --test NAME` does not, so a
-/// command older than a source it is built from is refused as stale.
-pub fn bin() -> PathBuf {
-    static BIN: std::sync::OnceLock<PathBuf> = std::sync::OnceLock::new();
-    BIN.get_or_init(|| {
-        if let Some(p) = std::env::var_os("MMBM_BIN") {
-            return PathBuf::from(p);
-        }
-        let exe = std::env::current_exe().expect("the test binary's path");
-        let dir = exe
-            .parent()
-            .and_then(Path::parent)
-            .expect("the test binary lies in target/<profile>/deps");
-        let p = dir.join(format!("mmbm{}", std::env::consts::EXE_SUFFIX));
-        let build = "run `cargo test` from the workspace root (it builds cli/ too), or \
-                     `cargo build -p mmbm-cli` with this profile first, or set MMBM_BIN";
-        let Some(made) = modified(&p) else {
-            panic!("the mmbm command is not built at {}: {build}", p.display());
-        };
-        let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-        let mut newest = None;
-        for sub in [
-            "src",
-            "core/src",
-            "lab/src",
-            "cli/src",
-            "shaders",
-            "Cargo.toml",
-            "core/Cargo.toml",
-            "lab/Cargo.toml",
-            "cli/Cargo.toml",
-        ] {
-            newest_in(&root.join(sub), &mut newest);
-        }
-        if let Some((t, f)) = newest {
-            assert!(
-                made >= t,
-                "the mmbm command at {} is older than {}: {build}",
-                p.display(),
-                f.display()
-            );
-        }
-        p
-    })
-    .clone()
-}
-
-fn modified(p: &Path) -> Option<std::time::SystemTime> {
-    std::fs::metadata(p).and_then(|m| m.modified()).ok()
-}
-
-/// The most recently modified file under `p` (a file or a folder).
-fn newest_in(p: &Path, newest: &mut Option<(std::time::SystemTime, PathBuf)>) {
-    if p.is_dir() {
-        for e in std::fs::read_dir(p).into_iter().flatten().flatten() {
-            newest_in(&e.path(), newest);
-        }
-    } else if let Some(t) = modified(p) {
-        if newest.as_ref().is_none_or(|(n, _)| t > *n) {
-            *newest = Some((t, p.to_path_buf()));
-        }
-    }
-}
-
-/// The `mmbm` binary under test, as a command to add arguments to.
-pub fn mmbm_cmd() -> Command {
-    Command::new(bin())
-}
-
-/// Runs `mmbm ARGS` (stdin empty) and returns its output, whatever its status.
-pub fn mmbm(args: &[&str]) -> Output {
-    mmbm_cmd()
-        .args(args)
-        .stdin(Stdio::null())
-        .output()
-        .expect("run mmbm")
-}
-
-/// [`mmbm`] in the working directory `dir`.
-pub fn mmbm_in(dir: &Path, args: &[&str]) -> Output {
-    mmbm_cmd()
-        .args(args)
-        .current_dir(dir)
-        .stdin(Stdio::null())
-        .output()
-        .expect("run mmbm")
-}
-
-/// [`mmbm_in`], asserting that it succeeded (its stderr is the message if not).
-pub fn mmbm_ok_in(dir: &Path, args: &[&str]) -> Output {
-    let o = mmbm_in(dir, args);
-    assert!(
-        o.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    o
+/// The repository's root (the workspace's folder, which holds `Cargo.lock`),
+/// whichever crate's tests include this file (`tests/` or `cli/tests/`).
+pub fn repo_root() -> PathBuf {
+    let here = Path::new(env!("CARGO_MANIFEST_DIR"));
+    here.ancestors()
+        .find(|d| d.join("Cargo.lock").is_file())
+        .unwrap_or(here)
+        .to_path_buf()
 }
 
 /// The running test's name (libtest names each test's thread after it).
@@ -150,7 +59,7 @@ fn missing(var: &str, reason: &str) {
 /// `../shared/data/NAME/gyro.csv` when it is beside the checkout, else `None`
 /// (skipped; a failure under `MMBM_REQUIRE_DATA=1`).
 pub fn shared_log(name: &str) -> Option<PathBuf> {
-    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+    let p = repo_root()
         .join("../shared/data")
         .join(name)
         .join("gyro.csv");
@@ -171,57 +80,6 @@ pub fn gpu() -> Option<&'static GpuContext> {
             None
         }
     }
-}
-
-/// Runs `mmbm ARGS` in `dir` with `stdin` on its standard input; fails the
-/// test if it does not end within `secs` seconds (it is killed then).
-pub fn mmbm_within(dir: &Path, args: &[&str], stdin: Vec<u8>, secs: u64) -> Output {
-    let mut child = mmbm_cmd()
-        .args(args)
-        .current_dir(dir)
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut input = child.stdin.take().unwrap();
-    let feeder = std::thread::spawn(move || {
-        // The reader may stop early (an error): a broken pipe is expected.
-        let _ = input.write_all(&stdin);
-    });
-    let start = std::time::Instant::now();
-    while child.try_wait().unwrap().is_none() {
-        if start.elapsed().as_secs() >= secs {
-            child.kill().unwrap();
-            panic!("mmbm {args:?} still running after {secs} s");
-        }
-        std::thread::sleep(std::time::Duration::from_millis(20));
-    }
-    feeder.join().unwrap();
-    child.wait_with_output().unwrap()
-}
-
-/// A free local UDP address (`127.0.0.1:PORT`): a port the system handed out
-/// a moment ago, for `mmbm live --udp`.
-pub fn free_udp_addr() -> String {
-    let s = std::net::UdpSocket::bind("127.0.0.1:0").unwrap();
-    format!("127.0.0.1:{}", s.local_addr().unwrap().port())
-}
-
-/// `mmbm live --udp` on a free local port (`fixed:5 --all`, idle exit after
-/// 1.5 s), a socket to send from, and the address, once it listens.
-pub fn udp_live() -> (std::process::Child, std::net::UdpSocket, String) {
-    let addr = free_udp_addr();
-    let child = mmbm_cmd()
-        .args(["live", "--policy", "fixed:5", "--all", "--idle-exit", "1.5"])
-        .args(["--udp", &addr])
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let sock = std::net::UdpSocket::bind("127.0.0.1:0").unwrap();
-    std::thread::sleep(std::time::Duration::from_millis(500));
-    (child, sock, addr)
 }
 
 /// A PNG file whose header claims `w` x `h` RGB pixels (no image data).
@@ -306,27 +164,6 @@ pub fn abs_diff_max_mean(a: &[f32], b: &[f32]) -> (f32, f32) {
     let diffs: Vec<f32> = a.iter().zip(b).map(|(x, y)| (x - y).abs()).collect();
     let max = diffs.iter().cloned().fold(0.0, f32::max);
     (max, diffs.iter().sum::<f32>() / diffs.len() as f32)
-}
-
-/// `mmbm simulate` of a 20 s moderate walk (seed 7) into `dir/walk.csv`.
-pub fn simulated_walk(dir: &Path) -> PathBuf {
-    let p = dir.join("walk.csv");
-    let o = mmbm_cmd()
-        .args([
-            "simulate",
-            "--gait",
-            "moderate",
-            "--duration",
-            "20",
-            "--seed",
-            "7",
-        ])
-        .arg("--out")
-        .arg(&p)
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    p
 }
 
 /// True when `ffmpeg` and `ffprobe` run (`mmbm sync` and the clip tests need

@@ -302,7 +302,7 @@ impl ImuRows {
 
 /// One row of an image list, s: exposure start of the first line, exposure,
 /// and the frame's own rolling-shutter readout when the list has a column
-/// for it ([`FRAME_READOUT`]).
+/// for it (`FRAME_READOUT`).
 pub type ImageListRow = (f64, f64, Option<f64>);
 
 /// An image list's header: the time, exposure and readout (with its unit,

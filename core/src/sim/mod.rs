@@ -51,7 +51,7 @@
 //! 0.4 mm/s (thesis Table 6.2: at threshold 0.4 the moderate walk still gave
 //! 3.5 fps), the slow walk is calmer, and the fast walk never settles below
 //! about 0.4 mm/s (the thesis got no frames at thresholds 0.4 and 0.2 there).
-//! `tests/sim.rs` checks the moderate targets; the report of the project lists
+//! `tests/trigger/sim.rs` checks the moderate targets; the report of the project lists
 //! the measured figures for all three.
 
 mod gen;

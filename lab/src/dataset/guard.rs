@@ -195,7 +195,7 @@ impl Record {
     /// recorded fingerprint is this one and that `count` is at least the
     /// recorded one (a larger one is recorded: the set grows). A directory
     /// with items but no record is refused (their configuration is unknown).
-    /// Done under [`DirLock`], so concurrent runs see each other's record.
+    /// Done under `DirLock`, so concurrent runs see each other's record.
     pub fn claim(&self, out: &Path) -> Result<()> {
         let p = out.join(RECORD);
         let _dir = DirLock::take(out)?;

@@ -3,13 +3,17 @@
 //! log-log plot.
 
 use crate::error::Result;
+#[cfg(feature = "plot")]
 use crate::io::atomic::write_atomic_path;
 use crate::metric::{mmbm, Method, Scene};
 use crate::model::motion::Twist;
+#[cfg(feature = "plot")]
 use crate::plot::{ensure_font, plot_error};
 use glam::DVec3;
+#[cfg(feature = "plot")]
 use plotters::prelude::*;
 use serde::Serialize;
+#[cfg(feature = "plot")]
 use std::path::Path;
 
 /// One point of the grid-error study.
@@ -104,6 +108,7 @@ pub fn grid_error() -> Result<Vec<GridErrorRow>> {
     Ok(rows)
 }
 
+#[cfg(feature = "plot")]
 /// Fig. 4.6-style plot: max |relative error| (%) of the riemann and gauss
 /// rules against the exact value, versus the number of points (log-log).
 pub fn grid_error_plot(rows: &[GridErrorRow], path: &Path) -> Result<()> {

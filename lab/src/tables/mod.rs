@@ -17,7 +17,9 @@ use serde::Serialize;
 
 mod grid_error;
 
-pub use grid_error::{grid_error, grid_error_plot, study_motions, GridErrorRow};
+#[cfg(feature = "plot")]
+pub use grid_error::grid_error_plot;
+pub use grid_error::{grid_error, study_motions, GridErrorRow};
 
 /// Exact-method tolerance used in the tables.
 pub const EXACT_TOL: f64 = 1e-10;

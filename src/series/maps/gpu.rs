@@ -5,9 +5,9 @@
 //! packing and the dispatch loop are shared with it
 //! ([`super::kernel`]).
 
-use super::{FrameMaps, MapsJob};
 use super::kernel::{self as mk, LineGpu, MapsParams, StepGpu, PLANES};
 use super::table::NodeGpu;
+use super::{FrameMaps, MapsJob};
 use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::gpu::compute::{
@@ -20,7 +20,10 @@ use std::sync::OnceLock;
 
 /// The WGSL source of the maps kernel: the shared lens module
 /// ([`crate::gpu::lens::LENS_WGSL`]) joined with `maps.wgsl`.
-pub const MAPS_WGSL: &str = concat!(include_str!("../../gpu/lens.wgsl"), include_str!("maps.wgsl"));
+pub const MAPS_WGSL: &str = concat!(
+    include_str!("../../gpu/lens.wgsl"),
+    include_str!("maps.wgsl")
+);
 
 struct Kernel {
     bgl: wgpu::BindGroupLayout,

@@ -1,16 +1,16 @@
 //! Host side of `maps.wgsl` (the GPU path of `frames --maps`): the
 //! structs shared with WGSL (with layout asserts), their packing from a
-//! frame's [`Plan`], the dispatch loop both backends share, and the CPU twin
+//! frame's `Plan`, the dispatch loop both backends share, and the CPU twin
 //! of the kernel: the same f32 operations, function by function (the lens
 //! module's are twinned in [`crate::gpu::lens`], the lens table's in
 //! [`super::table`]).
 //!
 //! The f64 reference is [`super::frame_maps`]; the twin and the kernel
-//! agree with it to f32 rounding of the track (see `tests/maps_gpu.rs`).
+//! agree with it to f32 rounding of the track (see `cli/tests/frames/maps_gpu.rs`).
 
-use super::{plan, FrameMaps, MapRays, MapsJob, Plan};
 use super::line::LineMotion;
 pub use super::table::MapsTable;
+use super::{plan, FrameMaps, MapRays, MapsJob, Plan};
 use crate::error::{Error, Result};
 use crate::gpu::lens::{self, LensGpu, MODEL_NONE, MODEL_TABLE};
 use bytemuck::{Pod, Zeroable};
@@ -435,10 +435,7 @@ mod tests {
             ("Params", std::mem::size_of::<MapsParams>()),
             ("Line", std::mem::size_of::<LineGpu>()),
             ("Step", std::mem::size_of::<StepGpu>()),
-            (
-                "Node",
-                std::mem::size_of::<super::super::table::NodeGpu>(),
-            ),
+            ("Node", std::mem::size_of::<super::super::table::NodeGpu>()),
             ("Lens", std::mem::size_of::<LensGpu>()),
         ] {
             let (h, _) = m

@@ -23,8 +23,8 @@
 
 pub mod gpu;
 pub mod kernel;
-pub mod table;
 mod line;
+pub mod table;
 pub mod write;
 
 use crate::camera::Camera;
