@@ -20,7 +20,7 @@ use mmbm::series::maps::gpu::MapsRunner;
 use mmbm::series::maps::kernel::frame_maps_twin;
 use mmbm::series::maps::{frame_maps, FrameMaps, MapRays, MapsJob};
 use mmbm::Camera;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// A Gyroflow profile of the fixtures whose lens (a GoPro SuperView
 /// digital lens over the fisheye) has no formula in the lens module.
