@@ -18,8 +18,8 @@
 //! line). `exact` (adaptive cubature of the window-averaged speed) is for
 //! global shutters only: with a readout the integrand jumps at every line.
 
-use super::job::FrameWindow;
 use super::lerp::{instant_speed, window_speed};
+use super::window::FrameWindow;
 use super::{sample_scene, SeriesOptions};
 use crate::camera::{Camera, Shutter};
 use crate::error::{Error, Result};

@@ -3,74 +3,22 @@
 //! camera with a log's own rolling-shutter readout applied once
 //! ([`LogReadout::apply`]), the scene, the method and the velocity switch;
 //! [`FrameWindow`] is one frame's time window on the log's clock, its span
-//! the camera's busy time ([`Shutter::busy_s`]: exposure plus the frame's
+//! the camera's busy time ([`crate::camera::Shutter::busy_s`]: exposure plus the frame's
 //! readout, docs/spec.md section 9). `mmbm frames`, Python's `frames` and
 //! `frame_maps`, [`super::frames::frame_mmbm`] and [`super::maps`] take their
 //! windows from here and derive no span themselves.
 
 use super::frames::{frame_mmbm, FrameMmbm};
 use super::maps::{frame_maps, FrameMaps, MapRays};
+pub use super::window::FrameWindow;
 use super::SeriesOptions;
-use crate::camera::{Camera, Shutter};
-use crate::error::{Error, Result};
+use crate::camera::Camera;
+use crate::error::Result;
 use crate::io::frames::VideoFrame;
 use crate::io::gyro::GyroSample;
 use crate::metric::{Method, Scene};
 use crate::model::log::{ImuLog, LogReadout};
 use crate::model::motion::Plane;
-
-/// One frame's time window: line `j` of `n` is exposed over
-/// `[t_start + readout_s j / n, t_start + readout_s j / n + exposure_s]`
-/// (docs/spec.md section 9), so the frame spans
-/// `[t_start, t_start + shutter.busy_s(exposure_s)]`.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct FrameWindow {
-    /// 0-based row of the frame table.
-    pub index: usize,
-    /// Exposure start of the first line, s (the log's clock).
-    pub t_start: f64,
-    /// Exposure of each line, s.
-    pub exposure_s: f64,
-    /// The frame's shutter: its own readout (a frame table's `readout_s`),
-    /// else the camera's, in the camera's direction.
-    pub shutter: Shutter,
-}
-
-impl FrameWindow {
-    /// The window of `frame` (row `index` of its table) under `camera`'s
-    /// shutter; the frame is checked first ([`VideoFrame::check`]: the error
-    /// names the frame and the column).
-    pub fn of(camera: &Camera, index: usize, frame: &VideoFrame) -> Result<Self> {
-        frame.check().map_err(|(column, message)| {
-            Error::invalid(format!("frame {index}: {column}"), message)
-        })?;
-        Ok(FrameWindow {
-            index,
-            t_start: frame.t_start,
-            exposure_s: frame.exposure_s,
-            shutter: Shutter {
-                readout_s: frame.readout_s.unwrap_or(camera.shutter.readout_s),
-                direction: camera.shutter.direction,
-            },
-        })
-    }
-
-    /// Rolling-shutter readout of the frame, s (0: global shutter).
-    pub fn readout_s(&self) -> f64 {
-        self.shutter.readout_s
-    }
-
-    /// The frame's span, s: the first line's exposure start to the last
-    /// line's exposure end ([`Shutter::busy_s`]).
-    pub fn span_s(&self) -> f64 {
-        self.shutter.busy_s(self.exposure_s)
-    }
-
-    /// The last line's exposure end, s (the log's clock).
-    pub fn end_s(&self) -> f64 {
-        self.t_start + self.span_s()
-    }
-}
 
 /// What a [`FramesJob`] is made of.
 #[derive(Debug, Clone, Copy)]

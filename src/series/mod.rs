@@ -13,6 +13,7 @@ pub mod job;
 pub mod lerp;
 pub mod maps;
 pub mod select;
+pub mod window;
 
 use crate::error::{Error, Result};
 use crate::io::gyro::{GyroReader, GyroSample};

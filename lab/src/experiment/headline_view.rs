@@ -6,9 +6,9 @@
 
 use super::benefit::{headline_md_titled, Estimate, Headline};
 use super::benefit_map::render::WINDOW_PITCHES;
+use super::benefit_map::verdict::column;
 use super::benefit_map::{BenefitMap, Cell};
 use super::config::ExperimentConfig;
-use super::verdict::column;
 use crate::trigger::PolicySpec;
 
 /// The map's cell the headline reads: at the experiment's light (the

@@ -27,13 +27,12 @@ pub(crate) mod report;
 pub(crate) mod run;
 pub(crate) mod sweep;
 pub(crate) mod truth;
-pub(crate) mod verdict;
 pub(crate) mod walk;
 
 pub use benefit_map::report::{answer as map_answer, timing_verdict};
+pub use benefit_map::verdict::{cell_verdict, three_lines, Verdict};
 pub use benefit_map::{BenefitMap, Cell, CellPolicy};
 pub use config::{ExperimentConfig, MapSection, WalkTimes, DEMO_POLICIES};
 pub use headline_view::{headline_cell, headlines_of};
 pub use report::{table_6, Outcome};
 pub use run::{run, writes};
-pub use verdict::{cell_verdict, three_lines, Verdict};

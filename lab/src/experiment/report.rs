@@ -415,7 +415,7 @@ pub fn report_md(
         .map(|w| w.runs.iter().map(|(p, _)| p.clone()).collect())
         .unwrap_or_default();
     if let Some(m) = &o.map {
-        for line in super::verdict::three_lines(m) {
+        for line in super::benefit_map::verdict::three_lines(m) {
             s += &format!("- {line}\n");
         }
         s += "\n";

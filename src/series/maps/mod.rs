@@ -35,7 +35,7 @@ use crate::model::log::ImuLog;
 use crate::model::motion::Plane;
 use crate::model::track::LineTrack;
 use crate::model::trajectory::Trajectory;
-use crate::series::job::FrameWindow;
+use crate::series::window::FrameWindow;
 use crate::series::SeriesOptions;
 use line::LineMotion;
 use rayon::prelude::*;

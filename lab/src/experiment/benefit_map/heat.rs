@@ -8,8 +8,8 @@
 //! colours and black on light ones ([`crate::plot::text_on`]).
 
 use super::super::benefit::Estimate;
-use super::super::verdict::column;
 use super::report::{lost, timing_verdict};
+use super::verdict::column;
 use super::{BenefitMap, Cell};
 use crate::error::Result;
 use crate::io::atomic::write_atomic_path;

@@ -18,6 +18,7 @@
 pub(crate) mod heat;
 pub(crate) mod render;
 pub(crate) mod report;
+pub(crate) mod verdict;
 
 use super::benefit::{bootstrap_indices, Estimate, WalkBlocks};
 use super::config::ExperimentConfig;

@@ -5,8 +5,8 @@
 
 use super::super::benefit::{Estimate, BLOCK_S, BOOTSTRAP_SEED, RESAMPLES};
 use super::super::corners::{FAST_THRESHOLD, MATCH_PX, NMS_RADIUS, REPEAT_OK};
-use super::super::verdict::column;
 pub use super::heat::heat_map_png;
+use super::verdict::column;
 use super::{BenefitMap, Cell};
 use std::path::Path;
 
@@ -430,9 +430,9 @@ pub fn timing_md(m: &BenefitMap) -> String {
 }
 
 /// The few lines the terminal ends with: the three lines of
-/// [`super::super::verdict::three_lines`], the map's ratios and where the report is.
+/// [`super::verdict::three_lines`], the map's ratios and where the report is.
 pub fn answer(m: &BenefitMap, report: &Path) -> Vec<String> {
-    let mut out: Vec<String> = super::super::verdict::three_lines(m).into();
+    let mut out: Vec<String> = super::verdict::three_lines(m).into();
     let won = m.cells.iter().filter(|c| !lost(c)).count();
     out.push(format!(
         "Benefit map ({} cells, seeds {:?}): gyro-driven capture is below neither the best fixed exposure in hindsight \

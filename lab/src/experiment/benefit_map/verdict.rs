@@ -8,8 +8,8 @@
 //! ratio). It **pays** when every ratio's 95 % interval lies above 1, it
 //! **loses** when one lies below 1, and it **ties** otherwise.
 
-use super::benefit::Estimate;
-use super::benefit_map::{BenefitMap, Cell};
+use super::super::benefit::Estimate;
+use super::{BenefitMap, Cell};
 
 /// A cell's verdict.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
