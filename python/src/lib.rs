@@ -4,7 +4,7 @@
 //! library with the GIL released, and returns NumPy arrays. Library errors
 //! become `OSError` (files) or `ValueError` (everything else). The
 //! arguments every function shares (camera, plane, log, frame table,
-//! method) are turned into the library's types in one place, [`args`]; the
+//! method) are turned into the library's types in one place, `args.rs`; the
 //! jobs are the library's (`series::job::FramesJob`, `RenderJob::for_motion`).
 
 mod args;

@@ -111,7 +111,7 @@ pub fn track(
     track_from(cam, target, &inv_poses(traj, steps), x, y)
 }
 
-/// [`track`] for many pixel positions `points` (px), the poses computed once.
+/// [`track()`] for many pixel positions `points` (px), the poses computed once.
 pub fn tracks(
     cam: &Camera,
     target: &Target,

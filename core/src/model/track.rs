@@ -9,7 +9,7 @@
 //! [`LineTrack`] is the one owner of a line's window and of the instants a
 //! track is sampled at (`steps + 1`, uniform, `steps` chords): the
 //! renderer's blur maps (`render::maps`) project each pixel's scene point
-//! through its poses ([`LineTrack::path`]); the frames' maps
+//! through its poses ([`path`]); the frames' maps
 //! (`series::maps`) take the same poses relative to the line's start.
 
 use super::trajectory::{Pose, Trajectory};
@@ -69,7 +69,7 @@ impl LineTrack {
         }
     }
 
-    /// The poses as (world-to-camera rotation, centre), for [`LineTrack::path`].
+    /// The poses as (world-to-camera rotation, centre), for [`path`].
     pub fn world_to_camera(&self) -> Vec<(DMat3, DVec3)> {
         self.poses
             .iter()
