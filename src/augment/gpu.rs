@@ -10,7 +10,8 @@ use super::warp::{Maps, Src};
 use super::warp_kernel::{self as wk, WarpMap, WarpParams};
 use crate::error::{Error, Result};
 use crate::gpu::compute::{
-    self, ensure, read_back, storage_entry, uniform_entry, Buf, READ, STORAGE_DST, STORAGE_SRC,
+    self, ensure, read_back, storage_entry, uniform_entry, Buf, Kernel, READ, STORAGE_DST,
+    STORAGE_SRC,
 };
 use crate::gpu::{Backend, GpuContext, Resolved};
 use std::sync::atomic::AtomicBool;
@@ -22,11 +23,6 @@ pub const SHADER: &str = include_str!("warp.wgsl");
 /// Most pixel-samples (pixels x instants) in one dispatch, count.
 pub const SAMPLES_PER_DISPATCH: u64 = 1 << 25;
 
-struct Kernel {
-    bgl: wgpu::BindGroupLayout,
-    pipeline: wgpu::ComputePipeline,
-}
-
 fn build(ctx: &GpuContext) -> Result<Kernel> {
     let layout = [
         uniform_entry(0),
@@ -34,16 +30,7 @@ fn build(ctx: &GpuContext) -> Result<Kernel> {
         storage_entry(2, true),
         storage_entry(3, false),
     ];
-    let p = compute::build(ctx, "warp.wgsl", SHADER, Some(&layout), &["main"])?;
-    let pipeline = p
-        .pipelines
-        .into_iter()
-        .next()
-        .ok_or_else(|| Error::Gpu("augment/warp.wgsl: pipeline missing".into()))?;
-    Ok(Kernel {
-        bgl: p.bgl,
-        pipeline,
-    })
+    compute::build_one(ctx, "warp.wgsl", SHADER, &layout, "main")
 }
 
 static KERNEL: OnceLock<std::result::Result<Kernel, String>> = OnceLock::new();

@@ -209,6 +209,7 @@ impl Grid {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::gpu::compute::shader_const;
 
     #[test]
     fn grid_sizes_and_params() {
@@ -223,20 +224,6 @@ mod tests {
         );
         assert!(Grid::new(&cam, 0, 6).is_err());
         assert!(Grid::new(&cam, 100_000, 100_000).is_err());
-    }
-
-    /// The shader's `const` of this name, as a u32.
-    fn shader_const(m: &naga::Module, name: &str) -> u32 {
-        let c = m
-            .constants
-            .iter()
-            .map(|(_, c)| c)
-            .find(|c| c.name.as_deref() == Some(name))
-            .unwrap_or_else(|| panic!("field.wgsl has no const {name}"));
-        match m.global_expressions[c.init] {
-            naga::Expression::Literal(naga::Literal::U32(v)) => v,
-            ref e => panic!("const {name} is not a u32 literal: {e:?}"),
-        }
     }
 
     #[test]

@@ -43,6 +43,54 @@ pub struct Pipelines {
     pub pipelines: Vec<wgpu::ComputePipeline>,
 }
 
+/// A kernel with one entry point: its bind group 0 layout and its pipeline.
+pub struct Kernel {
+    /// The layout of bind group 0.
+    pub bgl: wgpu::BindGroupLayout,
+    /// The entry point's pipeline.
+    pub pipeline: wgpu::ComputePipeline,
+}
+
+/// [`build`] for a shader with the one entry point `entry` and the explicit
+/// bind group 0 `layout`.
+pub fn build_one(
+    ctx: &GpuContext,
+    file: &str,
+    source: &str,
+    layout: &[wgpu::BindGroupLayoutEntry],
+    entry: &str,
+) -> Result<Kernel> {
+    let p = build(ctx, file, source, Some(layout), &[entry])?;
+    let pipeline = p
+        .pipelines
+        .into_iter()
+        .next()
+        .ok_or_else(|| Error::Gpu(format!("{file}: pipeline missing")))?;
+    Ok(Kernel {
+        bgl: p.bgl,
+        pipeline,
+    })
+}
+
+/// The `u32` value of the WGSL `const` `name` in the parsed module `m` (for
+/// tests that tie a shader's constants to the host's).
+///
+/// # Panics
+/// When the module has no such `const`, or it is not a `u32` literal.
+#[cfg(test)]
+pub(crate) fn shader_const(m: &naga::Module, name: &str) -> u32 {
+    let c = m
+        .constants
+        .iter()
+        .map(|(_, c)| c)
+        .find(|c| c.name.as_deref() == Some(name))
+        .unwrap_or_else(|| panic!("the shader has no const {name}"));
+    match m.global_expressions[c.init] {
+        naga::Expression::Literal(naga::Literal::U32(v)) => v,
+        ref e => panic!("const {name} is not a u32 literal: {e:?}"),
+    }
+}
+
 /// Compiles `source` (named `file` in errors) and builds a pipeline for each
 /// of `entries`. With `layout` the bind group 0 layout is explicit; with
 /// `None` it is derived from the shader (from the first entry point).

@@ -11,7 +11,8 @@ use super::{FrameMaps, MapsJob};
 use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::gpu::compute::{
-    self, ensure, read_back, storage_entry, uniform_entry, Buf, READ, STORAGE_DST, STORAGE_SRC,
+    self, ensure, read_back, storage_entry, uniform_entry, Buf, Kernel, READ, STORAGE_DST,
+    STORAGE_SRC,
 };
 use crate::gpu::{Backend, GpuContext, Resolved};
 use bytemuck::Zeroable;
@@ -25,11 +26,6 @@ pub const MAPS_WGSL: &str = concat!(
     include_str!("maps.wgsl")
 );
 
-struct Kernel {
-    bgl: wgpu::BindGroupLayout,
-    pipeline: wgpu::ComputePipeline,
-}
-
 fn build(ctx: &GpuContext) -> Result<Kernel> {
     let layout = [
         uniform_entry(0),
@@ -40,16 +36,7 @@ fn build(ctx: &GpuContext) -> Result<Kernel> {
         storage_entry(5, true),
         storage_entry(6, true),
     ];
-    let p = compute::build(ctx, "maps.wgsl", MAPS_WGSL, Some(&layout), &["maps"])?;
-    let pipeline = p
-        .pipelines
-        .into_iter()
-        .next()
-        .ok_or_else(|| Error::Gpu("maps.wgsl: pipeline missing".into()))?;
-    Ok(Kernel {
-        bgl: p.bgl,
-        pipeline,
-    })
+    compute::build_one(ctx, "maps.wgsl", MAPS_WGSL, &layout, "maps")
 }
 
 static KERNEL: OnceLock<std::result::Result<Kernel, String>> = OnceLock::new();

@@ -406,20 +406,7 @@ fn thread(
 mod tests {
     use super::*;
     use crate::camera::Camera;
-
-    /// The shader's `const` of this name, as a u32.
-    fn shader_const(m: &naga::Module, name: &str) -> u32 {
-        let c = m
-            .constants
-            .iter()
-            .map(|(_, c)| c)
-            .find(|c| c.name.as_deref() == Some(name))
-            .unwrap_or_else(|| panic!("maps.wgsl has no const {name}"));
-        match m.global_expressions[c.init] {
-            naga::Expression::Literal(naga::Literal::U32(v)) => v,
-            ref e => panic!("const {name} is not a u32 literal: {e:?}"),
-        }
-    }
+    use crate::gpu::compute::shader_const;
 
     #[test]
     fn shader_constants_and_struct_sizes_match_host() {
