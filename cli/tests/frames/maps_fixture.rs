@@ -1,12 +1,14 @@
-//! Helpers of the frame-maps tests, shared by `cli/tests/frames/frame_maps.rs` and
-//! `cli/tests/frames/maps_gpu.rs`: the options, the example cameras and the shared
-//! logs with their frame tables.
+//! Helpers of the frame-maps tests, shared by `cli/tests/frames/frame_maps.rs`,
+//! `cli/tests/frames/maps_gpu.rs` and `maps_gpu_lens.rs`: the options, the example
+//! cameras, the shared logs with their frame tables, a frame's maps job and the
+//! largest difference of two maps.
 #![allow(dead_code)]
 
 use glam::DVec3;
 use mmbm::io::frames::{read_frames, VideoFrame};
 use mmbm::io::gyro::{read_log, GyroOptions, GyroSample};
 use mmbm::model::log::ImuLog;
+use mmbm::series::maps::{FrameMaps, MapRays, MapsJob};
 use mmbm::series::SeriesOptions;
 use mmbm::{Camera, Method, Plane, Scene};
 use std::path::{Path, PathBuf};
@@ -89,4 +91,47 @@ pub fn synthetic_log(depth: Option<f64>) -> ImuLog {
         })
         .collect();
     ImuLog::new(samples).unwrap()
+}
+
+/// The job of frame `index` with automatic chords.
+pub fn job<'a>(
+    log: &'a ImuLog,
+    opts: &'a SeriesOptions,
+    rays: &'a MapRays,
+    index: usize,
+    frame: &'a VideoFrame,
+) -> MapsJob<'a> {
+    MapsJob {
+        log,
+        opts,
+        rays,
+        index,
+        frame,
+        steps: None,
+    }
+}
+
+/// The largest |a - b| per channel relative to `(1 + path)` (channels 0..3)
+/// and `(1 + |flow|)` (3..5), of `b`; NaN must be in the same pixels.
+pub fn worst(a: &FrameMaps, b: &FrameMaps) -> (f64, f64) {
+    let (ca, cb) = (a.channels(), b.channels());
+    let (mut track, mut flow): (f64, f64) = (0.0, 0.0);
+    for i in 0..b.path_px.len() {
+        let path = b.path_px[i] as f64;
+        let speed = (b.flow_u[i] as f64).hypot(b.flow_v[i] as f64);
+        for c in 0..5 {
+            let (x, y) = (ca[c].1[i], cb[c].1[i]);
+            assert_eq!(x.is_nan(), y.is_nan(), "pixel {i} channel {c}: {x} vs {y}");
+            if x.is_nan() {
+                continue;
+            }
+            let e = (x - y).abs() as f64;
+            if c < 3 {
+                track = track.max(e / (1.0 + path));
+            } else {
+                flow = flow.max(e / (1.0 + speed));
+            }
+        }
+    }
+    (track, flow)
 }

@@ -24,27 +24,9 @@ use mmbm::io::frames::VideoFrame;
 use mmbm::model::log::ImuLog;
 use mmbm::series::maps::gpu::{resolve, MapsRunner};
 use mmbm::series::maps::kernel::frame_maps_twin;
-use mmbm::series::maps::{frame_maps, FrameMaps, MapRays, MapsJob};
+use mmbm::series::maps::{frame_maps, MapRays};
 use mmbm::series::SeriesOptions;
 use mmbm::{Camera, Plane};
-
-/// The job of frame `index` with automatic chords.
-fn job<'a>(
-    log: &'a ImuLog,
-    opts: &'a SeriesOptions,
-    rays: &'a MapRays,
-    index: usize,
-    frame: &'a VideoFrame,
-) -> MapsJob<'a> {
-    MapsJob {
-        log,
-        opts,
-        rays,
-        index,
-        frame,
-        steps: None,
-    }
-}
 
 /// The pinhole, an OpenCV lens, a fisheye, and a fisheye whose radial limit
 /// lies inside the sensor (pixels beyond it have no ray: NaN) on `base`.
@@ -87,31 +69,6 @@ fn lenses(base: Camera) -> [(&'static str, Camera); 4] {
             },
         ),
     ]
-}
-
-/// The largest |a - b| per channel relative to `(1 + path)` (channels 0..3)
-/// and `(1 + |flow|)` (3..5), of `b`; NaN must be in the same pixels.
-fn worst(a: &FrameMaps, b: &FrameMaps) -> (f64, f64) {
-    let (ca, cb) = (a.channels(), b.channels());
-    let (mut track, mut flow): (f64, f64) = (0.0, 0.0);
-    for i in 0..b.path_px.len() {
-        let path = b.path_px[i] as f64;
-        let speed = (b.flow_u[i] as f64).hypot(b.flow_v[i] as f64);
-        for c in 0..5 {
-            let (x, y) = (ca[c].1[i], cb[c].1[i]);
-            assert_eq!(x.is_nan(), y.is_nan(), "pixel {i} channel {c}: {x} vs {y}");
-            if x.is_nan() {
-                continue;
-            }
-            let e = (x - y).abs() as f64;
-            if c < 3 {
-                track = track.max(e / (1.0 + path));
-            } else {
-                flow = flow.max(e / (1.0 + speed));
-            }
-        }
-    }
-    (track, flow)
 }
 
 /// The frames of a shared log's tests: its blurriest (largest mean path at

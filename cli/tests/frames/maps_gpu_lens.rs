@@ -18,7 +18,7 @@ use mmbm::camera::{Distortion, Readout, Shutter};
 use mmbm::io::frames::VideoFrame;
 use mmbm::series::maps::gpu::MapsRunner;
 use mmbm::series::maps::kernel::frame_maps_twin;
-use mmbm::series::maps::{frame_maps, FrameMaps, MapRays, MapsJob};
+use mmbm::series::maps::{frame_maps, MapRays};
 use mmbm::Camera;
 use std::path::PathBuf;
 
@@ -73,47 +73,6 @@ fn table_lenses() -> Vec<(String, Camera)> {
     out
 }
 
-/// The largest |a - b| per channel relative to `(1 + path)` (channels 0..3)
-/// and `(1 + |flow|)` (3..5), of `b`; NaN must be in the same pixels.
-fn worst(a: &FrameMaps, b: &FrameMaps) -> (f64, f64) {
-    let (ca, cb) = (a.channels(), b.channels());
-    let (mut track, mut flow): (f64, f64) = (0.0, 0.0);
-    for i in 0..b.path_px.len() {
-        let path = b.path_px[i] as f64;
-        let speed = (b.flow_u[i] as f64).hypot(b.flow_v[i] as f64);
-        for c in 0..5 {
-            let (x, y) = (ca[c].1[i], cb[c].1[i]);
-            assert_eq!(x.is_nan(), y.is_nan(), "pixel {i} channel {c}: {x} vs {y}");
-            if x.is_nan() {
-                continue;
-            }
-            let e = (x - y).abs() as f64;
-            if c < 3 {
-                track = track.max(e / (1.0 + path));
-            } else {
-                flow = flow.max(e / (1.0 + speed));
-            }
-        }
-    }
-    (track, flow)
-}
-
-fn job<'a>(
-    log: &'a mmbm::model::log::ImuLog,
-    opts: &'a mmbm::series::SeriesOptions,
-    rays: &'a MapRays,
-    frame: &'a VideoFrame,
-) -> MapsJob<'a> {
-    MapsJob {
-        log,
-        opts,
-        rays,
-        index: 0,
-        frame,
-        steps: None,
-    }
-}
-
 /// The twin in table mode agrees with the f64 maps (rotation, and
 /// translation on a plane), and the kernel with the twin per pixel.
 #[test]
@@ -136,7 +95,7 @@ fn table_mode_matches_f64_and_kernel_matches_twin() {
             let cpu = frame_maps(&log, &o, &rays, 0, &frame, None)
                 .unwrap()
                 .unwrap();
-            let twin = frame_maps_twin(&job(&log, &o, &rays, &frame))
+            let twin = frame_maps_twin(&job(&log, &o, &rays, 0, &frame))
                 .unwrap()
                 .unwrap();
             assert!(cpu.mean_path_px().1 > 0.5, "{name}: a blur to measure");
@@ -148,7 +107,7 @@ fn table_mode_matches_f64_and_kernel_matches_twin() {
             (wt, wf) = (wt.max(t), wf.max(fl));
             if let Some(r) = runner.as_mut() {
                 let gpu = r
-                    .frame_maps(&job(&log, &o, &rays, &frame))
+                    .frame_maps(&job(&log, &o, &rays, 0, &frame))
                     .unwrap()
                     .unwrap();
                 let (t, fl) = worst(&gpu, &twin);
