@@ -7,6 +7,8 @@ mod common;
 
 #[path = "render/blobs_rendered.rs"]
 mod blobs_rendered;
+#[path = "render/houseg.rs"]
+mod houseg;
 #[path = "render/render_camera.rs"]
 mod render_camera;
 #[path = "render/render_exact.rs"]

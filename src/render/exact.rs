@@ -232,10 +232,9 @@ pub fn pixel_sum(
     }
     let (mut px, mut py) = (i as f32 + 0.5, j as f32 + 0.5);
     let mut l = [[1.0, 0.0], [0.0, 1.0]];
-    if p.lattice[2] != 0 {
-        let m = &homs[(p.lattice[2] + j * p.dims[0] + i) as usize];
-        (px, py) = (m.h0[0], m.h0[1]);
-        l = [[m.h0[2], m.h0[3]], [m.h1[0], m.h1[1]]];
+    if p.distortion.model != crate::gpu::lens::MODEL_NONE {
+        let m = super::cpu::pixel_map(p, homs, i, j);
+        ([px, py], l) = (m.p, m.l);
     }
     let mut acc = Vec3::ZERO;
     for k in p.range[1]..p.range[2] {

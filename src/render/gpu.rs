@@ -13,16 +13,28 @@ use crate::error::{Error, Result};
 use crate::gpu::{compute, GpuContext};
 use std::sync::OnceLock;
 
-/// WGSL source of the renderer's prelude alone (valid by itself).
-pub const PRELUDE: &str = include_str!("prelude.wgsl");
+/// WGSL source of the renderer's prelude after the lens module
+/// ([`crate::gpu::lens::LENS_WGSL`]; valid by itself).
+pub const PRELUDE: &str = concat!(
+    include_str!("../gpu/lens.wgsl"),
+    include_str!("prelude.wgsl")
+);
 
-/// WGSL source of the kernel: the prelude joined with `render.wgsl`.
-pub const SHADER: &str = concat!(include_str!("prelude.wgsl"), include_str!("render.wgsl"));
+/// WGSL source of the kernel: the lens module and the prelude joined with
+/// `render.wgsl`.
+pub const SHADER: &str = concat!(
+    include_str!("../gpu/lens.wgsl"),
+    include_str!("prelude.wgsl"),
+    include_str!("render.wgsl")
+);
 
-/// WGSL source of the `analytic` kernel for image textures: the prelude
-/// joined with `texture.wgsl` (same bindings).
-pub const TEXTURE_SHADER: &str =
-    concat!(include_str!("prelude.wgsl"), include_str!("texture.wgsl"));
+/// WGSL source of the `analytic` kernel for image textures: the lens module
+/// and the prelude joined with `texture.wgsl` (same bindings).
+pub const TEXTURE_SHADER: &str = concat!(
+    include_str!("../gpu/lens.wgsl"),
+    include_str!("prelude.wgsl"),
+    include_str!("texture.wgsl")
+);
 
 /// Upper bound of pixel-samples in one dispatch.
 pub const SAMPLES_PER_DISPATCH: u64 = 1 << 25;
@@ -315,5 +327,32 @@ mod tests {
         )
         .validate(&m)
         .expect("texture.wgsl validates");
+    }
+
+    /// The size of WGSL struct `name` in `src` (naga's layout).
+    fn struct_size(src: &str, name: &str) -> usize {
+        let m = naga::front::wgsl::parse_str(src).expect("parses");
+        let mut layouter = naga::proc::Layouter::default();
+        layouter.update(m.to_ctx()).expect("layout");
+        let (h, _) = m
+            .types
+            .iter()
+            .find(|(_, t)| t.name.as_deref() == Some(name))
+            .unwrap_or_else(|| panic!("no struct {name}"));
+        layouter[h].size as usize
+    }
+
+    #[test]
+    fn params_match_the_host_struct() {
+        use super::super::layout::{GpuHomography, RenderParams};
+        use std::mem::size_of;
+        for src in [super::SHADER, super::TEXTURE_SHADER] {
+            assert_eq!(struct_size(src, "Params"), size_of::<RenderParams>());
+            assert_eq!(struct_size(src, "Homography"), size_of::<GpuHomography>());
+            assert_eq!(
+                struct_size(src, "Lens"),
+                size_of::<crate::gpu::lens::LensGpu>()
+            );
+        }
     }
 }

@@ -30,6 +30,7 @@ use super::target::{Target, TargetKind};
 use super::texture::MipTexture;
 use crate::board::{BLOB_RED, BOARD_WHITE};
 use crate::camera::Camera;
+use crate::gpu::lens::LensGpu;
 
 pub use super::homography::{homographies, masked_pixels, pixel_maps, target_bbox};
 pub use super::layout::{RenderParams, KIND_BLOBS, KIND_CHECKER, KIND_IMAGE, LOD_SCALE};
@@ -51,6 +52,19 @@ pub fn lens_params(cam: &Camera) -> [f32; 4] {
         (cam.fy_px() / l.focus_m) as f32,
         (cam.skew / l.focus_m) as f32,
     ]
+}
+
+/// The renderer's lens distortion ([`RenderParams::distortion`]), by the
+/// one strategy of every kernel ([`crate::gpu::lens`]): none for a pinhole
+/// camera; the OpenCV and fisheye models computed in the kernel; table mode
+/// (the host's f64 per-pixel table, [`pixel_maps`]) for every other model
+/// and for a camera with a pixel centre beyond its radial distortion limit
+/// ([`masked_pixels`]: the table holds its placeholder).
+pub fn distortion(cam: &Camera) -> LensGpu {
+    match cam.distortion.coefficients() {
+        Some(m) if masked_pixels(cam).is_none() => LensGpu::new(Some(m)),
+        _ => LensGpu::table(),
+    }
 }
 
 /// The parameter block for a whole image (`range` set to all rows and samples).
@@ -115,6 +129,14 @@ pub fn params(cam: &Camera, target: &Target, n: u32, bbox: [u32; 4], seed: u32) 
         lens: lens_params(cam),
         lens_gen: [g3, g4, 0, 0],
         poster,
+        pixel: [
+            cam.cx as f32,
+            cam.cy as f32,
+            (cam.pitch_x_mm / cam.focal_mm) as f32,
+            (cam.pitch_y_mm / cam.focal_mm) as f32,
+        ],
+        pixel2: [cam.skew as f32, 0.0, 0.0, 0.0],
+        distortion: distortion(cam),
     }
 }
 
@@ -144,6 +166,7 @@ pub fn texture_of(target: &Target) -> Option<&MipTexture> {
 
 #[cfg(test)]
 mod tests {
+    use super::super::layout::GpuHomography;
     use super::*;
 
     #[test]
@@ -160,5 +183,115 @@ mod tests {
         assert_eq!(p.tex[1], h.pitch_m() as f32);
         assert_eq!(p.tex[2], h.half_width_m() as f32);
         assert_eq!(t.blob_centres().map(|c| c.len()), Some(16));
+    }
+
+    /// An OpenCV barrel lens and an unmasked fisheye, with skew and an
+    /// off-centre principal point (the pixel map's every term).
+    fn lens_cameras() -> Vec<Camera> {
+        use crate::camera::Distortion;
+        let base = Camera {
+            skew: 0.7,
+            cx: 30.5,
+            cy: 25.0,
+            ..Camera::new(0.7, 0.00465, 64, 48)
+        };
+        vec![
+            Camera {
+                distortion: Distortion::Opencv {
+                    k1: -0.3,
+                    k2: 0.08,
+                    p1: 0.001,
+                    p2: -0.002,
+                    k3: 0.01,
+                },
+                ..base
+            },
+            Camera {
+                distortion: Distortion::Fisheye {
+                    k1: 0.05,
+                    k2: -0.01,
+                    k3: 0.002,
+                    k4: 0.0,
+                },
+                ..base
+            },
+        ]
+    }
+
+    /// Table mode's parameters and table for `cam` (the host's f64 map).
+    fn table_mode(
+        p: &RenderParams,
+        homs: &[GpuHomography],
+        cam: &Camera,
+    ) -> (RenderParams, Vec<GpuHomography>) {
+        let mut q = *p;
+        let mut h = homs.to_vec();
+        q.distortion = LensGpu::table();
+        q.lattice[2] = h.len() as u32;
+        h.extend(pixel_maps(cam).unwrap().unwrap());
+        (q, h)
+    }
+
+    #[test]
+    fn kernel_pixel_map_matches_the_host_table() {
+        // The analytic models' map in f32 (the lens module's twins) against
+        // the host's f64 table: the point to 1e-3 px, the Jacobian to 1e-4.
+        for cam in lens_cameras() {
+            assert!(masked_pixels(&cam).is_none());
+            let p = params(&cam, &Target::checker(0.02, 1.0), 16, [0, 0, 64, 48], 0);
+            assert_eq!(p.distortion.model, cam.distortion.coefficients().unwrap().0);
+            let (t, h) = table_mode(&p, &[], &cam);
+            let (mut dp, mut dl) = (0.0f32, 0.0f32);
+            for (i, j) in (0..48).flat_map(|j| (0..64).map(move |i| (i, j))) {
+                let (a, b) = (
+                    super::super::cpu::pixel_map(&p, &[], i, j),
+                    super::super::cpu::pixel_map(&t, &h, i, j),
+                );
+                dp = dp.max((a.p[0] - b.p[0]).abs().max((a.p[1] - b.p[1]).abs()));
+                for r in 0..2 {
+                    for c in 0..2 {
+                        dl = dl.max((a.l[r][c] - b.l[r][c]).abs());
+                    }
+                }
+            }
+            let name = cam.distortion.name();
+            eprintln!("{name}: pixel map, max |point| {dp:.2e} px, max |L| {dl:.2e}");
+            assert!(dp <= 1e-3 && dl <= 1e-4, "{name}: {dp} px, {dl}");
+        }
+    }
+
+    #[test]
+    fn analytic_lens_renders_as_the_table() {
+        // The CPU twin's image with the lens in the kernel against table
+        // mode (the renderer before the shared lens module): a sample may
+        // cross an edge (1/N), the mean stays at the f32 level.
+        use crate::model::motion::Twist;
+        use crate::model::trajectory::Trajectory;
+        let tw = Twist::new(
+            glam::DVec3::new(0.5, -0.7, 1.0),
+            glam::DVec3::new(0.1, 0.05, 0.3),
+        );
+        let tr = Trajectory::from_twist(tw, 0.03).unwrap();
+        let n = 32;
+        for cam in lens_cameras() {
+            for target in [Target::blobs(0.5, 1.5), Target::checker(0.03, 1.2)] {
+                let homs = homographies(&cam, &target, &tr, 0.03, n);
+                let p = params(&cam, &target, n, [0, 0, 64, 48], 3);
+                let (t, h) = table_mode(&p, &homs, &cam);
+                for analytic in [false, true] {
+                    let a = super::super::cpu::render(&p, &homs, None, analytic, None);
+                    let b = super::super::cpu::render(&t, &h, None, analytic, None);
+                    let d: Vec<f32> = a.iter().zip(&b).map(|(x, y)| (x - y).abs()).collect();
+                    let max = d.iter().cloned().fold(0.0, f32::max);
+                    let mean = d.iter().sum::<f32>() / d.len() as f32;
+                    let name = cam.distortion.name();
+                    eprintln!("{name} analytic {analytic}: max {max:.2e}, mean {mean:.2e}");
+                    assert!(
+                        max <= 3.0 / n as f32 + 1e-3 && mean <= 1e-4,
+                        "{name} {analytic}: {max} {mean}"
+                    );
+                }
+            }
+        }
     }
 }

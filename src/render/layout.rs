@@ -2,6 +2,7 @@
 //! homography-table entry shared with `render.wgsl` (bytemuck Pod,
 //! sizes and offsets asserted), and the target kinds' codes.
 
+use crate::gpu::lens::LensGpu;
 use bytemuck::{Pod, Zeroable};
 
 /// Target kind codes in [`RenderParams::dims`].
@@ -32,7 +33,8 @@ pub struct RenderParams {
     pub lod: [f32; 4],
     /// width, height (full image, px), target kind, N (samples per pixel).
     pub dims: [u32; 4],
-    /// g1, g2 (lattice generator), distortion map offset (`kernel::pixel_maps`; 0: none), seed.
+    /// g1, g2 (lattice generator), distortion table offset (`kernel::pixel_maps`;
+    /// table mode only, else 0), seed.
     pub lattice: [u32; 4],
     /// First row of this dispatch, first and end sample index k0, k1, (k0*g1) mod N.
     pub range: [u32; 4],
@@ -47,9 +49,19 @@ pub struct RenderParams {
     pub lens_gen: [u32; 4],
     /// The poster's layers (`poster::kernel_block`): `[S, 1/S, pa, pb]`, `[r, g, b, 0]` each.
     pub poster: [[f32; 4]; 8],
+    /// Lens distortion's pixel map (`pixel_map` in `prelude.wgsl`): `cx, cy`
+    /// (px) and `pitch_x / f, pitch_y / f` (normalised units per px).
+    pub pixel: [f32; 4],
+    /// `skew` (px), 0, 0, 0.
+    pub pixel2: [f32; 4],
+    /// Lens distortion ([`crate::gpu::lens`]): none, OpenCV or fisheye in
+    /// the kernel, else table mode (the per-pixel table at `lattice[2]`).
+    pub distortion: LensGpu,
 }
 
-const _: () = assert!(std::mem::size_of::<RenderParams>() == 20 * 16);
+const _: () = assert!(std::mem::size_of::<RenderParams>() == 24 * 16);
+const _: () = assert!(std::mem::offset_of!(RenderParams, pixel) == 20 * 16);
+const _: () = assert!(std::mem::offset_of!(RenderParams, distortion) == 22 * 16);
 const _: () = assert!(std::mem::offset_of!(RenderParams, poster) == 12 * 16);
 const _: () = assert!(std::mem::offset_of!(RenderParams, lens) == 10 * 16);
 const _: () = assert!(std::mem::offset_of!(RenderParams, dims) == 5 * 16);

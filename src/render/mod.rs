@@ -420,9 +420,11 @@ fn render_frame_stream(job: &RenderJob, stream: u64) -> Result<RenderOutput> {
         [0, 0, cam.width, cam.height]
     };
     let mut params = kernel::params(cam, &job.target, n, bbox, job.seed);
-    if let Some(maps) = kernel::pixel_maps(cam)? {
-        params.lattice[2] = homs.len() as u32;
-        homs.extend(maps);
+    if params.distortion.model == crate::gpu::lens::MODEL_TABLE {
+        if let Some(maps) = kernel::pixel_maps(cam)? {
+            params.lattice[2] = homs.len() as u32;
+            homs.extend(maps);
+        }
     }
     let tex = kernel::texture_of(&job.target);
     let (rgb, backend_used) = match job.backend.resolve("render", "renderer", &ANNOUNCED)? {

@@ -21,8 +21,9 @@
 // edge crosses the footprint; it is approximate only where two edges do (a
 // corner inside a pixel). Formulas and their derivation: src/render/cpu.rs.
 
-// Params, Homography, the bindings and line_base: src/render/prelude.wgsl,
-// joined in front of this file at build (src/render/gpu.rs).
+// Params, Homography, the bindings, line_base and pixel_map:
+// src/render/prelude.wgsl, joined with the lens module (src/gpu/lens.wgsl)
+// in front of this file at build (src/render/gpu.rs).
 
 fn pcg(v: u32) -> u32 {
     let state = v * 747796405u + 2891336453u;
@@ -125,15 +126,13 @@ fn shade(h: Homography, px: f32, py: f32) -> vec3<f32> {
     return trilinear(u, v, lod);
 }
 
-// Lens distortion (docs/spec.md section 9): entry lattice.z + (j w + i) of the table is pixel
-// (i, j)'s map: h0 = (x', y', L00, L01), h1 = (L10, L11, _, _), with (x', y')
-// the pinhole pixel coordinates of the ray through the pixel centre and L the
-// Jacobian of undistortion there (host f64). A sample at (sx, sy) in the
-// pixel goes to (x', y') + L (sx - 1/2, sy - 1/2): first order in the pixel.
-fn pixel_point(m: Homography, sx: f32, sy: f32) -> vec2<f32> {
+// Lens distortion (docs/spec.md section 9): sample (sx, sy) of a pixel
+// through its map m (pixel_map, src/render/prelude.wgsl): p + L (sx - 1/2,
+// sy - 1/2), first order in the pixel.
+fn pixel_point(m: PixelMap, sx: f32, sy: f32) -> vec2<f32> {
     let dx = sx - 0.5;
     let dy = sy - 0.5;
-    return vec2<f32>(m.h0.x + m.h0.z * dx + m.h0.w * dy, m.h0.y + m.h1.x * dx + m.h1.y * dy);
+    return vec2<f32>(m.p.x + m.l0.x * dx + m.l0.y * dy, m.p.y + m.l1.x * dx + m.l1.y * dy);
 }
 
 // Defocus (docs/spec.md section 9, thin lens): a uniform point of the unit disc from a point
@@ -208,9 +207,10 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let fj = f32(j);
     let base = line_base(i, j);
     // Lens distortion: the pixel's map (see pixel_point).
-    var m = Homography(vec4<f32>(0.0), vec4<f32>(0.0), vec4<f32>(0.0));
-    if (P.lattice.z != 0u) {
-        m = homs[P.lattice.z + j * w + i];
+    let distorted = P.distortion.model != 0u;
+    var m = PixelMap(vec2<f32>(0.0), vec2<f32>(0.0), vec2<f32>(0.0));
+    if (distorted) {
+        m = pixel_map(i, j);
     }
     // Defocus: two more lattice dimensions with their own per-pixel shifts.
     let h3 = pcg(h2);
@@ -222,7 +222,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         let sx = fract(f32(xi) * inv_n + shx);
         let sy = fract(f32(yi) * inv_n + shy);
         var q = vec2<f32>(fi + sx, fj + sy);
-        if (P.lattice.z != 0u) {
+        if (distorted) {
             q = pixel_point(m, sx, sy);
         }
         if (P.lens.x > 0.0) {
@@ -454,10 +454,10 @@ fn analytic(@builtin(global_invocation_id) gid: vec3<u32>) {
     let py = f32(j) + 0.5;
     var acc = vec3<f32>(0.0);
     let base = line_base(i, j);
-    if (P.lattice.z != 0u) {
-        let m = homs[P.lattice.z + j * w + i];
+    if (P.distortion.model != 0u) {
+        let m = pixel_map(i, j);
         for (var k = P.range.y; k < P.range.z; k = k + 1u) {
-            acc = acc + footprint_mean_l(homs[base + k], m.h0.x, m.h0.y, m.h0.zw, m.h1.xy);
+            acc = acc + footprint_mean_l(homs[base + k], m.p.x, m.p.y, m.l0, m.l1);
         }
     } else {
         for (var k = P.range.y; k < P.range.z; k = k + 1u) {

@@ -12,8 +12,9 @@
 // table: its f32 differences would). Bindings and Params: the renderer's
 // prelude (src/render/prelude.wgsl; the same bind group layout).
 
-// Params, Homography, the bindings and line_base: src/render/prelude.wgsl,
-// joined in front of this file at build (src/render/gpu.rs).
+// Params, Homography, the bindings, line_base and pixel_map:
+// src/render/prelude.wgsl, joined with the lens module (src/gpu/lens.wgsl)
+// in front of this file at build (src/render/gpu.rs).
 
 const MAX_NODES: u32 = 8u;
 const MAX_REACH: f32 = 2.5;
@@ -215,12 +216,12 @@ fn texture(@builtin(global_invocation_id) gid: vec3<u32>) {
     var py = f32(j) + 0.5;
     var l0 = vec2<f32>(1.0, 0.0);
     var l1 = vec2<f32>(0.0, 1.0);
-    if (P.lattice.z != 0u) {
-        let m = homs[P.lattice.z + j * w + i];
-        px = m.h0.x;
-        py = m.h0.y;
-        l0 = m.h0.zw;
-        l1 = m.h1.xy;
+    if (P.distortion.model != 0u) {
+        let m = pixel_map(i, j);
+        px = m.p.x;
+        py = m.p.y;
+        l0 = m.l0;
+        l1 = m.l1;
     }
     let base = line_base(i, j);
     var acc = vec3<f32>(0.0);

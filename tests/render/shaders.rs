@@ -1,7 +1,8 @@
 //! Every shader parses and validates with naga (no GPU needed): each
-//! kernel's joined source as the runner compiles it (the lens module or the
-//! renderer's prelude, then the kernel's file), the shared modules alone,
-//! and every other `.wgsl` file under `src/` alone.
+//! kernel's joined source as the runner compiles it (the lens module, the
+//! renderer's prelude for the render kernels, then the kernel's file), the
+//! shared modules (the lens module alone, the prelude after it), and every
+//! other `.wgsl` file under `src/` alone.
 
 use std::path::Path;
 
@@ -24,16 +25,20 @@ fn validate(path: &Path) -> Result<(), String> {
 }
 
 /// Each kernel's joined source, as its runner compiles it.
-fn joined() -> [(&'static str, &'static str); 4] {
+fn joined() -> [(&'static str, &'static str); 5] {
     [
         ("field (lens + field.wgsl)", mmbm::field::FIELD_WGSL),
         (
             "maps (lens + maps.wgsl)",
             mmbm::series::maps::gpu::MAPS_WGSL,
         ),
-        ("render (prelude + render.wgsl)", mmbm::render::RENDER_WGSL),
+        ("prelude (lens + prelude.wgsl)", mmbm::render::PRELUDE_WGSL),
         (
-            "texture (prelude + texture.wgsl)",
+            "render (lens + prelude + render.wgsl)",
+            mmbm::render::RENDER_WGSL,
+        ),
+        (
+            "texture (lens + prelude + texture.wgsl)",
             mmbm::render::TEXTURE_WGSL,
         ),
     ]
@@ -74,12 +79,13 @@ fn all_shaders_validate() {
         .iter()
         .filter_map(|(name, src)| validate_src(name, src).err())
         .collect();
-    // The shared modules are valid alone; a kernel's own file is valid
-    // only joined (it uses the module), so it is checked above. Every other
-    // file (a kernel without a shared part) is checked alone.
+    // The lens module is valid alone, the prelude after it; a kernel's own
+    // file is valid only joined (it uses the modules), so it is checked
+    // above. Every other file (a kernel without a shared part) is checked
+    // alone.
     for p in &files {
         let text = std::fs::read_to_string(p).unwrap();
-        let module = p.ends_with("lens.wgsl") || p.ends_with("prelude.wgsl");
+        let module = p.ends_with("lens.wgsl");
         let part = joined().iter().any(|(_, src)| src.contains(&text));
         if module || !part {
             errors.extend(validate(p).err());
@@ -88,13 +94,16 @@ fn all_shaders_validate() {
     assert!(errors.is_empty(), "{}", errors.join("\n\n"));
 }
 
-/// The shared lens module and the renderer's prelude are joined into their
-/// kernels once, and their copies are gone from the kernels' own files.
+/// The shared lens module (every kernel) and the renderer's prelude (the
+/// render kernels, after the lens module) are joined into their kernels
+/// once, and no kernel's own file (nor the prelude) redefines their items.
 #[test]
 fn shared_modules_are_joined_not_copied() {
     let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
     let read = |p: &str| std::fs::read_to_string(src.join(p)).unwrap();
     let (lens, prelude) = (read("gpu/lens.wgsl"), read("render/prelude.wgsl"));
+    let lens_prelude = format!("{lens}{prelude}");
+    assert_eq!(mmbm::render::PRELUDE_WGSL, lens_prelude);
     for (joined, module, own) in [
         (mmbm::field::FIELD_WGSL, &lens, "field/field.wgsl"),
         (
@@ -102,28 +111,41 @@ fn shared_modules_are_joined_not_copied() {
             &lens,
             "series/maps/maps.wgsl",
         ),
-        (mmbm::render::RENDER_WGSL, &prelude, "render/render.wgsl"),
-        (mmbm::render::TEXTURE_WGSL, &prelude, "render/texture.wgsl"),
+        (
+            mmbm::render::RENDER_WGSL,
+            &lens_prelude,
+            "render/render.wgsl",
+        ),
+        (
+            mmbm::render::TEXTURE_WGSL,
+            &lens_prelude,
+            "render/texture.wgsl",
+        ),
     ] {
         assert_eq!(joined, format!("{module}{}", read(own)), "{own}");
     }
+    let lens_items = [
+        "struct Lens",
+        "fn distort(",
+        "fn jacobian(",
+        "fn undistort(",
+        "fn atan_poly(",
+    ];
+    let prelude_items = [
+        "struct Params",
+        "struct Homography",
+        "fn line_base(",
+        "struct PixelMap",
+        "fn pixel_map(",
+    ];
     for (own, defs) in [
-        (
-            "field/field.wgsl",
-            &["fn distort(", "fn jacobian(", "fn atan_poly("][..],
-        ),
-        (
-            "series/maps/maps.wgsl",
-            &["fn distort(", "fn jacobian(", "fn atan_poly("][..],
-        ),
-        (
-            "render/render.wgsl",
-            &["struct Params", "struct Homography", "fn line_base("][..],
-        ),
-        (
-            "render/texture.wgsl",
-            &["struct Params", "struct Homography", "fn line_base("][..],
-        ),
+        ("field/field.wgsl", &lens_items[..]),
+        ("series/maps/maps.wgsl", &lens_items[..]),
+        ("render/prelude.wgsl", &lens_items[..]),
+        ("render/render.wgsl", &lens_items[..]),
+        ("render/render.wgsl", &prelude_items[..]),
+        ("render/texture.wgsl", &lens_items[..]),
+        ("render/texture.wgsl", &prelude_items[..]),
     ] {
         let text = read(own);
         for d in defs {
@@ -175,5 +197,15 @@ fn host_structs_match_the_joined_shaders() {
         assert_eq!(struct_size(src, "Lens"), lens);
         assert_eq!(struct_size(src, "Params"), params);
         assert!(src.contains("    lens: Lens,"), "Params holds the Lens");
+    }
+    // The render kernels' Params hold it as `distortion` (their `lens` is
+    // the defocus aperture); their Params size is asserted in
+    // src/render/gpu.rs's unit tests (the host struct is private).
+    for src in [mmbm::render::RENDER_WGSL, mmbm::render::TEXTURE_WGSL] {
+        assert_eq!(struct_size(src, "Lens"), lens);
+        assert!(
+            src.contains("    distortion: Lens,"),
+            "Params holds the Lens"
+        );
     }
 }
