@@ -5,9 +5,10 @@ use super::kernel::{FlowParams, Grid, TwistGpu, MAX_DISPATCH, WG};
 use super::table::{valid_len, LensTable};
 use crate::error::{Error, Result};
 use crate::gpu::compute::{
-    self, ensure, read_back, storage_entry, uniform_entry, Buf, READ, STORAGE_DST, STORAGE_SRC,
+    self, ensure, read_back, storage_entry, uniform_entry, Buf, Kernel, READ, STORAGE_DST,
+    STORAGE_SRC,
 };
-use crate::gpu::{gpu, GpuContext};
+use crate::gpu::GpuContext;
 use std::sync::{Arc, OnceLock};
 
 /// The WGSL source of the flow kernels: the shared lens module
@@ -18,11 +19,10 @@ pub const FIELD_WGSL: &str = concat!(include_str!("../gpu/lens.wgsl"), include_s
 /// twist) for batches; larger ones use `flow_tiles` (one workgroup per tile).
 pub const ROWS_KERNEL_MAX_SAMPLES: usize = 4096;
 
-/// The bind group layout and the two pipelines.
+/// The two entry points (one bind group layout, [`compute::build_each`]).
 pub struct Kernels {
-    bgl: wgpu::BindGroupLayout,
-    tiles: wgpu::ComputePipeline,
-    rows: wgpu::ComputePipeline,
+    tiles: Kernel,
+    rows: Kernel,
 }
 
 fn build(ctx: &GpuContext) -> Result<Kernels> {
@@ -33,34 +33,21 @@ fn build(ctx: &GpuContext) -> Result<Kernels> {
         storage_entry(3, false),
         storage_entry(4, true),
     ];
-    let p = compute::build(
+    let [tiles, rows] = compute::build_each(
         ctx,
         "field.wgsl",
         FIELD_WGSL,
-        Some(&layout),
-        &["flow_tiles", "rows_per_twist"],
+        &layout,
+        ["flow_tiles", "rows_per_twist"],
     )?;
-    let mut it = p.pipelines.into_iter();
-    match (it.next(), it.next()) {
-        (Some(tiles), Some(rows)) => Ok(Kernels {
-            bgl: p.bgl,
-            tiles,
-            rows,
-        }),
-        _ => Err(Error::Gpu("field.wgsl: pipelines missing".into())),
-    }
+    Ok(Kernels { tiles, rows })
 }
 
 static KERNELS: OnceLock<std::result::Result<Kernels, String>> = OnceLock::new();
 
 /// The shared device and the flow kernels (compiled once per process).
 pub fn kernels() -> Result<(&'static GpuContext, &'static Kernels)> {
-    let ctx = gpu()?;
-    let k = KERNELS
-        .get_or_init(|| build(ctx).map_err(|e| e.to_string()))
-        .as_ref()
-        .map_err(|e| Error::Gpu(e.trim_start_matches("GPU: ").to_string()))?;
-    Ok((ctx, k))
+    compute::compiled(&KERNELS, build)
 }
 
 /// Dispatches the flow kernels, reusing its buffers between calls (they grow as needed).
@@ -194,7 +181,7 @@ impl FlowRunner {
         ctx.queue.write_buffer(tw_buf, 0, tw_bytes);
         let bg = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("flow"),
-            layout: &self.k.bgl,
+            layout: &self.k.tiles.bgl,
             entries: &[
                 wgpu::BindGroupEntry {
                     binding: 0,
@@ -228,7 +215,11 @@ impl FlowRunner {
                 label: Some("flow"),
                 timestamp_writes: None,
             });
-            pass.set_pipeline(if rows { &self.k.rows } else { &self.k.tiles });
+            pass.set_pipeline(if rows {
+                &self.k.rows.pipeline
+            } else {
+                &self.k.tiles.pipeline
+            });
             pass.set_bind_group(0, &bg, &[]);
             pass.dispatch_workgroups(groups.0, groups.1, groups.2);
         }

@@ -1,5 +1,6 @@
 //! Compute plumbing shared by every kernel: building a WGSL module and its
-//! pipelines under a validation error scope, bind group layout entries,
+//! pipelines under a validation error scope (every runner builds its
+//! kernels with [`build_one`] or [`build_each`]), bind group layout entries,
 //! growable storage buffers with limit checks, and mapping a buffer back to
 //! the host.
 
@@ -34,25 +35,18 @@ pub fn uniform_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
     }
 }
 
-/// A compiled WGSL module: its bind group layout (group 0) and one pipeline
-/// per entry point, in the order asked for.
-pub struct Pipelines {
-    /// The layout of bind group 0.
-    pub bgl: wgpu::BindGroupLayout,
-    /// One pipeline per entry point.
-    pub pipelines: Vec<wgpu::ComputePipeline>,
-}
-
-/// A kernel with one entry point: its bind group 0 layout and its pipeline.
+/// A kernel's entry point: its bind group 0 layout and its pipeline.
 pub struct Kernel {
-    /// The layout of bind group 0.
+    /// The layout of bind group 0 (shared by the entry points of one
+    /// [`build_each`]: a bind group made with it serves each of them).
     pub bgl: wgpu::BindGroupLayout,
     /// The entry point's pipeline.
     pub pipeline: wgpu::ComputePipeline,
 }
 
-/// [`build`] for a shader with the one entry point `entry` and the explicit
-/// bind group 0 `layout`.
+/// Compiles `source` (named `file` in errors) with the explicit bind group 0
+/// `layout` and builds the one entry point `entry`; validation errors come
+/// back as [`Error::Gpu`] naming `file`.
 pub fn build_one(
     ctx: &GpuContext,
     file: &str,
@@ -60,16 +54,51 @@ pub fn build_one(
     layout: &[wgpu::BindGroupLayoutEntry],
     entry: &str,
 ) -> Result<Kernel> {
-    let p = build(ctx, file, source, Some(layout), &[entry])?;
-    let pipeline = p
-        .pipelines
-        .into_iter()
-        .next()
-        .ok_or_else(|| Error::Gpu(format!("{file}: pipeline missing")))?;
-    Ok(Kernel {
-        bgl: p.bgl,
-        pipeline,
-    })
+    let [k] = build_each(ctx, file, source, layout, [entry])?;
+    Ok(k)
+}
+
+/// [`build_one`] for a shader with several entry points: one [`Kernel`] per
+/// entry of `entries`, in order, all with the same bind group 0 layout
+/// (the module compiled once). Validation errors come back as
+/// [`Error::Gpu`] naming `file`.
+pub fn build_each<const N: usize>(
+    ctx: &GpuContext,
+    file: &str,
+    source: &str,
+    layout: &[wgpu::BindGroupLayoutEntry],
+    entries: [&str; N],
+) -> Result<[Kernel; N]> {
+    let d = &ctx.device;
+    let scope = d.push_error_scope(wgpu::ErrorFilter::Validation);
+    let module = d.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some(file),
+        source: wgpu::ShaderSource::Wgsl(source.into()),
+    });
+    let bgl = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some(file),
+        entries: layout,
+    });
+    let pl = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some(file),
+        bind_group_layouts: &[Some(&bgl)],
+        immediate_size: 0,
+    });
+    let kernels = entries.map(|entry| Kernel {
+        bgl: bgl.clone(),
+        pipeline: d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some(entry),
+            layout: Some(&pl),
+            module: &module,
+            entry_point: Some(entry),
+            compilation_options: Default::default(),
+            cache: None,
+        }),
+    });
+    if let Some(e) = pollster::block_on(scope.pop()) {
+        return Err(Error::Gpu(format!("building {file}: {e}")));
+    }
+    Ok(kernels)
 }
 
 /// The `u32` value of the WGSL `const` `name` in the parsed module `m` (for
@@ -89,61 +118,6 @@ pub(crate) fn shader_const(m: &naga::Module, name: &str) -> u32 {
         naga::Expression::Literal(naga::Literal::U32(v)) => v,
         ref e => panic!("const {name} is not a u32 literal: {e:?}"),
     }
-}
-
-/// Compiles `source` (named `file` in errors) and builds a pipeline for each
-/// of `entries`. With `layout` the bind group 0 layout is explicit; with
-/// `None` it is derived from the shader (from the first entry point).
-/// Validation errors come back as [`Error::Gpu`] naming `file`.
-pub fn build(
-    ctx: &GpuContext,
-    file: &str,
-    source: &str,
-    layout: Option<&[wgpu::BindGroupLayoutEntry]>,
-    entries: &[&str],
-) -> Result<Pipelines> {
-    let d = &ctx.device;
-    let scope = d.push_error_scope(wgpu::ErrorFilter::Validation);
-    let module = d.create_shader_module(wgpu::ShaderModuleDescriptor {
-        label: Some(file),
-        source: wgpu::ShaderSource::Wgsl(source.into()),
-    });
-    let explicit = layout.map(|l| {
-        let bgl = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some(file),
-            entries: l,
-        });
-        let pl = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some(file),
-            bind_group_layouts: &[Some(&bgl)],
-            immediate_size: 0,
-        });
-        (bgl, pl)
-    });
-    let pipelines: Vec<wgpu::ComputePipeline> = entries
-        .iter()
-        .map(|entry| {
-            d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(entry),
-                layout: explicit.as_ref().map(|(_, pl)| pl),
-                module: &module,
-                entry_point: Some(entry),
-                compilation_options: Default::default(),
-                cache: None,
-            })
-        })
-        .collect();
-    if let Some(e) = pollster::block_on(scope.pop()) {
-        return Err(Error::Gpu(format!("building {file}: {e}")));
-    }
-    let bgl = match explicit {
-        Some((bgl, _)) => bgl,
-        None => pipelines
-            .first()
-            .ok_or_else(|| Error::Gpu(format!("{file}: no entry point asked for")))?
-            .get_bind_group_layout(0),
-    };
-    Ok(Pipelines { bgl, pipelines })
 }
 
 /// The shared device and a kernel compiled once per process into `cell` by

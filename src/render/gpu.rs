@@ -39,14 +39,13 @@ pub const TEXTURE_SHADER: &str = concat!(
 /// Upper bound of pixel-samples in one dispatch.
 pub const SAMPLES_PER_DISPATCH: u64 = 1 << 25;
 
-/// The compiled kernels: render.wgsl's bind group layout and pipelines
-/// (`main`, `analytic`), texture.wgsl's (`texture`; the same layout entries).
-struct Kernel {
-    bgl: wgpu::BindGroupLayout,
-    lattice: wgpu::ComputePipeline,
-    analytic: wgpu::ComputePipeline,
-    tex_bgl: wgpu::BindGroupLayout,
-    texture: wgpu::ComputePipeline,
+/// The compiled kernels: render.wgsl's entry points (`main`, `analytic`)
+/// and texture.wgsl's (`texture`), all with the same bind group layout
+/// entries.
+struct Kernels {
+    lattice: compute::Kernel,
+    analytic: compute::Kernel,
+    texture: compute::Kernel,
 }
 
 /// The kernel's buffers, reused between frames (grown when too small).
@@ -68,64 +67,26 @@ static BUFFERS: std::sync::Mutex<Buffers> = std::sync::Mutex::new(Buffers {
     read: None,
 });
 
-static KERNEL: OnceLock<std::result::Result<Kernel, String>> = OnceLock::new();
+static KERNELS: OnceLock<std::result::Result<Kernels, String>> = OnceLock::new();
 
-fn kernel(ctx: &GpuContext) -> Result<&'static Kernel> {
-    KERNEL
-        .get_or_init(|| {
-            // One explicit layout shared by both entry points (`analytic`
-            // does not read the texture bindings).
-            let entry = |binding: u32, ty: wgpu::BufferBindingType| wgpu::BindGroupLayoutEntry {
-                binding,
-                visibility: wgpu::ShaderStages::COMPUTE,
-                ty: wgpu::BindingType::Buffer {
-                    ty,
-                    has_dynamic_offset: false,
-                    min_binding_size: None,
-                },
-                count: None,
-            };
-            let ro = wgpu::BufferBindingType::Storage { read_only: true };
-            let layout = [
-                entry(0, wgpu::BufferBindingType::Uniform),
-                entry(1, ro),
-                entry(2, ro),
-                entry(3, ro),
-                entry(4, wgpu::BufferBindingType::Storage { read_only: false }),
-            ];
-            let p = compute::build(
-                ctx,
-                "render.wgsl",
-                SHADER,
-                Some(&layout),
-                &["main", "analytic"],
-            )
-            .map_err(|e| e.to_string())?;
-            let mut it = p.pipelines.into_iter();
-            let (Some(lattice), Some(analytic)) = (it.next(), it.next()) else {
-                return Err("render.wgsl: missing pipeline".to_string());
-            };
-            let t = compute::build(
-                ctx,
-                "texture.wgsl",
-                TEXTURE_SHADER,
-                Some(&layout),
-                &["texture"],
-            )
-            .map_err(|e| e.to_string())?;
-            let Some(texture) = t.pipelines.into_iter().next() else {
-                return Err("texture.wgsl: missing pipeline".to_string());
-            };
-            Ok(Kernel {
-                bgl: p.bgl,
-                lattice,
-                analytic,
-                tex_bgl: t.bgl,
-                texture,
-            })
-        })
-        .as_ref()
-        .map_err(|e| Error::Gpu(e.trim_start_matches("GPU: ").to_string()))
+fn build(ctx: &GpuContext) -> Result<Kernels> {
+    // One explicit layout for every entry point (`analytic` does not read
+    // the texture bindings).
+    let layout = [
+        compute::uniform_entry(0),
+        compute::storage_entry(1, true),
+        compute::storage_entry(2, true),
+        compute::storage_entry(3, true),
+        compute::storage_entry(4, false),
+    ];
+    let [lattice, analytic] =
+        compute::build_each(ctx, "render.wgsl", SHADER, &layout, ["main", "analytic"])?;
+    let texture = compute::build_one(ctx, "texture.wgsl", TEXTURE_SHADER, &layout, "texture")?;
+    Ok(Kernels {
+        lattice,
+        analytic,
+        texture,
+    })
 }
 
 /// Renders on the GPU; returns linear RGB interleaved (mean over the N
@@ -137,12 +98,13 @@ pub fn render(
     tex: Option<&MipTexture>,
     analytic: bool,
 ) -> Result<Vec<f32>> {
-    let k = kernel(ctx)?;
-    let (pipe, bgl) = match (analytic, tex.is_some()) {
-        (true, true) => (&k.texture, &k.tex_bgl),
-        (true, false) => (&k.analytic, &k.bgl),
-        (false, _) => (&k.lattice, &k.bgl),
+    let (_, k) = compute::compiled(&KERNELS, build)?;
+    let kernel = match (analytic, tex.is_some()) {
+        (true, true) => &k.texture,
+        (true, false) => &k.analytic,
+        (false, _) => &k.lattice,
     };
+    let (pipe, bgl) = (&kernel.pipeline, &kernel.bgl);
     let dev = &ctx.device;
     let (w, h, n) = (p.dims[0], p.dims[1], p.dims[3]);
     let npix = w as u64 * h as u64;
