@@ -1,8 +1,11 @@
-//! The kernels' one lens: `lens.wgsl` (joined at build in front of the
-//! field and maps kernels, `crate::field::gpu::FIELD_WGSL`,
-//! `crate::series::maps::gpu::MAPS_WGSL`), its host struct [`LensGpu`]
-//! (every kernel's `Params` holds one) and the CPU twin of each of its
-//! functions, with the same names and f32 operations.
+//! The kernels' one lens: `lens.wgsl` (joined at build in front of every
+//! kernel that evaluates a lens: the field and maps kernels,
+//! `crate::field::gpu::FIELD_WGSL`, `crate::series::maps::gpu::MAPS_WGSL`,
+//! and the renderer's, `crate::render::RENDER_WGSL`,
+//! `crate::render::TEXTURE_WGSL`, after which comes the renderer's
+//! prelude), its host struct [`LensGpu`] (each of these kernels' `Params`
+//! holds one) and the CPU twin of each of its functions, with the same
+//! names and f32 operations.
 //!
 //! One strategy for every kernel: the two models with a formula in the
 //! module (OpenCV `k1, k2, p1, p2, k3` and the OpenCV fisheye) run
@@ -10,7 +13,10 @@
 //! host computes the lens with the library's f64 camera code and the kernel
 //! reads its table (the field kernel's per grid sample,
 //! `crate::field::table`; the maps kernel's over the undistorted plane,
-//! `crate::series::maps::table`).
+//! `crate::series::maps::table`; the renderer's per pixel,
+//! `crate::render::kernel::pixel_maps`). The field kernel also uses table
+//! mode for a camera whose radial distortion limit masks part of the
+//! sensor, the renderer for one with a pixel centre beyond it.
 
 use bytemuck::{Pod, Zeroable};
 

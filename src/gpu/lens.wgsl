@@ -1,8 +1,11 @@
 // Lens distortion (docs/spec.md section 9) in normalised coordinates q = (x, y),
-// the one lens module of the kernels: joined at build in front of
-// src/field/field.wgsl and src/series/maps.wgsl (src/gpu/lens.rs: the
-// joined sources, the host struct `LensGpu` and the CPU twin of every
-// function here, with the same names and operations).
+// the one lens module of the kernels: joined at build in front of every
+// kernel that evaluates a lens, src/field/field.wgsl,
+// src/series/maps/maps.wgsl and the renderer's src/render/render.wgsl and
+// texture.wgsl (with the renderer's prelude between), each holding a `Lens`
+// in its Params (src/gpu/lens.rs: the joined sources, the host struct
+// `LensGpu` and the CPU twin of every function here, with the same names
+// and operations).
 //
 // The distortion map, its Jacobian at q and its inverse by Newton's method
 // (a fixed UNDISTORT_STEPS steps from the distorted point), for the two
@@ -12,7 +15,9 @@
 // evaluates with the same operations. Every other model is table mode
 // (model 3): the host computes the lens's values with the library's f64
 // camera code and the kernel reads them (each kernel's table is its own:
-// src/field/table.rs, src/series/maps/table.rs).
+// src/field/table.rs, src/series/maps/table.rs, the renderer's per-pixel
+// maps in src/render/homography.rs). One strategy in every kernel: formula
+// for models 1-2, host table for model 3.
 
 // The lens of a kernel's Params. Must match `LensGpu` (32 bytes).
 struct Lens {
