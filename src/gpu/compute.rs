@@ -120,6 +120,24 @@ pub(crate) fn shader_const(m: &naga::Module, name: &str) -> u32 {
     }
 }
 
+/// The size in bytes of the WGSL struct `name` in `src` (naga's layout; for
+/// tests that tie a shader's structs to the host's).
+///
+/// # Panics
+/// When `src` does not parse or has no such struct.
+#[cfg(test)]
+pub(crate) fn struct_size(src: &str, name: &str) -> usize {
+    let m = naga::front::wgsl::parse_str(src).expect("the shader parses");
+    let mut layouter = naga::proc::Layouter::default();
+    layouter.update(m.to_ctx()).expect("layout");
+    let (h, _) = m
+        .types
+        .iter()
+        .find(|(_, t)| t.name.as_deref() == Some(name))
+        .unwrap_or_else(|| panic!("the shader has no struct {name}"));
+    layouter[h].size as usize
+}
+
 /// The shared device and a kernel compiled once per process into `cell` by
 /// `build`; a failed build is cached and returned to every caller.
 pub fn compiled<K>(

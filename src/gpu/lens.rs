@@ -208,15 +208,10 @@ mod tests {
 
     #[test]
     fn lens_struct_size_matches_wgsl() {
-        let m = naga::front::wgsl::parse_str(LENS_WGSL).expect("lens.wgsl parses alone");
-        let mut layouter = naga::proc::Layouter::default();
-        layouter.update(m.to_ctx()).expect("layout");
-        let (h, _) = m
-            .types
-            .iter()
-            .find(|(_, t)| t.name.as_deref() == Some("Lens"))
-            .expect("struct Lens");
-        assert_eq!(layouter[h].size as usize, std::mem::size_of::<LensGpu>());
+        assert_eq!(
+            crate::gpu::compute::struct_size(LENS_WGSL, "Lens"),
+            std::mem::size_of::<LensGpu>()
+        );
     }
 
     #[test]

@@ -291,22 +291,10 @@ mod tests {
         .expect("texture.wgsl validates");
     }
 
-    /// The size of WGSL struct `name` in `src` (naga's layout).
-    fn struct_size(src: &str, name: &str) -> usize {
-        let m = naga::front::wgsl::parse_str(src).expect("parses");
-        let mut layouter = naga::proc::Layouter::default();
-        layouter.update(m.to_ctx()).expect("layout");
-        let (h, _) = m
-            .types
-            .iter()
-            .find(|(_, t)| t.name.as_deref() == Some(name))
-            .unwrap_or_else(|| panic!("no struct {name}"));
-        layouter[h].size as usize
-    }
-
     #[test]
     fn params_match_the_host_struct() {
         use super::super::layout::{GpuHomography, RenderParams};
+        use crate::gpu::compute::struct_size;
         use std::mem::size_of;
         for src in [super::SHADER, super::TEXTURE_SHADER] {
             assert_eq!(struct_size(src, "Params"), size_of::<RenderParams>());

@@ -125,7 +125,7 @@ fn shared_modules_are_joined_not_copied() {
         assert_eq!(joined, format!("{module}{}", read(own)), "{own}");
     }
     let lens_items = [
-        "struct Lens",
+        "struct Lens {",
         "fn distort(",
         "fn jacobian(",
         "fn undistort(",
