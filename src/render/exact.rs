@@ -233,7 +233,7 @@ pub fn pixel_sum(
     let (mut px, mut py) = (i as f32 + 0.5, j as f32 + 0.5);
     let mut l = [[1.0, 0.0], [0.0, 1.0]];
     if p.distortion.model != crate::gpu::lens::MODEL_NONE {
-        let m = super::cpu::pixel_map(p, homs, i, j);
+        let m = super::pixel_map::pixel_map(p, homs, i, j);
         ([px, py], l) = (m.p, m.l);
     }
     let mut acc = Vec3::ZERO;

@@ -244,8 +244,8 @@ mod tests {
             let (mut dp, mut dl) = (0.0f32, 0.0f32);
             for (i, j) in (0..48).flat_map(|j| (0..64).map(move |i| (i, j))) {
                 let (a, b) = (
-                    super::super::cpu::pixel_map(&p, &[], i, j),
-                    super::super::cpu::pixel_map(&t, &h, i, j),
+                    super::super::pixel_map::pixel_map(&p, &[], i, j),
+                    super::super::pixel_map::pixel_map(&t, &h, i, j),
                 );
                 dp = dp.max((a.p[0] - b.p[0]).abs().max((a.p[1] - b.p[1]).abs()));
                 for r in 0..2 {

@@ -28,6 +28,7 @@ pub(crate) mod kernel;
 mod layout;
 pub mod maps;
 mod motion;
+mod pixel_map;
 pub mod poster;
 pub(crate) mod psf;
 mod sampling;
