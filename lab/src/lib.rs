@@ -28,6 +28,7 @@
 pub mod dataset;
 #[cfg(feature = "experiment")]
 pub mod experiment;
+pub mod pickers;
 #[cfg(feature = "plot")]
 pub mod plot;
 pub mod tables;
