@@ -111,6 +111,9 @@ pub struct Format {
     pub fps: f64,
     /// Frames per clip.
     pub frames: usize,
+    /// Whether the clips hold the stretches the gyro cannot see
+    /// ([`Stretches`]).
+    pub invisible: bool,
 }
 
 /// The stretches the gyro cannot see: frame ranges.
@@ -125,9 +128,16 @@ pub struct Stretches {
 }
 
 impl Stretches {
-    /// 30-40 % of the clip defocused, 60-72 % stabilised.
+    /// 30-40 % of the clip defocused, 60-72 % stabilised (none without
+    /// [`Format::invisible`]).
     pub fn of(f: &Format) -> Self {
-        let at = |x: f64| (x * f.frames as f64).round() as usize;
+        let at = |x: f64| {
+            if f.invisible {
+                (x * f.frames as f64).round() as usize
+            } else {
+                0
+            }
+        };
         Stretches {
             defocus: at(0.30)..at(0.40),
             defocus_px: DEFOCUS_PX_AT_320 * f.width as f64 / 320.0,

@@ -53,6 +53,7 @@ impl Config {
                 height: 120,
                 fps: 30.0,
                 frames: 60,
+                invisible: true,
             }
         } else {
             Format {
@@ -60,6 +61,7 @@ impl Config {
                 height: 240,
                 fps: 30.0,
                 frames: 180,
+                invisible: true,
             }
         };
         let specs = clips::specs(&repo);

@@ -381,9 +381,9 @@ pub fn losses(o: &Outcome) -> String {
                 better.join(", ")
             },
             st.defocus.start,
-            st.defocus.end - 1,
+            st.defocus.end.saturating_sub(1),
             st.ois.start,
-            st.ois.end - 1,
+            st.ois.end.saturating_sub(1),
         );
     }
     s
@@ -411,10 +411,10 @@ pub fn page(o: &Outcome, m: &Machine) -> String {
         1e3 * super::clips::READOUT_S,
         super::clips::LIGHT_E_PER_S,
         o.stretches.defocus.start,
-        o.stretches.defocus.end - 1,
+        o.stretches.defocus.end.saturating_sub(1),
         o.stretches.defocus_px,
         o.stretches.ois.start,
-        o.stretches.ois.end - 1,
+        o.stretches.ois.end.saturating_sub(1),
         100.0 * super::clips::OIS_RESIDUAL,
         super::clips::GYRO_NOISE,
         super::clips::GYRO_BIAS,
