@@ -34,13 +34,14 @@ fn scores_of_hand_made_lists() {
     assert!((s.mean_px - 6.5 / 3.0).abs() < 1e-12);
     assert!((s.over - 2.0 / 3.0).abs() < 1e-12);
     assert_eq!(s.picks, 3);
-    // tp 2 (frames 0, 2), fp 1 (frame 1), fn 1 (frame 3): 2/3 each.
+    // tp 2 (frames 0, 2), fp 1 (frame 1), fn 2 (frames 3, 4): precision
+    // 2/3, recall 1/2, F1 2 (2/3)(1/2) / (2/3 + 1/2) = 4/7.
     let said = [true, true, true, false, false];
-    let is = [true, false, true, true, false];
+    let is = [true, false, true, true, true];
     let r = prf(&said, &is);
-    for x in [r.precision, r.recall, r.f1] {
-        assert!((x - 2.0 / 3.0).abs() < 1e-12, "{r:?}");
-    }
+    assert!((r.precision - 2.0 / 3.0).abs() < 1e-12, "{r:?}");
+    assert!((r.recall - 0.5).abs() < 1e-12, "{r:?}");
+    assert!((r.f1 - 4.0 / 7.0).abs() < 1e-12, "{r:?}");
     // Sharpness that orders the frames as the truth does: the threshold
     // that calls exactly the sharp ones (truth <= 2) is the least sharpness
     // among them, 100 / 1.5.
