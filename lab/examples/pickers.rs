@@ -43,12 +43,13 @@ fn main() -> mmbm::Result<()> {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let quick = args.iter().any(|a| a == "--quick");
     let repo = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
-    let out = args
-        .iter()
-        .position(|a| a == "--out")
-        .and_then(|i| args.get(i + 1))
-        .map(PathBuf::from)
-        .unwrap_or_else(|| repo.join("target/pickers"));
+    let out = match args.iter().position(|a| a == "--out") {
+        Some(i) => PathBuf::from(
+            args.get(i + 1)
+                .ok_or_else(|| mmbm::error::Error::invalid("--out", "needs a folder: --out DIR"))?,
+        ),
+        None => repo.join("target/pickers"),
+    };
     if let Some(a) = args
         .iter()
         .enumerate()
