@@ -39,7 +39,14 @@ fn cpu() -> String {
     format!("{model}, {cores} cores")
 }
 
-fn main() -> mmbm::Result<()> {
+fn main() {
+    if let Err(e) = bench() {
+        eprintln!("pickers: {e}");
+        std::process::exit(1);
+    }
+}
+
+fn bench() -> mmbm::Result<()> {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let quick = args.iter().any(|a| a == "--quick");
     let repo = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
