@@ -33,7 +33,7 @@
 //! | 3 | lab | `tables` | thesis tables |
 //! | 4 | library | [`series`], [`render`], [`sync`] | MMBM of a log (CPU and GPU batch); the blur renderer; the gyro-to-video offset from the video (ffmpeg) |
 //! | 5 | library | [`trigger`], [`augment`], [`prelude`] | trigger policies; motion-blur augmentation of any image; the types a user needs first |
-//! | 6 | lab | `experiment`, `dataset` | the thesis experiment end to end; blur datasets at scale |
+//! | 6 | lab | `experiment`, `dataset`, `pickers` | the thesis experiment end to end; blur datasets at scale; the frame-picking benchmark |
 //!
 //! The `mmbm` command (the workspace's `cli/` crate) sits on top; the throughput benchmarks are
 //! `cargo bench` targets in `benches/`. [`prelude`] holds the types a user needs first.

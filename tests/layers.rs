@@ -51,6 +51,7 @@ const LAYERS: &[(&str, u32, &str)] = &[
     ("prelude", 5, "library"),
     ("experiment", 6, "lab"),
     ("dataset", 6, "lab"),
+    ("pickers", 6, "lab"),
 ];
 
 fn layer(m: &str) -> Option<u32> {

@@ -14,7 +14,7 @@
 //! |---|---|---|
 //! | 2 | [`plot`] | figures |
 //! | 3 | [`tables`] | thesis tables |
-//! | 6 | [`experiment`], [`dataset`] | the thesis experiment end to end; blur datasets at scale |
+//! | 6 | [`experiment`], [`dataset`], [`pickers`] | the thesis experiment end to end; blur datasets at scale; the frame-picking benchmark (issue 36) |
 //!
 //! # Features
 //!
@@ -28,6 +28,7 @@
 pub mod dataset;
 #[cfg(feature = "experiment")]
 pub mod experiment;
+pub mod pickers;
 #[cfg(feature = "plot")]
 pub mod plot;
 pub mod tables;
