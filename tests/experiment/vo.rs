@@ -53,6 +53,21 @@ fn a_still_log_ties_every_policy_and_a_moving_one_is_a_column_too() {
     let m = o.map.as_ref().expect("a map");
     assert_eq!(m.gaits, ["still", "moving"]);
     assert_eq!(m.cells.len(), 2);
+    for c in &m.cells {
+        for p in &c.policies {
+            eprintln!(
+                "{}: {} {} frames {} sharp, rep. {:.2}, {:.1} inliers, {:.2} VO/s, {:.2} trackable/s",
+                c.gait,
+                p.policy,
+                p.frames,
+                p.sharp,
+                p.corner_rep,
+                p.mean_inliers,
+                p.vo_fps,
+                p.trackable_fps
+            );
+        }
+    }
     let c = m.cells.iter().find(|c| c.gait == "still").unwrap();
     let names: Vec<&str> = c.policies.iter().map(|p| p.policy.as_str()).collect();
     assert_eq!(names, ["fixed:5", "deadline:5"]);
@@ -117,4 +132,13 @@ fn a_bad_log_is_refused_naming_the_file_before_any_output() {
         .unwrap()
         .to_string();
     assert!(e.contains("already a column"), "{e}");
+}
+
+#[test]
+fn the_example_map_for_my_robot_loads_with_its_log() {
+    let root = crate::common::repo_root();
+    let cfg = ExperimentConfig::load(&root.join("examples/map-my-robot.toml")).unwrap();
+    assert_eq!(cfg.map.logs.len(), 1);
+    assert!(root.join(&cfg.map.logs[0]).is_file());
+    assert_eq!(cfg.map.gaits, ["moderate"]);
 }

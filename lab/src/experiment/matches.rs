@@ -117,6 +117,12 @@ pub fn features(gray: &GrayImage, corners: &[(f64, f64)], offset: (f64, f64)) ->
     })
 }
 
+/// [`features`] of `gray`'s own FAST-9 corners ([`super::corners::corners`]),
+/// at offset zero.
+pub fn describe(gray: &GrayImage) -> Result<Features> {
+    features(gray, &super::corners::corners(gray), (0.0, 0.0))
+}
+
 fn hamming(a: &[u128], b: &[u128]) -> u32 {
     a.iter().zip(b).map(|(x, y)| (x ^ y).count_ones()).sum()
 }

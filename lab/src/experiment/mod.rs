@@ -22,7 +22,7 @@ pub(crate) mod figures;
 mod frame_figure;
 mod frames_csv;
 pub(crate) mod headline_view;
-pub(crate) mod matches;
+pub mod matches;
 pub(crate) mod measure;
 pub(crate) mod report;
 pub(crate) mod run;
