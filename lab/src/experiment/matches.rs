@@ -207,11 +207,11 @@ pub fn fit_homography(pairs: &[((f64, f64), (f64, f64))]) -> Option<Homography> 
             ([x, y, 1.0, 0.0, 0.0, 0.0, -u * x, -u * y], u),
             ([0.0, 0.0, 0.0, x, y, 1.0, -v * x, -v * y], v),
         ] {
-            for r in 0..8 {
-                for c in 0..8 {
-                    m[r][c] += row[r] * row[c];
+            for (mr, &a) in m.iter_mut().zip(&row) {
+                for (v, &b) in mr.iter_mut().zip(&row) {
+                    *v += a * b;
                 }
-                m[r][8] += row[r] * rhs;
+                mr[8] += a * rhs;
             }
         }
     }
@@ -246,18 +246,19 @@ fn solve8(mut m: [[f64; 9]; 8]) -> Option<[f64; 8]> {
             return None;
         }
         m.swap(col, piv);
-        for r in 0..8 {
+        let pivot = m[col];
+        for (r, mr) in m.iter_mut().enumerate() {
             if r != col {
-                let f = m[r][col] / m[col][col];
-                for c in col..9 {
-                    m[r][c] -= f * m[col][c];
+                let f = mr[col] / pivot[col];
+                for (v, p) in mr.iter_mut().zip(&pivot).skip(col) {
+                    *v -= f * p;
                 }
             }
         }
     }
     let mut x = [0.0; 8];
-    for (r, v) in x.iter_mut().enumerate() {
-        *v = m[r][8] / m[r][r];
+    for (r, (v, mr)) in x.iter_mut().zip(&m).enumerate() {
+        *v = mr[8] / mr[r];
     }
     Some(x)
 }

@@ -1,6 +1,6 @@
 //! The map's columns from gyro logs ("my robot, my light"; docs/spec.md
 //! section 11): `[map] logs = ["path.csv", ...]`, any format
-//! [`mmbm::telemetry::read_gyro`] reads (the CSV log of docs/spec.md
+//! [`crate::telemetry::read_gyro`] reads (the CSV log of docs/spec.md
 //! section 5, phone apps' exports, GoPro and Insta360 files, ...), each a
 //! column of the map beside the simulated gaits, named by its file stem.
 //!
@@ -45,7 +45,7 @@ pub fn map_logs(cfg: &ExperimentConfig) -> Vec<PathBuf> {
 /// Reads `path` and checks that it holds at least one frame interval of
 /// the map's rate (`fps`), naming the file and the reason when not.
 pub fn read_map_log(path: &Path, fps: f64) -> Result<ImuLog> {
-    let log = mmbm::telemetry::read_gyro(path, &Default::default()).map_err(|e| bad(path, e))?;
+    let log = crate::telemetry::read_gyro(path, &Default::default()).map_err(|e| bad(path, e))?;
     let span = match (log.first(), log.last()) {
         (Some(a), Some(b)) => b.t - a.t,
         _ => 0.0,

@@ -375,8 +375,9 @@ pub fn goals_md(m: &BenefitMap) -> String {
         })
         .count();
     s += &format!(
-        "- Dim cells (<= {DIM_LIGHT} e-/s), odometry task: {vo_ok} of {} reach 1.5x the VO frames per second of the \
-         strongest baseline (hindsight grid, auto-exposure, `gyro-exposure`) with the CI above 1 (goal: all, {}){}.\n",
+        "- Dim cells (<= {DIM_LIGHT} e-/s), odometry task: {vo_ok} of {} reach 1.5x the VO frames per second (VO rule: \
+         repeatability >= {REPEAT_OK} and >= {TRACK_MIN} inliers to the previous kept frame) of the strongest baseline \
+         (hindsight grid, auto-exposure, `gyro-exposure`) with the CI above 1 (goal: all, {}){}.\n",
         dim.len(),
         met(!dim.is_empty() && vo_ok == dim.len()),
         dim.iter()
