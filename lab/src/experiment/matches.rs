@@ -117,10 +117,15 @@ pub fn features(gray: &GrayImage, corners: &[(f64, f64)], offset: (f64, f64)) ->
     })
 }
 
+/// The FAST-9 corners the matches describe ([`super::corners::corners`]).
+pub fn corners(gray: &GrayImage) -> Vec<(f64, f64)> {
+    super::corners::corners(gray)
+}
+
 /// [`features`] of `gray`'s own FAST-9 corners ([`super::corners::corners`]),
 /// at offset zero.
 pub fn describe(gray: &GrayImage) -> Result<Features> {
-    features(gray, &super::corners::corners(gray), (0.0, 0.0))
+    features(gray, &corners(gray), (0.0, 0.0))
 }
 
 fn hamming(a: &[u128], b: &[u128]) -> u32 {
@@ -280,7 +285,6 @@ pub fn true_homography(
 
 #[cfg(test)]
 mod tests {
-    use super::super::corners::corners;
     use super::*;
 
     /// A textured test image: random 8 x 8 px blocks of 256 grey levels
