@@ -56,6 +56,9 @@ pub struct Features {
 /// A plane-to-plane homography, row-major, acting on `(x, y, 1)`.
 pub type Homography = [[f64; 3]; 3];
 
+/// A point in one image and where it is in another, px.
+pub type Correspondence = ((f64, f64), (f64, f64));
+
 /// The BRIEF test pairs every frame uses: [`BRIEF_BITS`] pairs of points in
 /// the 31 x 31 patch, each coordinate drawn from a normal distribution
 /// centred on the patch with sigma 6.6 px (Calonder et al.'s isotropic
@@ -187,7 +190,7 @@ pub fn inliers(prev: &Features, cur: &Features, h: &Homography) -> usize {
 /// (the direct linear transform with `h33 = 1`, on points normalised to a
 /// zero centroid and unit mean distance); None with fewer than 4 pairs or a
 /// degenerate set.
-pub fn fit_homography(pairs: &[((f64, f64), (f64, f64))]) -> Option<Homography> {
+pub fn fit_homography(pairs: &[Correspondence]) -> Option<Homography> {
     if pairs.len() < 4 {
         return None;
     }
@@ -275,7 +278,7 @@ pub fn true_homography(
     prev: &[Option<(f64, f64)>],
     cur: &[Option<(f64, f64)>],
 ) -> Option<Homography> {
-    let pairs: Vec<((f64, f64), (f64, f64))> = prev
+    let pairs: Vec<Correspondence> = prev
         .iter()
         .zip(cur)
         .filter_map(|(a, b)| Some(((*a)?, (*b)?)))
