@@ -10,6 +10,7 @@ use std::path::PathBuf;
 #[command(after_help = "Examples:
   mmbm experiment --config examples/experiment.toml --out report/
   mmbm experiment --print-config > my.toml     # the defaults, to edit
+  mmbm experiment --config examples/map-my-robot.toml --out report/   # the map with my gyro log ([map] logs)
 
 Writes DIR/frames.csv, DIR/report.md and PNG figures.")]
 pub struct ExperimentArgs {

@@ -40,4 +40,4 @@ use mmbm::{
 };
 // Those only the experiment uses.
 #[cfg(feature = "experiment")]
-use mmbm::{assess, board, gpu, series, stats, trigger};
+use mmbm::{assess, board, gpu, series, stats, telemetry, trigger};

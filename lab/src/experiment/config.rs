@@ -100,8 +100,14 @@ pub const DEMO_POLICIES: [&str; 7] = [
 pub struct MapSection {
     /// The light levels (rows), e-/s for a white pixel; empty: no map.
     pub lights_e_per_s: Vec<f64>,
-    /// Gaits (columns); empty: the experiment's `walks`.
+    /// Gaits (columns); empty: the experiment's `walks` (none when the
+    /// experiment has a `gyro` log).
     pub gaits: Vec<String>,
+    /// Gyro logs, each a column of the map beside the gaits, named by its
+    /// file stem (any format `mmbm::telemetry::read_gyro` reads; paths as
+    /// given, relative to the working directory); the experiment's `gyro`
+    /// log is one too. The seeds change only the noise of a log's frames.
+    pub logs: Vec<PathBuf>,
     /// Boards (columns, with the gaits): `blobs:0.5`, `blobs`.
     pub boards: Vec<String>,
     /// Seeds (at least 5 for the goals); empty: the experiment's seeds.
@@ -126,6 +132,7 @@ impl Default for MapSection {
         MapSection {
             lights_e_per_s: Vec::new(),
             gaits: Vec::new(),
+            logs: Vec::new(),
             boards: vec!["blobs:0.5".into(), "blobs".into()],
             seeds: Vec::new(),
             policies: builtin(&[
@@ -193,6 +200,7 @@ impl MapSection {
         use crate::limits::{check_len, MAX_LIST_ENTRIES as MAX};
         check_len("map.lights_e_per_s", self.lights_e_per_s.len(), MAX)?;
         check_len("map.gaits", self.gaits.len(), MAX)?;
+        check_len("map.logs", self.logs.len(), MAX)?;
         check_len("map.boards", self.boards.len(), MAX)?;
         check_len("map.policies", self.policies.len(), MAX)?;
         check_len("map.grid_ms", self.grid_ms.len(), MAX)
@@ -491,12 +499,6 @@ impl ExperimentConfig {
         }
         self.camera().validate().map_err(|e| key("camera", e))?;
         self.map.validate(self.exposure_s)?;
-        if !self.map.lights_e_per_s.is_empty() && self.gyro.is_some() {
-            return Err(Error::invalid(
-                "map",
-                "the benefit map simulates its gaits; it does not take a gyro log",
-            ));
-        }
         Ok(())
     }
 

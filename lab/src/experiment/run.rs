@@ -48,10 +48,17 @@ pub fn run(cfg: &ExperimentConfig, out: &Path, progress: bool) -> Result<Outcome
     cfg.validate()?;
     // The outputs' place is checked before minutes of rendering: writable,
     // and not over the gyro log it reads.
-    crate::io::guard::OutputGuard::new()
+    let mut guard = crate::io::guard::OutputGuard::new()
         .output_dir("--out", Some(out), writes)
-        .input("gyro (config)", cfg.gyro.as_deref())
-        .check()?;
+        .input("gyro (config)", cfg.gyro.as_deref());
+    for l in &cfg.map.logs {
+        guard = guard.input("map.logs", Some(l));
+    }
+    guard.check()?;
+    // The map's logs read now, a bad one refused before any render.
+    if !cfg.map.lights_e_per_s.is_empty() {
+        super::benefit_map::logs::check_logs(cfg, &super::benefit_map::map_gaits(cfg))?;
+    }
     let t_start = Instant::now();
     let quality = Quality::from_str(&cfg.quality)?;
     let scene = Scene {

@@ -54,6 +54,25 @@ pub fn make_walk(
             )
         }
     };
+    let mut w = walk_of(cfg, name, seed, samples, scene)?;
+    if cfg.gyro.is_some() {
+        w.seed = 0;
+    } else if suffix {
+        w.name = format!("{}-s{seed}", w.name);
+    }
+    Ok(w)
+}
+
+/// The walk of `samples` named `name` (the gait or the log): its MMBM
+/// series, the board's distance and every policy's frames; `seed` is
+/// recorded as the walk's seed.
+pub fn walk_of(
+    cfg: &ExperimentConfig,
+    name: String,
+    seed: u64,
+    samples: ImuLog,
+    scene: &Scene,
+) -> Result<Walk> {
     let mmbm = crate::series::mmbm_series(&samples, scene, Method::default())?;
     // Distance to the target: integrate the forward velocity (or the
     // configured speed), starting at start_distance, never closer than min_distance.
@@ -70,13 +89,8 @@ pub fn make_walk(
     let specs = cfg.policies.clone();
     let frames = Policies::new(specs.clone(), timing(cfg))?.run(&samples, &mmbm)?;
     let runs: Vec<(PolicySpec, Vec<Frame>)> = specs.into_iter().zip(frames).collect();
-    let seed = if cfg.gyro.is_some() { 0 } else { seed };
     Ok(Walk {
-        name: if suffix && cfg.gyro.is_none() {
-            format!("{name}-s{seed}")
-        } else {
-            name.clone()
-        },
+        name: name.clone(),
         gait: name,
         seed,
         samples,

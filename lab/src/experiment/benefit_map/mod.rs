@@ -16,12 +16,14 @@
 //! its blocks (point estimates) and then held fixed in the resamples.
 
 pub(crate) mod heat;
+pub(crate) mod logs;
 pub(crate) mod render;
 pub(crate) mod report;
 pub(crate) mod verdict;
 
 use super::benefit::{bootstrap_indices, Estimate, WalkBlocks};
 use super::config::ExperimentConfig;
+use super::matches::{inliers as match_inliers, true_homography, TRACK_MIN};
 use super::walk::{make_walk, Walk};
 use crate::camera::Noise;
 use crate::error::Result;
@@ -30,7 +32,7 @@ use crate::render::Quality;
 use crate::stats::percentile;
 use crate::trigger::{Frame, PolicyFamily, PolicySpec};
 use rayon::prelude::*;
-use render::{judge_at_lights, Judged, Light};
+use render::{judge_at_lights, FrameFeatures, Judged, Light};
 
 /// One policy in one cell.
 #[derive(Debug, Clone, PartialEq)]
@@ -58,9 +60,19 @@ pub struct CellPolicy {
     /// Mean corner repeatability of the kept frames with corners
     /// (`corners.rs`; NaN when none had any).
     pub corner_rep: f64,
-    /// Frames usable for odometry per second: repeatability at least
-    /// `corners::REPEAT_OK` (all seeds pooled).
+    /// Frames usable for odometry per second (all seeds pooled), by the
+    /// combined rule of docs/spec.md section 11: repeatability at least
+    /// `corners::REPEAT_OK` and, after the walk's first kept frame, at
+    /// least `matches::TRACK_MIN` inlier matches to the previous kept frame.
     pub vo_fps: f64,
+    /// Frames per second with repeatability at least `corners::REPEAT_OK`
+    /// (the repeatability half of the rule alone).
+    pub rep_fps: f64,
+    /// Trackable frames per second: at least `matches::TRACK_MIN` inlier
+    /// matches to the previous kept frame (`matches.rs`).
+    pub trackable_fps: f64,
+    /// Mean inlier matches to the previous kept frame (NaN without a pair).
+    pub mean_inliers: f64,
 }
 
 /// One cell of the map.
@@ -158,6 +170,19 @@ pub fn map_policies(cfg: &ExperimentConfig) -> Result<Vec<PolicySpec>> {
     Ok(out)
 }
 
+/// The map's simulated gaits: `map.gaits`, else the experiment's walks
+/// (none with the experiment's `gyro` log: it is a column of its own,
+/// [`logs::map_logs`]).
+pub fn map_gaits(cfg: &ExperimentConfig) -> Vec<String> {
+    if !cfg.map.gaits.is_empty() {
+        cfg.map.gaits.clone()
+    } else if cfg.gyro.is_some() {
+        Vec::new()
+    } else {
+        cfg.walks.clone()
+    }
+}
+
 /// True when policy `p` is in the hindsight grid.
 fn in_grid(cfg: &ExperimentConfig, p: &PolicySpec) -> bool {
     match p.policy_family() {
@@ -181,6 +206,14 @@ struct Tally {
     false_alarms: usize,
     rep_sum: f64,
     rep_n: usize,
+    /// Frames with repeatability at least `corners::REPEAT_OK`.
+    rep_ok: usize,
+    /// Inlier matches to the previous kept frame, summed over `pairs` frames.
+    inliers: usize,
+    pairs: usize,
+    /// Frames with at least `TRACK_MIN` inliers to the previous kept frame.
+    trackable: usize,
+    /// Frames usable for odometry by the combined rule.
     vo: usize,
 }
 
@@ -205,11 +238,9 @@ pub fn benefit_map(
     let t_start = std::time::Instant::now();
     let policies = map_policies(cfg)?;
     let np = policies.len();
-    let gaits = if m.gaits.is_empty() {
-        cfg.walks.clone()
-    } else {
-        m.gaits.clone()
-    };
+    let mut gaits = map_gaits(cfg);
+    let map_logs = logs::map_logs(cfg);
+    logs::check_logs(cfg, &gaits)?;
     let seeds = if m.seeds.is_empty() {
         cfg.seed_list()
     } else {
@@ -241,6 +272,13 @@ pub fn benefit_map(
         for &s in &seeds {
             walks.push((gi, make_walk(&mcfg, g, s, true, &scene)?));
         }
+    }
+    for p in &map_logs {
+        let w = logs::log_walk(&mcfg, p, &scene)?;
+        for _ in &seeds {
+            walks.push((gaits.len(), w.clone()));
+        }
+        gaits.push(w.gait);
     }
     let kept = |w: &Walk| -> usize {
         w.runs
@@ -278,7 +316,7 @@ pub fn benefit_map(
                     if let Some(f) = kept.first() {
                         bar.message(&format!("{g} {board} {}", f.policy));
                     }
-                    let judged: Vec<Vec<Judged>> = kept
+                    let judged: Vec<(Vec<Judged>, FrameFeatures)> = kept
                         .par_iter()
                         .enumerate()
                         .map(|(j, f)| {
@@ -296,9 +334,12 @@ pub fn benefit_map(
                         .collect::<Result<_>>()?;
                     renders += kept.len();
                     bar.advance(kept.len() as u64);
-                    for (f, judged) in kept.iter().zip(&judged) {
+                    for (n, (f, (js, feats))) in kept.iter().zip(&judged).enumerate() {
                         let b = wb.index(f.trigger_t);
-                        for (li, j) in judged.iter().enumerate() {
+                        // Inlier matches to the previous kept frame, per
+                        // light (None for the walk's first kept frame).
+                        let inl = (n > 0).then(|| tracked(&judged[n - 1].1, feats));
+                        for (li, j) in js.iter().enumerate() {
                             let k = li * np + pi;
                             blocks[first + b].sharp[k] += f64::from(u8::from(j.ok));
                             let t = &mut tally[k];
@@ -307,10 +348,18 @@ pub fn benefit_map(
                             t.exposure_s += f.exposure_s();
                             t.capped += usize::from(lights[li].capped(f.gain));
                             t.false_alarms += j.false_alarms;
+                            let inliers = inl.as_ref().map(|v| v[li]);
+                            if let Some(i) = inliers {
+                                t.inliers += i;
+                                t.pairs += 1;
+                                t.trackable += usize::from(i >= TRACK_MIN);
+                            }
                             if j.corner_rep.is_finite() {
                                 t.rep_sum += j.corner_rep;
                                 t.rep_n += 1;
-                                let vo = j.corner_rep >= super::corners::REPEAT_OK;
+                                let rep = j.corner_rep >= super::corners::REPEAT_OK;
+                                t.rep_ok += usize::from(rep);
+                                let vo = rep && inliers.is_none_or(|i| i >= TRACK_MIN);
                                 t.vo += usize::from(vo);
                                 blocks[first + b].vo[k] += f64::from(u8::from(vo));
                             }
@@ -352,6 +401,17 @@ pub fn benefit_map(
         renders,
         seconds: t_start.elapsed().as_secs_f64(),
     }))
+}
+
+/// Inlier matches of `cur` to `prev` at each light, against the true
+/// homography between the two frames (0 when the board does not give one).
+fn tracked(prev: &FrameFeatures, cur: &FrameFeatures) -> Vec<usize> {
+    let h = true_homography(&prev.board_px, &cur.board_px);
+    prev.per_light
+        .iter()
+        .zip(&cur.per_light)
+        .map(|(a, b)| h.as_ref().map_or(0, |h| match_inliers(a, b, h)))
+        .collect()
 }
 
 /// The best policy (highest point estimate; the first of ties) among those `pick` accepts.
@@ -426,6 +486,13 @@ fn cell(
                 f64::NAN
             },
             vo_fps: tally[pi].vo as f64 / seconds,
+            rep_fps: tally[pi].rep_ok as f64 / seconds,
+            trackable_fps: tally[pi].trackable as f64 / seconds,
+            mean_inliers: if tally[pi].pairs > 0 {
+                tally[pi].inliers as f64 / tally[pi].pairs as f64
+            } else {
+                f64::NAN
+            },
         })
         .collect();
     let fam = |f: PolicyFamily| move |p: &CellPolicy| p.policy.policy_family() == f;

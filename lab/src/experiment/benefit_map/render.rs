@@ -3,6 +3,7 @@
 //! that light and the gain a camera would set there (docs/spec.md section 10).
 
 use super::super::corners;
+use super::super::matches::{self, Features};
 use super::super::measure::{blob_metrics, bulk_job, frame_motion};
 use super::super::walk::Walk;
 use crate::camera::{Camera, Noise};
@@ -70,12 +71,23 @@ pub struct Judged {
     pub corner_rep: f64,
 }
 
+/// What the matches between consecutive kept frames need of one frame.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FrameFeatures {
+    /// The board's blob centres at mid-exposure, full-frame px (None off the image).
+    pub board_px: Vec<Option<(f64, f64)>>,
+    /// The described corners of the frame at each light (full-frame px).
+    pub per_light: Vec<Features>,
+}
+
 /// Renders `frame` of `walk` on `target` (`blobs` or `blobs:0.5`, with
 /// `surround` behind it) once with the noiseless camera `cam` and returns,
 /// for each of `lights`, the blob verdict, the false alarms and the corner
 /// repeatability against the sharp frame at mid-exposure (noiseless, the
 /// same window). `seed` seeds the render's sampling lattice and the noise
-/// (RNG stream `seed * 64 + light index`).
+/// (RNG stream `seed * 64 + light index`). With them, the frame's
+/// described corners at each light and the board's blob centres
+/// ([`FrameFeatures`]) for the matches to the next kept frame.
 #[allow(clippy::too_many_arguments)]
 pub fn judge_at_lights(
     target: &str,
@@ -86,7 +98,7 @@ pub fn judge_at_lights(
     quality: Quality,
     seed: u32,
     lights: &[Light],
-) -> Result<Vec<Judged>> {
+) -> Result<(Vec<Judged>, FrameFeatures)> {
     let cam = Camera { noise: None, ..cam };
     let exposure = frame.exposure_s();
     let (distance, traj) = frame_motion(walk, frame, &cam)?;
@@ -97,12 +109,13 @@ pub fn judge_at_lights(
     let out = render::render_frame(&job)?;
     // True blob centres at mid-exposure, as the experiment's measure.
     let mid = traj.pose_at(0.5 * cam.shutter.busy_s(exposure));
-    let expected: Vec<(f64, f64)> = target
+    let board_px: Vec<Option<(f64, f64)>> = target
         .blob_centres()
         .unwrap_or_default()
         .iter()
-        .filter_map(|&p| render::project(&cam, &mid, p))
+        .map(|&p| render::project(&cam, &mid, p))
         .collect();
+    let expected: Vec<(f64, f64)> = board_px.iter().flatten().copied().collect();
     // Noise, extraction and corners on a window around the board (the blob
     // grid padded by WINDOW_PITCHES pitches), not the whole frame: the noise
     // is most of the cost.
@@ -141,6 +154,7 @@ pub fn judge_at_lights(
         .map(|&(x, y)| (x - x0 as f64, y - y0 as f64))
         .collect();
     let mut ok = Vec::with_capacity(lights.len());
+    let mut per_light = Vec::with_capacity(lights.len());
     for (k, light) in lights.iter().enumerate() {
         let mut rgb = window.clone();
         light
@@ -148,7 +162,9 @@ pub fn judge_at_lights(
             .apply(&mut rgb, exposure, u64::from(seed) * 64 + k as u64)?;
         let img = to_rgb8(cw as u32, ch as u32, &rgb)?;
         let b = blob_metrics(&img, &shifted);
-        let found = corners::corners(&crate::assess::luma(&img));
+        let gray = crate::assess::luma(&img);
+        let found = corners::corners(&gray);
+        per_light.push(matches::features(&gray, &found, (x0 as f64, y0 as f64))?);
         ok.push(Judged {
             ok: b.ok,
             false_alarms: b.false_alarms,
@@ -156,7 +172,13 @@ pub fn judge_at_lights(
                 .unwrap_or(f64::NAN),
         });
     }
-    Ok(ok)
+    Ok((
+        ok,
+        FrameFeatures {
+            board_px,
+            per_light,
+        },
+    ))
 }
 
 #[cfg(test)]

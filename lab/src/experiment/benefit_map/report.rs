@@ -5,6 +5,7 @@
 
 use super::super::benefit::{Estimate, BLOCK_S, BOOTSTRAP_SEED, RESAMPLES};
 use super::super::corners::{FAST_THRESHOLD, MATCH_PX, NMS_RADIUS, REPEAT_OK};
+use super::super::matches::{BRIEF_BITS, INLIER_PX, MAX_FEATURES, RATIO, TRACK_MIN};
 pub use super::heat::heat_map_png;
 use super::verdict::column;
 use super::{BenefitMap, Cell};
@@ -166,18 +167,35 @@ pub fn map_md(m: &BenefitMap, figure: Option<&str>) -> String {
 /// The second task metric per cell, next to the blob metric: for the best
 /// `mmbm` policy, the best fixed exposure in hindsight and auto-exposure,
 /// sharp frames per second (blobs), frames usable for odometry per second
-/// (corner repeatability at least [`REPEAT_OK`]), the mean repeatability and
-/// the false alarms per frame; then, computed from the table, the policy
+/// (the VO rule: corner repeatability at least [`REPEAT_OK`] and, after the
+/// walk's first kept frame, at least [`TRACK_MIN`] inlier matches to the
+/// previous kept frame), the mean repeatability, the trackable frames per
+/// second, the mean inliers and the false alarms per frame; then, computed from the table, the policy
 /// with the most odometry frames per second in each cell.
 pub fn second_metric_md(m: &BenefitMap) -> String {
     let mut s = format!(
         "Second task metric (visual odometry): FAST-9 corners (threshold {}, non-maximum suppression over {} px) \
          of each frame against those of the sharp, noiseless frame at its mid-exposure pose, in the same window; \
          repeatability = share of the sharp frame's corners re-found within {} px by the frame's strongest corners \
-         (as many as the sharp frame has, so that noise corners do not match by chance); a frame is usable for odometry \
-         (VO) at repeatability >= {}. Per policy: sharp frames/s by the blob verdict, VO frames/s, mean \
-         repeatability, false alarms per frame (blobs found away from every board place).\n\n",
-        FAST_THRESHOLD, NMS_RADIUS, MATCH_PX, REPEAT_OK
+         (as many as the sharp frame has, so that noise corners do not match by chance). Feature matches between \
+         consecutive kept frames (what odometry consumes): the strongest {} FAST-9 corners of each frame described by \
+         {}-bit BRIEF (imageproc, fixed test pairs), each matched to its nearest descriptor in the previous kept frame \
+         of the same policy and walk, kept by the ratio test (nearest < {} x second nearest), and counted as inliers \
+         when the true homography between the two frames (the board's plane, fitted to its 16 blob centres at both \
+         mid-exposure poses) carries the match within {} px; a frame is trackable at >= {} inliers. \
+         **VO rule**: a frame is usable for odometry (VO) when its repeatability is >= {} and, after the walk's first \
+         kept frame, it is trackable; the VO winner and the VO ratios use this rule. Per policy: sharp frames/s by \
+         the blob verdict, VO frames/s, mean repeatability, trackable frames/s and mean inliers, false alarms per \
+         frame (blobs found away from every board place).\n\n",
+        FAST_THRESHOLD,
+        NMS_RADIUS,
+        MATCH_PX,
+        MAX_FEATURES,
+        BRIEF_BITS,
+        RATIO,
+        INLIER_PX,
+        TRACK_MIN,
+        REPEAT_OK
     );
     s += "| light | gait, board | best `mmbm` | best fixed in hindsight | auto-exposure | most VO frames/s | VO: best `mmbm` over the strongest baseline |\n";
     s += "|---|---|---|---|---|---|---|\n";
@@ -185,11 +203,13 @@ pub fn second_metric_md(m: &BenefitMap) -> String {
         i.map_or("-".into(), |i| {
             let p = &c.policies[i];
             format!(
-                "`{}` {:.2} sharp/s, {:.2} VO/s, rep. {:.2}, {:.2} false/frame",
+                "`{}` {:.2} sharp/s, {:.2} VO/s, rep. {:.2}, {:.2} trackable/s, {:.1} inliers, {:.2} false/frame",
                 p.policy,
                 p.sharp_fps,
                 p.vo_fps,
                 p.corner_rep,
+                p.trackable_fps,
+                p.mean_inliers,
                 p.false_alarms as f64 / p.frames.max(1) as f64
             )
         })
@@ -355,8 +375,9 @@ pub fn goals_md(m: &BenefitMap) -> String {
         })
         .count();
     s += &format!(
-        "- Dim cells (<= {DIM_LIGHT} e-/s), odometry task: {vo_ok} of {} reach 1.5x the VO frames per second of the \
-         strongest baseline (hindsight grid, auto-exposure, `gyro-exposure`) with the CI above 1 (goal: all, {}){}.\n",
+        "- Dim cells (<= {DIM_LIGHT} e-/s), odometry task: {vo_ok} of {} reach 1.5x the VO frames per second (VO rule: \
+         repeatability >= {REPEAT_OK} and >= {TRACK_MIN} inliers to the previous kept frame) of the strongest baseline \
+         (hindsight grid, auto-exposure, `gyro-exposure`) with the CI above 1 (goal: all, {}){}.\n",
         dim.len(),
         met(!dim.is_empty() && vo_ok == dim.len()),
         dim.iter()
@@ -479,6 +500,9 @@ mod tests {
             false_alarms: 0,
             corner_rep: 0.5,
             vo_fps: 1.0,
+            rep_fps: 1.0,
+            trackable_fps: 1.0,
+            mean_inliers: 40.0,
         };
         let mut c = Cell {
             light: 1000.0,

@@ -132,6 +132,9 @@ mod tests {
             false_alarms: 0,
             corner_rep: 0.5,
             vo_fps: 1.0,
+            rep_fps: 1.0,
+            trackable_fps: 1.0,
+            mean_inliers: 40.0,
         };
         let e = |(lo, hi): (f64, f64)| Estimate {
             value: (lo + hi) / 2.0,
