@@ -14,7 +14,7 @@
 //! |---|---|---|
 //! | 2 | [`plot`] | figures |
 //! | 3 | [`tables`] | thesis tables |
-//! | 6 | [`experiment`], [`dataset`], [`pickers`] | the thesis experiment end to end; blur datasets at scale; the frame-picking benchmark (issue 36) |
+//! | 6 | [`experiment`], [`dataset`], [`pickers`] | the thesis experiment end to end; blur datasets at scale; the frame-picking benchmark (docs/pickers.md) |
 //!
 //! # Features
 //!

@@ -1,4 +1,4 @@
-//! The proof of issue 36: gyro-based frame picking against the image-only
+//! The proof for docs/pickers.md: gyro-based frame picking against the image-only
 //! pickers photogrammetry and splatting users run today, on rendered clips
 //! with ground truth (`cargo run --release -p mmbm-lab --example pickers`;
 //! the results page is `docs/pickers.md`).

@@ -230,7 +230,7 @@ fn clear_budget(o: &Outcome, c: &ClipResult) -> super::score::Prf {
     super::score::prf(&said, &is)
 }
 
-/// The goals of issue 36, each with the numbers and met / not met.
+/// The benchmark's goals, each with the numbers and met / not met.
 pub fn goals(o: &Outcome) -> String {
     let mut s = String::new();
     let f1: Vec<String> = o
@@ -524,7 +524,7 @@ pub fn page(o: &Outcome, m: &Machine) -> String {
         o.lap_threshold,
         budget_table(o)
     );
-    let _ = writeln!(s, "## Goals of issue 36\n\n{}", goals(o));
+    let _ = writeln!(s, "## Goals\n\n{}", goals(o));
     let _ = write!(s, "## Where the gyro loses\n\n{}", losses(o));
     s
 }
