@@ -63,7 +63,7 @@ pub fn plan(
     fps: f64,
     budget: usize,
 ) -> Option<Vec<Window>> {
-    if budget == 0 || packets <= 2 * budget || keys.is_empty() || !(fps > 0.0) {
+    if budget == 0 || packets <= 2 * budget || keys.is_empty() || fps.is_nan() || fps <= 0.0 {
         return None;
     }
     // The keyframes with a whole window after them (the keyframe itself is
