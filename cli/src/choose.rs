@@ -71,7 +71,7 @@ pub struct ChoiceArgs {
     #[arg(long, value_name = "FILE")]
     pub image_list: Option<PathBuf>,
     /// Write the chosen frames as an ffmpeg select expression:
-    /// ffmpeg -i in.mp4 -vf "select=$(cat FILE)" -fps_mode passthrough out_%04d.png.
+    /// `ffmpeg -i in.mp4 -vf "select=$(cat FILE)" -fps_mode passthrough out_%04d.png`.
     #[arg(long, value_name = "FILE")]
     pub ffmpeg_select: Option<PathBuf>,
     /// The N blurriest frames, for a deblurrer (without N: the blurriest
@@ -85,7 +85,7 @@ pub struct ChoiceArgs {
     #[arg(long, value_name = "FILE")]
     pub worst_ffmpeg_select: Option<PathBuf>,
     /// Image name of a frame in the lists, printf style: frame number
-    /// (0-based row + --frame-start) in its %d (as ffmpeg -i in.mp4 frame_%06d.png names them).
+    /// (0-based row + --frame-start) in its %d (as `ffmpeg -i in.mp4 frame_%06d.png` names them).
     #[arg(long, value_name = "PATTERN", default_value = "frame_%06d.png")]
     pub frame_name: FrameName,
     /// Number of the video's first frame in the names (ffmpeg's image2

@@ -5,7 +5,7 @@ use super::series::GyroArgs;
 use clap::Args;
 use mmbm::error::{Error, Result};
 use mmbm::limits::SYNC_MAX_SEARCH_S;
-use mmbm::sync::{sync, SyncFile, SyncOptions};
+use mmbm::sync::{sync_decoding, SyncFile, SyncOptions};
 use std::path::PathBuf;
 
 /// The gyro-to-video clock offset (and rolling-shutter readout) from the video's own motion.
@@ -38,6 +38,11 @@ pub struct SyncArgs {
     /// Half width of the offset search around --time-offset, s (at most 60).
     #[arg(long, value_name = "S", default_value_t = 2.0)]
     pub search: f64,
+    /// Frames to decode of a long clip, about: a clip of more than twice as many frames
+    /// is decoded in windows of consecutive frames from keyframes spread over it (most of
+    /// sync's time is decoding); 0 decodes every frame.
+    #[arg(long, value_name = "N", default_value_t = mmbm::sync::plan::DEFAULT_DECODE_FRAMES)]
+    pub decode_frames: usize,
     /// Output TOML (written whole or not at all).
     #[arg(long, value_name = "FILE")]
     pub out: PathBuf,
@@ -97,7 +102,7 @@ pub fn run(a: SyncArgs) -> Result<()> {
         search_s: a.search,
     };
     let started = std::time::Instant::now();
-    let out = sync(&a.video, &log, &camera, &opts)?;
+    let out = sync_decoding(&a.video, &log, &camera, &opts, a.decode_frames)?;
     let secs = started.elapsed().as_secs_f64();
     let file = SyncFile::new(&out, &a.video, &a.gyro, exposure_s, a.search);
     let text = file.to_toml()?;
@@ -106,7 +111,7 @@ pub fn run(a: SyncArgs) -> Result<()> {
             .map_err(|e| Error::io(&a.out, e))
     })?;
     println!(
-        "sync: offset {:.5} s (--time-offset), readout {:.4} s ({}), confidence {:.2} (explained {:.3}, focal scale {:.2}); {} frames in {secs:.2} s ({:.0} frames/s)",
+        "sync: offset {:.5} s (--time-offset), readout {:.4} s ({}), confidence {:.2} (explained {:.3}, focal scale {:.2}); {} frames ({}) in {secs:.2} s ({:.0} frames/s)",
         file.offset_s,
         file.readout_s,
         if file.readout_distinguishable { "distinguishable" } else { "not distinguishable" },
@@ -114,6 +119,7 @@ pub fn run(a: SyncArgs) -> Result<()> {
         file.explained,
         file.focal_scale,
         file.frames,
+        if out.windows > 1 { format!("{} windows", out.windows) } else { "the whole clip".into() },
         file.frames as f64 / secs.max(1e-9),
     );
     if file.confidence < 0.5 {

@@ -7,5 +7,7 @@ mod common;
 
 #[path = "docs/docs.rs"]
 mod docs;
+#[path = "docs/ffmpeg_lines.rs"]
+mod ffmpeg_lines;
 #[path = "docs/limits_doc.rs"]
 mod limits_doc;

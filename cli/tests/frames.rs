@@ -8,6 +8,8 @@ mod common;
 mod frames_fixture;
 #[path = "frames/maps_fixture.rs"]
 mod maps_fixture;
+#[path = "logs/telemetry_fixture.rs"]
+mod telemetry_fixture;
 
 #[path = "frames/frame_maps.rs"]
 mod frame_maps;
@@ -23,3 +25,5 @@ mod frames_video;
 mod maps_gpu;
 #[path = "frames/maps_gpu_lens.rs"]
 mod maps_gpu_lens;
+#[path = "frames/worked_example.rs"]
+mod worked_example;

@@ -13,6 +13,7 @@
 //! --time-offset` takes (it is added to the gyro's times).
 
 pub use crate::video::decode;
+pub mod plan;
 pub mod report;
 pub mod search;
 pub mod track;
@@ -47,6 +48,8 @@ pub struct SyncOutcome {
     pub estimate: search::Estimate,
     /// Frames decoded.
     pub frames: usize,
+    /// Windows of consecutive frames decoded (1: the whole clip; [`plan`]).
+    pub windows: usize,
     /// Share of the patches tracked (textured and matched), 0..1.
     pub tracked_share: f64,
     /// RMS of the tracked patches' motion between frames, px at the analysis size.
@@ -96,9 +99,97 @@ fn no_overlap(video: &Path, v: (f64, f64), g: (f64, f64), o: &SyncOptions) -> Er
     )
 }
 
+/// Where the patches lie and what their motion means, at the analysis size.
+struct Geometry<'a> {
+    size: (u32, u32),
+    centres: &'a [(f64, f64)],
+    /// Each patch's flow per radian about x, y, z (analysis px / rad).
+    jac: &'a [[DVec3; 2]],
+    /// The readout line fractions, and each patch's.
+    lines: &'a [f64],
+    line_of: &'a [usize],
+}
+
+/// The motion measured in one run of decoded frames.
+struct Measured {
+    /// Presentation times of the frames, s.
+    times: Vec<f64>,
+    /// (index of the pair's first frame in `times`, its observations).
+    pairs: Vec<(usize, Vec<LineObs>)>,
+    tracked: usize,
+    tried: usize,
+    /// Sum of the tracked patches' squared motion, px^2.
+    m2: f64,
+}
+
+/// Decodes `window` of `video` (None: the whole clip) and tracks the patches
+/// from each frame to the next.
+fn measure(video: &Path, g: &Geometry, window: Option<decode::Window>) -> Result<Measured> {
+    let (w, h) = g.size;
+    let mut out = Measured {
+        times: Vec::new(),
+        pairs: Vec::new(),
+        tracked: 0,
+        tried: 0,
+        m2: 0.0,
+    };
+    let mut prev: Option<track::Pyramid> = None;
+    let each = |fi: usize, px: &[u8]| -> Result<()> {
+        crate::cancel::check()?;
+        let cur = track::Pyramid::new(track::Gray::from_u8(w as usize, h as usize, px));
+        if let Some(p) = &prev {
+            use rayon::prelude::*;
+            let found: Vec<Option<(f64, f64)>> = g
+                .centres
+                .par_iter()
+                .map(|&c| track::track_patch(p, &cur, c))
+                .collect();
+            let mut obs: Vec<LineObs> = g
+                .lines
+                .iter()
+                .map(|&line| LineObs {
+                    line,
+                    ..Default::default()
+                })
+                .collect();
+            for (i, f) in found.iter().enumerate() {
+                out.tried += 1;
+                if let Some(m) = *f {
+                    out.tracked += 1;
+                    out.m2 += m.0 * m.0 + m.1 * m.1;
+                    obs[g.line_of[i]].add(g.jac[i], m);
+                }
+            }
+            out.pairs.push((fi - 1, obs));
+        }
+        prev = Some(cur);
+        Ok(())
+    };
+    out.times = match window {
+        None => decode::decode(video, g.size, each)?,
+        Some(win) => decode::decode_window(video, g.size, win, each)?,
+    };
+    Ok(out)
+}
+
 /// Finds the offset between `log` (its own clock, no offset applied) and
-/// `video`, whose frames `camera` took (scaled to the video's size).
+/// `video`, whose frames `camera` took (scaled to the video's size),
+/// decoding about [`plan::DEFAULT_DECODE_FRAMES`] frames of a long clip
+/// ([`sync_decoding`]).
 pub fn sync(video: &Path, log: &ImuLog, camera: &Camera, o: &SyncOptions) -> Result<SyncOutcome> {
+    sync_decoding(video, log, camera, o, plan::DEFAULT_DECODE_FRAMES)
+}
+
+/// [`sync`] decoding about `budget` frames of a clip of more than twice
+/// that many, in windows from keyframes spread over it ([`plan::plan`]);
+/// 0: every frame.
+pub fn sync_decoding(
+    video: &Path,
+    log: &ImuLog,
+    camera: &Camera,
+    o: &SyncOptions,
+    budget: usize,
+) -> Result<SyncOutcome> {
     let info = decode::probe(video)?;
     let frame_dt = 1.0 / info.fps;
     let samples = log.samples();
@@ -156,42 +247,44 @@ pub fn sync(video: &Path, log: &ImuLog, camera: &Camera, o: &SyncOptions) -> Res
             }
         })
         .collect();
-    let mut prev: Option<track::Pyramid> = None;
-    let mut motions: Vec<Vec<LineObs>> = Vec::new();
+    let windows = if budget > 0 && info.duration_s * info.fps > 2.0 * budget as f64 {
+        let (packets, keys) = plan::keyframes(video)?;
+        plan::plan(packets, &keys, info.start_s, info.fps, budget)
+    } else {
+        None
+    };
+    let geometry = Geometry {
+        size: (w, h),
+        centres: &centres,
+        jac: &jac,
+        lines: &lines,
+        line_of: &line_of,
+    };
+    let n_windows = windows.as_ref().map_or(1, Vec::len);
+    // The windows decode and track at once (one ffmpeg each; two cores are
+    // kept busy by two windows), each its own pairs.
+    let per_window: Vec<Result<Measured>> = {
+        use rayon::prelude::*;
+        (0..n_windows)
+            .into_par_iter()
+            .map(|k| measure(video, &geometry, windows.as_ref().map(|ws| ws[k])))
+            .collect()
+    };
+    let mut motions: Vec<(usize, Vec<LineObs>)> = Vec::new();
+    let mut times: Vec<f64> = Vec::new();
     let (mut tracked, mut tried, mut m2) = (0usize, 0usize, 0.0f64);
-    let times = decode::decode(video, (w, h), |_, px| {
-        crate::cancel::check()?;
-        let cur = track::Pyramid::new(track::Gray::from_u8(w as usize, h as usize, px));
-        if let Some(p) = &prev {
-            use rayon::prelude::*;
-            let found: Vec<Option<(f64, f64)>> = centres
-                .par_iter()
-                .map(|&c| track::track_patch(p, &cur, c))
-                .collect();
-            let mut obs: Vec<LineObs> = lines
-                .iter()
-                .map(|&line| LineObs {
-                    line,
-                    ..Default::default()
-                })
-                .collect();
-            for (i, f) in found.iter().enumerate() {
-                tried += 1;
-                if let Some(m) = *f {
-                    tracked += 1;
-                    m2 += m.0 * m.0 + m.1 * m.1;
-                    obs[line_of[i]].add(jac[i], m);
-                }
-            }
-            motions.push(obs);
-        }
-        prev = Some(cur);
-        Ok(())
-    })?;
+    for m in per_window {
+        let m = m?;
+        let base = times.len();
+        motions.extend(m.pairs.into_iter().map(|(i, o)| (base + i, o)));
+        times.extend(m.times);
+        tracked += m.tracked;
+        tried += m.tried;
+        m2 += m.m2;
+    }
     let frames = times.len();
     let pairs: Vec<PairObs> = motions
         .into_iter()
-        .enumerate()
         .map(|(k, lines)| PairObs {
             t_prev: times[k],
             t_cur: times[k + 1],
@@ -234,6 +327,7 @@ pub fn sync(video: &Path, log: &ImuLog, camera: &Camera, o: &SyncOptions) -> Res
     Ok(SyncOutcome {
         estimate,
         frames,
+        windows: n_windows,
         tracked_share,
         motion_rms_px,
         analysis_size: (w, h),

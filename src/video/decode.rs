@@ -196,15 +196,43 @@ pub fn decode(
     size: (u32, u32),
     each: impl FnMut(usize, &[u8]) -> Result<()>,
 ) -> Result<Vec<f64>> {
-    let o = RawDecode {
+    decode_raw(video, &sync_frames(size, SYNC_MAX_FRAMES), each)
+}
+
+/// How `sync` decodes: grey, as stored, with times, at most `max_frames`.
+fn sync_frames(size: (u32, u32), max_frames: usize) -> RawDecode<'static> {
+    RawDecode {
         size,
         pixels: Pixels::Gray,
         as_stored: true,
         times: true,
-        max_frames: SYNC_MAX_FRAMES,
+        max_frames,
         who: "sync",
-    };
-    decode_raw(video, &o, each)
+    }
+}
+
+/// A stretch of consecutive frames to decode (instead of the whole clip).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Window {
+    /// Seek position, s from the start of the file (ffmpeg's input `-ss`):
+    /// decoding starts at the keyframe at or before it and the frames before
+    /// it are dropped, so a keyframe's own time costs no extra decoding.
+    pub start_s: f64,
+    /// Most frames decoded from there.
+    pub frames: usize,
+}
+
+/// Decodes the frames of `window` of `video` to `sync`'s grey frames of
+/// `size`, as [`decode`] does the whole clip: `each(k, pixels)` for the
+/// window's `k`-th frame; returns their presentation times, s (on the
+/// file's clock, as [`decode`] gives them).
+pub fn decode_window(
+    video: &Path,
+    size: (u32, u32),
+    window: Window,
+    each: impl FnMut(usize, &[u8]) -> Result<()>,
+) -> Result<Vec<f64>> {
+    decode_at(video, &sync_frames(size, window.frames), Some(window), each)
 }
 
 /// Decodes `video` as `o` says and calls `each(k, pixels)` for every frame
@@ -215,6 +243,17 @@ pub fn decode(
 pub fn decode_raw(
     video: &Path,
     o: &RawDecode<'_>,
+    each: impl FnMut(usize, &[u8]) -> Result<()>,
+) -> Result<Vec<f64>> {
+    decode_at(video, o, None, each)
+}
+
+/// [`decode_raw`], of the whole clip or of one window (at most
+/// `o.max_frames` of it, not an error there: ffmpeg stops at that count).
+fn decode_at(
+    video: &Path,
+    o: &RawDecode<'_>,
+    window: Option<Window>,
     mut each: impl FnMut(usize, &[u8]) -> Result<()>,
 ) -> Result<Vec<f64>> {
     let (w, h) = o.size;
@@ -227,9 +266,15 @@ pub fn decode_raw(
     if o.as_stored {
         cmd.arg("-noautorotate");
     }
+    if let Some(win) = window {
+        // The file's own timestamps (-copyts), so that the times are those of a whole decode.
+        cmd.args(["-ss", &format!("{:.6}", win.start_s.max(0.0)), "-copyts"]);
+    }
+    cmd.arg("-i").arg(video);
+    if let Some(win) = window {
+        cmd.args(["-frames:v", &win.frames.to_string()]);
+    }
     let mut child = cmd
-        .arg("-i")
-        .arg(video)
         .args(["-map", "0:v:0", "-an", "-sn", "-dn", "-vf"])
         .arg(vf)
         .args(["-fps_mode", "passthrough", "-f", "rawvideo", "-pix_fmt"])
@@ -279,7 +324,7 @@ pub fn decode_raw(
                 break;
             }
         }
-        if k >= o.max_frames {
+        if k >= o.max_frames && window.is_none() {
             let (n, who) = (o.max_frames, o.who);
             failed = Some(Error::invalid(
                 show_path(video),
@@ -311,6 +356,11 @@ pub fn decode_raw(
     if !o.times {
         return Ok(Vec::new());
     }
+    let mut times = times;
+    if window.is_some() {
+        // The filter may see a frame past -frames:v before ffmpeg stops.
+        times.truncate(k);
+    }
     if bad_times > 0 || times.len() != k {
         return Err(Error::invalid(
             show_path(video),
@@ -334,9 +384,9 @@ pub fn decode_raw(
     Ok(times)
 }
 
-/// The video's first video stream's width and height, px (ffprobe).
-pub fn probe_size(video: &Path) -> Result<(u32, u32)> {
-    crate::io::input::open_file(video)?;
+/// ffprobe's `entries` (its `-show_entries`, e.g. `stream=width,height`)
+/// of the first video stream of `video`, as CSV without section names.
+pub fn probe_csv(video: &Path, entries: &str) -> Result<String> {
     let out = run_tool(
         "ffprobe",
         &[
@@ -345,13 +395,19 @@ pub fn probe_size(video: &Path) -> Result<(u32, u32)> {
             "-select_streams".as_ref(),
             "v:0".as_ref(),
             "-show_entries".as_ref(),
-            "stream=width,height".as_ref(),
+            entries.as_ref(),
             "-of".as_ref(),
             "csv=p=0".as_ref(),
             video.as_os_str(),
         ],
     )?;
-    let text = String::from_utf8_lossy(&out);
+    Ok(String::from_utf8_lossy(&out).into_owned())
+}
+
+/// The video's first video stream's width and height, px (ffprobe).
+pub fn probe_size(video: &Path) -> Result<(u32, u32)> {
+    crate::io::input::open_file(video)?;
+    let text = probe_csv(video, "stream=width,height")?;
     let bad = || {
         Error::invalid(
             "--video",

@@ -586,3 +586,47 @@ fn frames_reads_the_sync_file() {
     );
     assert!(!d.join("e.csv").exists());
 }
+
+/// A clip with a keyframe every 15 frames, as cameras write them, synced
+/// from 3 windows of 24 consecutive frames spread over it (`--decode-frames
+/// 72` of its 150): the offset within 2 ms, as from every frame.
+#[test]
+fn windows_of_frames_give_the_offset_within_2ms() {
+    if !ffmpeg() {
+        return;
+    }
+    let (dir, _) = setup(Clip {
+        exposure: 0.012,
+        readout: 0.0,
+        amp: 1.0,
+        textured: true,
+    });
+    let d = dir.path();
+    let st = Command::new("ffmpeg")
+        .args([
+            "-v", "error", "-y", "-i", "clip.mp4", "-g", "15", "-q:v", "2",
+        ])
+        .args(["-crf", "16", "-pix_fmt", "yuv420p", "keys.mp4"])
+        .current_dir(d)
+        .stdin(Stdio::null())
+        .status()
+        .unwrap();
+    assert!(st.success(), "ffmpeg re-encoding");
+    std::fs::rename(d.join("keys.mp4"), d.join("clip.mp4")).unwrap();
+    let mut args = sync_args(0.012);
+    args.extend(["--decode-frames".to_string(), "72".to_string()]);
+    let a: Vec<&str> = args.iter().map(String::as_str).collect();
+    let o = mmbm_ok_in(d, &a);
+    let line = String::from_utf8_lossy(&o.stdout).into_owned();
+    let t = read_toml(&d.join("sync.toml"));
+    let err = num(&t, "offset_s") - OFFSET;
+    report(&format!(
+        "3 windows of 24 frames: offset error {:.3} ms, confidence {:.3}; {line}",
+        err * 1e3,
+        num(&t, "confidence")
+    ));
+    assert!(line.contains("3 windows"), "{line}");
+    assert_eq!(t["frames"].as_integer(), Some(72), "{t:?}");
+    assert!(err.abs() < 0.002, "offset error {err} s: {t:?}");
+    assert!(num(&t, "confidence") > 0.7, "{t:?}");
+}

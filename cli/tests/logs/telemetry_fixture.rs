@@ -79,9 +79,17 @@ pub fn truth(k: usize, i: usize) -> DVec3 {
 
 /// One GPMF payload of `n` GYRO samples (ORIN `ZXY`: channels Z, X, Y).
 pub fn payload(k: usize, n: usize, scal: i16) -> Vec<u8> {
+    let rates: Vec<DVec3> = (0..n).map(|i| truth(k, i)).collect();
+    payload_of(k, &rates, scal)
+}
+
+/// GPMF payload `k` holding the camera-frame rates `rates` (rad/s), written
+/// in GoPro's axes as GYRO samples scaled by `scal` (ORIN `ZXY`).
+pub fn payload_of(k: usize, rates: &[DVec3], scal: i16) -> Vec<u8> {
+    let n = rates.len();
     let mut data = Vec::new();
-    for i in 0..n {
-        let [x, y, z] = gopro_axes(truth(k, i));
+    for &w in rates {
+        let [x, y, z] = gopro_axes(w);
         for v in [z, x, y] {
             data.extend_from_slice(&((v * scal as f64).round() as i16).to_be_bytes());
         }
@@ -167,6 +175,22 @@ pub fn gopro_mp4() -> Vec<u8> {
     let meta = trak(b"meta", b"gpmd", 1000, &sizes, &offs, 1000);
     let moov = mp4_box(b"moov", &[video, meta].concat());
     [ftyp, mp4_box(b"mdat", &mdat), moov].concat()
+}
+
+/// An MP4 with one track: GPMF `payloads`, one a second (a camera file's
+/// telemetry alone, for ffmpeg to mux beside a video track).
+pub fn gpmf_mp4(payloads: &[Vec<u8>]) -> Vec<u8> {
+    let ftyp = mp4_box(b"ftyp", b"mp41\0\0\0\0mp41");
+    let mdat_start = ftyp.len() as u32 + 8;
+    let mut mdat = Vec::new();
+    let mut offs = Vec::new();
+    for p in payloads {
+        offs.push(mdat_start + mdat.len() as u32);
+        mdat.extend_from_slice(p);
+    }
+    let sizes: Vec<u32> = payloads.iter().map(|p| p.len() as u32).collect();
+    let meta = trak(b"meta", b"gpmd", 1000, &sizes, &offs, 1000);
+    [ftyp, mp4_box(b"mdat", &mdat), mp4_box(b"moov", &meta)].concat()
 }
 
 pub fn gopro_truth() -> Vec<(f64, DVec3)> {
