@@ -135,7 +135,9 @@ fn fixture() -> Option<&'static Fixture> {
         if !common::ffmpeg() {
             return None;
         }
-        let root = std::env::temp_dir().join(format!("mmbm-worked-{}", std::process::id()));
+        // Under cargo's per-target scratch folder, replaced on every run (nothing left in the
+        // system's temp folder).
+        let root = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("mmbm-worked-example");
         let _ = std::fs::remove_dir_all(&root);
         let (gopro, gyroflow) = (root.join("gopro"), root.join("gyroflow"));
         for d in [&root, &gopro, &gyroflow] {
