@@ -34,8 +34,8 @@ impl FixedExposure {
 }
 
 impl Policy for FixedExposure {
-    fn spec(&self) -> &str {
-        self.inner.spec()
+    fn label(&self) -> &str {
+        self.inner.label()
     }
     fn prepare(&mut self, log: &LogView, timing: &CameraTiming) -> Result<()> {
         self.inner.prepare(log, timing)
@@ -135,8 +135,8 @@ impl AutoExposure {
 }
 
 impl Policy for AutoExposure {
-    fn spec(&self) -> &str {
-        self.inner.spec()
+    fn label(&self) -> &str {
+        self.inner.label()
     }
     fn prepare(&mut self, log: &LogView, timing: &CameraTiming) -> Result<()> {
         self.log_p = 0.0;

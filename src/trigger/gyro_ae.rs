@@ -92,8 +92,8 @@ impl BlurCappedAe {
 }
 
 impl Policy for BlurCappedAe {
-    fn spec(&self) -> &str {
-        self.ae.spec()
+    fn label(&self) -> &str {
+        self.ae.label()
     }
     fn prepare(&mut self, log: &LogView, timing: &CameraTiming) -> Result<()> {
         self.ae.prepare(log, timing)
@@ -145,8 +145,8 @@ impl ImuTradeAe {
 }
 
 impl Policy for ImuTradeAe {
-    fn spec(&self) -> &str {
-        self.ae.spec()
+    fn label(&self) -> &str {
+        self.ae.label()
     }
     fn prepare(&mut self, log: &LogView, timing: &CameraTiming) -> Result<()> {
         self.ae.prepare(log, timing)
@@ -228,7 +228,7 @@ mod tests {
     fn run(spec: &str, m: f64) -> Vec<crate::trigger::Frame> {
         let t: Vec<f64> = (0..=6000).map(|k| k as f64 / 600.0).collect();
         let mm = vec![m; t.len()];
-        let mut p = PolicySpec::parse(spec).unwrap().build();
+        let mut p = PolicySpec::parse(spec).unwrap().build().unwrap();
         crate::trigger::run(&t, &mm, p.as_mut(), &CameraTiming::default()).unwrap()
     }
 

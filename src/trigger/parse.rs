@@ -9,7 +9,7 @@ use super::grad_ae::{parse_white, GradientAe};
 use super::gyro_ae::{parse_imu, split_keys, AeVariant, BlurCappedAe, ImuTradeAe};
 use super::numbers::{parse_num, parse_pos};
 use super::phase::Phase;
-use super::policy::{Level, Policy};
+use super::policy::{Level, Policy, Specified};
 use super::predict::{Forecast, Oracle};
 use super::rules::{Adaptive, Deadline, Fixed, Gate, Threshold};
 use super::task::{parse_task, Task, TaskModel};
@@ -80,7 +80,7 @@ each optionally followed by +exp:B[:TMIN] (exposure control: blur budget B px, s
 /// Parses a policy string (grammar in the module docs) and builds the policy.
 /// The policy keeps the string exactly as given for the `policy` column.
 pub fn parse_policy(spec: &str) -> Result<Box<dyn Policy>> {
-    Ok(PolicySpec::parse(spec)?.build())
+    PolicySpec::parse(spec)?.build()
 }
 
 /// The thesis's rule at its threshold (thesis ch. 6): three falling MMBM
@@ -313,7 +313,9 @@ impl PolicySpec {
 
     /// The family of docs/spec.md section 10 (the benefit map's grouping).
     pub fn policy_family(&self) -> PolicyFamily {
-        if !self.is_causal() {
+        if self.family == Family::Custom {
+            PolicyFamily::Custom
+        } else if !self.is_causal() {
             PolicyFamily::Oracle
         } else if self.ae_variant.is_some_and(|v| v.reads_gyro()) {
             PolicyFamily::GyroExposure
@@ -357,10 +359,13 @@ impl PolicySpec {
         }
     }
 
-    /// The policy, ready to run (its `spec()` is [`Self::as_str`]).
-    pub fn build(&self) -> Box<dyn Policy> {
-        let inner = self.build_base();
-        match self.exposure {
+    /// The policy, ready to run: its [`Policy::spec`] is this spec (which
+    /// every frame it triggers carries), its [`Policy::label`]
+    /// [`Self::as_str`]. Errors for a [`Self::custom`] spec, which names a
+    /// policy it cannot build.
+    pub fn build(&self) -> Result<Box<dyn Policy>> {
+        let inner = self.build_base()?;
+        let inner = match self.exposure {
             Some(e) => Box::new(Exposure::new(
                 &self.text,
                 inner,
@@ -368,15 +373,19 @@ impl PolicySpec {
                 e.min_exposure_s,
             )),
             None => inner,
-        }
+        };
+        Ok(Box::new(Specified {
+            spec: self.clone(),
+            inner,
+        }))
     }
 
-    fn build_base(&self) -> Box<dyn Policy> {
+    fn build_base(&self) -> Result<Box<dyn Policy>> {
         let spec = &self.text[..self.base_len];
         let level = self.threshold.unwrap_or(Level::Abs(0.0));
         let rate = self.rate.unwrap_or(DEFAULT_GATE_RATE);
         let h = self.horizon.unwrap_or(DEFAULT_HORIZON_S);
-        match self.family {
+        Ok(match self.family {
             Family::Fixed => match self.fixed_exposure_s {
                 Some(te) => Box::new(FixedExposure::new(spec, rate.fps, rate.phase, te)),
                 None => Box::new(Fixed::new(spec, rate.fps, rate.phase)),
@@ -417,7 +426,16 @@ impl PolicySpec {
                 rate.fps,
                 self.task.unwrap_or(TaskModel::at_light(1.0)),
             )),
-        }
+            Family::Custom => {
+                return Err(Error::invalid(
+                    "policy",
+                    format!(
+                        "'{}' is a custom policy's label, not a built-in policy; run the custom policy itself",
+                        self.text
+                    ),
+                ))
+            }
+        })
     }
 }
 
@@ -496,8 +514,9 @@ mod tests {
             "ae-grad:5:white=0.9",
         ] {
             let p = spec(s);
-            let b = p.build();
-            assert_eq!(b.spec(), s);
+            let b = p.build().unwrap();
+            assert_eq!(b.label(), s);
+            assert_eq!(b.spec(), p, "{s}");
             assert_eq!(b.is_causal(), p.is_causal(), "{s}");
             assert_eq!(p.to_string(), s);
         }

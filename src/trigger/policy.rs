@@ -1,5 +1,6 @@
 //! The policy trait, what a policy observes, and thresholds.
 
+use super::parse::PolicySpec;
 use super::timing::{CameraTiming, Frame};
 use crate::error::{Error, Result};
 use crate::stats::percentile;
@@ -81,8 +82,17 @@ impl Observation<'_> {
 /// true triggers a frame when the camera is free (the runner ignores it
 /// otherwise; the built-in policies only return true when it is free).
 pub trait Policy {
-    /// The policy string exactly as given to [`super::parse_policy`].
-    fn spec(&self) -> &str;
+    /// The policy's label, the `policy` column: for a built-in policy the
+    /// policy string exactly as given to [`super::parse_policy`].
+    fn label(&self) -> &str;
+    /// The typed spec the policy was built from, which every frame it
+    /// triggers carries ([`Frame::policy`]): [`PolicySpec::build`]'s
+    /// policies return the spec they were built from; any other policy (a
+    /// user's own, or a rule's constructor called directly) a
+    /// [`PolicySpec::custom`] of its [`Self::label`] (the default).
+    fn spec(&self) -> PolicySpec {
+        PolicySpec::custom(self.label())
+    }
     /// False for policies that use knowledge of the future (the oracle).
     fn is_causal(&self) -> bool {
         true
@@ -109,6 +119,42 @@ pub trait Policy {
     /// uses the MMBM at the decision sample).
     fn forecast_exposure_mmbm(&self, _obs: &Observation, _exposure_s: f64) -> Option<f64> {
         None
+    }
+}
+
+/// A policy with the spec it was built from ([`PolicySpec::build`]): its
+/// [`Policy::spec`] is that spec, everything else the built policy's.
+pub(super) struct Specified {
+    /// The spec `inner` was built from.
+    pub(super) spec: PolicySpec,
+    /// The policy.
+    pub(super) inner: Box<dyn Policy>,
+}
+
+impl Policy for Specified {
+    fn label(&self) -> &str {
+        self.spec.as_str()
+    }
+    fn spec(&self) -> PolicySpec {
+        self.spec.clone()
+    }
+    fn is_causal(&self) -> bool {
+        self.inner.is_causal()
+    }
+    fn prepare(&mut self, log: &LogView, timing: &CameraTiming) -> Result<()> {
+        self.inner.prepare(log, timing)
+    }
+    fn decide(&mut self, obs: &Observation) -> bool {
+        self.inner.decide(obs)
+    }
+    fn keep(&self, frame: &Frame) -> bool {
+        self.inner.keep(frame)
+    }
+    fn exposure(&self, obs: &Observation) -> (f64, f64) {
+        self.inner.exposure(obs)
+    }
+    fn forecast_exposure_mmbm(&self, obs: &Observation, exposure_s: f64) -> Option<f64> {
+        self.inner.forecast_exposure_mmbm(obs, exposure_s)
     }
 }
 

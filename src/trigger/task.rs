@@ -178,7 +178,7 @@ impl Task {
 }
 
 impl Policy for Task {
-    fn spec(&self) -> &str {
+    fn label(&self) -> &str {
         &self.spec
     }
     fn prepare(&mut self, _log: &LogView, _timing: &CameraTiming) -> Result<()> {
@@ -308,7 +308,7 @@ mod tests {
             (1000.0, 3.0, 0.0005)
         );
         assert_eq!(p.to_string(), "task:5:light=1000:read=3:tmin=0.5ms");
-        assert_eq!(p.build().spec(), p.as_str());
+        assert_eq!(p.build().unwrap().spec(), p);
         assert_eq!(PolicySpec::parse(p.as_str()).unwrap(), p);
         for (s, needle) in [
             ("task:5", "light must be stated"),
@@ -340,7 +340,7 @@ mod tests {
             })
             .collect();
         let spec = PolicySpec::parse("task:5:light=1000").unwrap();
-        let mut p = spec.build();
+        let mut p = spec.build().unwrap();
         let f = run(&t, &m, p.as_mut(), &CameraTiming::default()).unwrap();
         assert!(f.len() >= 45, "{}", f.len());
         let quiet = f.iter().filter(|x| x.mmbm_trigger_mm_s < 0.1).count();
