@@ -18,7 +18,7 @@ pub mod search;
 pub mod track;
 
 use crate::camera::Camera;
-use crate::camera::Readout;
+use crate::camera::{Readout, Shutter};
 use crate::error::{show_path, Error, Result};
 use crate::model::flow::flow_distorted;
 use crate::model::log::ImuLog;
@@ -57,6 +57,9 @@ pub struct SyncOutcome {
     pub video_span: (f64, f64),
     /// The gyro log's first and last time, s.
     pub gyro_span: (f64, f64),
+    /// The camera's shutter with the log's own rolling-shutter readout, when
+    /// it was applied ([`ImuLog::apply_readout`]: the camera had none).
+    pub log_shutter: Option<Shutter>,
 }
 
 /// Least RMS motion between frames for an offset to be told at all, px at
@@ -97,8 +100,12 @@ fn no_overlap(video: &Path, v: (f64, f64), g: (f64, f64), o: &SyncOptions) -> Er
 }
 
 /// Finds the offset between `log` (its own clock, no offset applied) and
-/// `video`, whose frames `camera` took (scaled to the video's size).
+/// `video`, whose frames `camera` took (scaled to the video's size; with
+/// the log's own rolling-shutter readout where it has none,
+/// [`SyncOutcome::log_shutter`]).
 pub fn sync(video: &Path, log: &ImuLog, camera: &Camera, o: &SyncOptions) -> Result<SyncOutcome> {
+    let (camera, from_log) = log.apply_readout(camera.clone())?;
+    let log_shutter = from_log.then_some(camera.shutter);
     let info = decode::probe(video)?;
     let frame_dt = 1.0 / info.fps;
     let samples = log.samples();
@@ -239,5 +246,6 @@ pub fn sync(video: &Path, log: &ImuLog, camera: &Camera, o: &SyncOptions) -> Res
         analysis_size: (w, h),
         video_span,
         gyro_span,
+        log_shutter,
     })
 }
