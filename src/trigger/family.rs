@@ -33,9 +33,8 @@ pub enum Family {
     AeImu,
     /// `ae-grad:FPS[...]`, gradient auto-exposure (motion-blind).
     AeGrad,
-    /// A user's own policy, known by its label only
-    /// ([`PolicySpec::custom`](super::PolicySpec::custom)); no policy
-    /// string parses to it.
+    /// A user's own policy, known by its label only (`PolicySpec::custom`);
+    /// no policy string parses to it.
     Custom,
 }
 

@@ -1,9 +1,9 @@
-//! The policy trait, what a policy observes, and thresholds.
+//! The policy trait and what a policy observes.
 
-use super::parse::PolicySpec;
+pub use super::level::Level;
+use super::spec::PolicySpec;
 use super::timing::{CameraTiming, Frame};
-use crate::error::{Error, Result};
-use crate::stats::percentile;
+use crate::error::Result;
 
 /// Tolerance (s) on interval comparisons, against rounding in sums of times.
 pub(crate) const TIME_EPS: f64 = 1e-9;
@@ -119,86 +119,6 @@ pub trait Policy {
     /// uses the MMBM at the decision sample).
     fn forecast_exposure_mmbm(&self, _obs: &Observation, _exposure_s: f64) -> Option<f64> {
         None
-    }
-}
-
-/// A policy with the spec it was built from ([`PolicySpec::build`]): its
-/// [`Policy::spec`] is that spec, everything else the built policy's.
-pub(super) struct Specified {
-    /// The spec `inner` was built from.
-    pub(super) spec: PolicySpec,
-    /// The policy.
-    pub(super) inner: Box<dyn Policy>,
-}
-
-impl Policy for Specified {
-    fn label(&self) -> &str {
-        self.spec.as_str()
-    }
-    fn spec(&self) -> PolicySpec {
-        self.spec.clone()
-    }
-    fn is_causal(&self) -> bool {
-        self.inner.is_causal()
-    }
-    fn prepare(&mut self, log: &LogView, timing: &CameraTiming) -> Result<()> {
-        self.inner.prepare(log, timing)
-    }
-    fn decide(&mut self, obs: &Observation) -> bool {
-        self.inner.decide(obs)
-    }
-    fn keep(&self, frame: &Frame) -> bool {
-        self.inner.keep(frame)
-    }
-    fn exposure(&self, obs: &Observation) -> (f64, f64) {
-        self.inner.exposure(obs)
-    }
-    fn forecast_exposure_mmbm(&self, obs: &Observation, exposure_s: f64) -> Option<f64> {
-        self.inner.forecast_exposure_mmbm(obs, exposure_s)
-    }
-}
-
-/// A threshold: an absolute MMBM (mm/s) or a percentile of the log's own series.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Level {
-    /// mm/s.
-    Abs(f64),
-    /// Percentile 0..100 of the whole log's MMBM.
-    Percentile(f64),
-}
-
-impl Level {
-    /// Parses `X` (mm/s, >= 0) or `pNN` (0 <= NN <= 100).
-    pub fn parse(s: &str, what: &str) -> Result<Self> {
-        let bad = || {
-            Error::invalid(
-                what,
-                format!(
-                    "'{s}': expected a threshold in mm/s (e.g. 0.4) or a percentile pNN (e.g. p20)"
-                ),
-            )
-        };
-        if let Some(p) = s.strip_prefix(['p', 'P']) {
-            let q: f64 = p.parse().map_err(|_| bad())?;
-            if !(0.0..=100.0).contains(&q) {
-                return Err(bad());
-            }
-            return Ok(Level::Percentile(q));
-        }
-        let x: f64 = s.parse().map_err(|_| bad())?;
-        if !(x.is_finite() && x >= 0.0) {
-            return Err(bad());
-        }
-        Ok(Level::Abs(x))
-    }
-
-    /// The threshold in mm/s for a log whose MMBM series is `mmbm`.
-    pub fn resolve(&self, mmbm: &[f64]) -> Result<f64> {
-        match *self {
-            Level::Abs(x) => Ok(x),
-            Level::Percentile(q) => percentile(mmbm, q)
-                .ok_or_else(|| Error::invalid("percentile threshold", "the MMBM series is empty")),
-        }
     }
 }
 

@@ -10,8 +10,8 @@
 //! ([`Session::stream`]).
 
 use super::live::Live;
-use super::parse::PolicySpec;
 use super::run::run_px;
+use super::spec::PolicySpec;
 use super::stream::{Stream, StreamControl, StreamOptions};
 use super::timing::{CameraTiming, Frame};
 use crate::camera::Camera;

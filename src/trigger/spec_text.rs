@@ -1,11 +1,12 @@
 //! A [`PolicySpec`] as text: built from the numbers of a fixed rate with
-//! the text the parser would be given ([`PolicySpec::fixed`]), a custom
-//! policy's label ([`PolicySpec::custom`]), read from
+//! the text the parser would be given ([`PolicySpec::fixed`]), read from
 //! text (`FromStr`, serde) and written as the text it was given
 //! (`Display`, serde), and compared with it.
 
+use super::family::Family;
 use super::numbers::check_pos;
-use super::parse::{check_fps, Family, PolicySpec, Rate};
+use super::parse::check_fps;
+use super::spec::{PolicySpec, Rate};
 use crate::error::{Error, Result};
 
 impl PolicySpec {
@@ -45,36 +46,6 @@ impl PolicySpec {
             ae_variant: None,
             task: None,
         })
-    }
-}
-
-impl PolicySpec {
-    /// The spec of a user's own policy, known by its label only (the
-    /// default [`Policy::spec`](super::Policy::spec)): family
-    /// [`Family::Custom`] (benefit-map family `custom`), no rate, threshold
-    /// or exposure; `Display` and [`Self::as_str`] give `label` unchanged.
-    /// [`Self::build`] refuses it, and no policy string parses to it.
-    ///
-    /// ```
-    /// use mmbm::trigger::{Family, PolicySpec};
-    /// let c = PolicySpec::custom("my-rule:3");
-    /// assert_eq!((c.family, c.to_string()), (Family::Custom, "my-rule:3".into()));
-    /// assert!(c.build().is_err());
-    /// ```
-    pub fn custom(label: &str) -> Self {
-        PolicySpec {
-            text: label.into(),
-            base_len: label.len(),
-            family: Family::Custom,
-            rate: None,
-            threshold: None,
-            horizon: None,
-            exposure: None,
-            fixed_exposure_s: None,
-            ae: None,
-            ae_variant: None,
-            task: None,
-        }
     }
 }
 

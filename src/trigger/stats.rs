@@ -1,6 +1,6 @@
 //! Summaries of a run, the thesis Table 5.1 analysis, and the frames CSV.
 
-use super::parse::PolicySpec;
+use super::spec::PolicySpec;
 use super::timing::Frame;
 use crate::error::{Error, Result};
 use crate::stats::percentile;

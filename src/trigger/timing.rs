@@ -1,7 +1,7 @@
 //! The camera's timing (thesis Fig. 5.1), a triggered [`Frame`], and the
 //! exposure average of the MMBM series ([`Integral`]).
 
-use super::parse::PolicySpec;
+use super::spec::PolicySpec;
 use crate::error::{Error, Result};
 pub use crate::model::log::Integral;
 
