@@ -104,7 +104,7 @@ fn no_overlap(video: &Path, v: (f64, f64), g: (f64, f64), o: &SyncOptions) -> Er
 /// the log's own rolling-shutter readout where it has none,
 /// [`SyncOutcome::log_shutter`]).
 pub fn sync(video: &Path, log: &ImuLog, camera: &Camera, o: &SyncOptions) -> Result<SyncOutcome> {
-    let (camera, from_log) = log.apply_readout(camera.clone())?;
+    let (camera, from_log) = log.apply_readout(*camera)?;
     let log_shutter = from_log.then_some(camera.shutter);
     let info = decode::probe(video)?;
     let frame_dt = 1.0 / info.fps;
