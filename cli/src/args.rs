@@ -129,36 +129,24 @@ impl CameraArgs {
     }
 }
 
-/// `camera` with the rolling-shutter readout of a Gyroflow `.gcsv` log
-/// (`frame_readout_time`, `frame_readout_direction`) when the camera gives
-/// none (a camera file's or `--rolling-readout`'s readout wins).
-pub fn with_log_readout(
-    camera: Camera,
-    readout: Option<mmbm::model::log::LogReadout>,
-    gyro: &std::path::Path,
-) -> Result<Camera> {
-    let (camera, applied) = mmbm::model::log::LogReadout::apply(readout, camera)?;
-    if applied {
-        print_log_readout(&camera, gyro);
-    }
-    Ok(camera)
-}
-
 /// Says on stderr that `session`'s camera took the rolling shutter of the
-/// log `gyro` (as [`with_log_readout`] does), when it did.
+/// log `gyro` (the library applies a Gyroflow `.gcsv` log's
+/// `frame_readout_time` and `frame_readout_direction` when the camera gives
+/// none: a camera file's or `--rolling-readout`'s readout wins), when it did.
 pub fn report_log_readout(session: &mmbm::trigger::Session, gyro: &Path) {
     if session.readout_from_log() {
-        print_log_readout(session.camera(), gyro);
+        print_log_readout(&session.camera().shutter, gyro);
     }
 }
 
-/// Says on stderr that `camera` took the rolling shutter of the log `gyro`.
-pub fn print_log_readout(camera: &Camera, gyro: &Path) {
+/// Says on stderr that the camera took the rolling shutter `shutter` of the
+/// log `gyro`.
+pub fn print_log_readout(shutter: &mmbm::camera::Shutter, gyro: &Path) {
     eprintln!(
         "rolling shutter from {}: readout {} s, {:?}",
         gyro.display(),
-        camera.shutter.readout_s,
-        camera.shutter.direction
+        shutter.readout_s,
+        shutter.direction
     );
 }
 

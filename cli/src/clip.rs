@@ -171,9 +171,13 @@ pub fn run(args: ClipArgs) -> Result<()> {
             .map_err(|e| Error::invalid("--maps", e.to_string()))?;
     }
     let target = target(&a.target, a.distance)?;
-    let mut camera = a.camera.camera()?;
+    let camera = a.camera.camera()?;
     let log = mmbm::telemetry::read_gyro(&a.gyro, &a.gyro_opts.telemetry()?)?;
-    camera = super::args::with_log_readout(camera, log.readout(), &a.gyro)?;
+    // The log's own rolling-shutter readout, where the camera has none.
+    let (camera, from_log) = log.apply_readout(camera)?;
+    if from_log {
+        super::args::print_log_readout(&camera.shutter, &a.gyro);
+    }
     let s = log.samples();
     let (first, last) = (s[0].t, s[s.len() - 1].t);
     let start_s = a.start.unwrap_or(first);

@@ -175,7 +175,7 @@ pub fn run(a: FramesArgs) -> Result<()> {
     };
     let job = FramesJob::new(cfg, samples.readout())?;
     if job.readout_from_log() {
-        super::args::print_log_readout(job.camera(), &a.gyro);
+        super::args::print_log_readout(&job.camera().shutter, &a.gyro);
     }
     let job = match (&synced, &a.sync) {
         (Some(s), Some(path)) => job.map_camera(|c| {

@@ -187,13 +187,9 @@ pub fn run(args: RenderArgs) -> Result<()> {
         .input("--camera", a.camera.camera.as_deref())
         .input("--target image:", texture_path(&a.target).as_deref())
         .check()?;
-    let mut camera = a.camera.camera()?;
+    let camera = a.camera.camera()?;
     let log = match &a.gyro {
-        Some(g) => {
-            let log = mmbm::telemetry::read_gyro(g, &a.gyro_opts.telemetry()?)?;
-            camera = super::args::with_log_readout(camera, log.readout(), g)?;
-            Some(log)
-        }
+        Some(g) => Some(mmbm::telemetry::read_gyro(g, &a.gyro_opts.telemetry()?)?),
         None => None,
     };
     let motion = match (&a.omega, &log) {
@@ -212,6 +208,11 @@ pub fn run(args: RenderArgs) -> Result<()> {
             ))
         }
     };
+    // A log's own rolling-shutter readout, where the camera has none.
+    let (camera, from_log) = motion.camera(camera)?;
+    if let (true, Some(g)) = (from_log, &a.gyro) {
+        super::args::print_log_readout(&camera.shutter, g);
+    }
     let mut target = Target::parse(&a.target, a.distance)?;
     if let Some(s) = &a.tilt {
         target.tilt_deg = pair(s, "--tilt")?;

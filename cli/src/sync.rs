@@ -95,7 +95,6 @@ pub fn run(a: SyncArgs) -> Result<()> {
     let centre_s = telemetry.gyro.time_offset;
     telemetry.gyro.time_offset = 0.0;
     let log = mmbm::telemetry::read_gyro(&a.gyro, &telemetry)?;
-    let camera = super::args::with_log_readout(camera, log.readout(), &a.gyro)?;
     let opts = SyncOptions {
         exposure_s,
         centre_s,
@@ -103,6 +102,9 @@ pub fn run(a: SyncArgs) -> Result<()> {
     };
     let started = std::time::Instant::now();
     let out = sync_decoding(&a.video, &log, &camera, &opts, a.decode_frames)?;
+    if let Some(shutter) = &out.log_shutter {
+        super::args::print_log_readout(shutter, &a.gyro);
+    }
     let secs = started.elapsed().as_secs_f64();
     let file = SyncFile::new(&out, &a.video, &a.gyro, exposure_s, a.search);
     let text = file.to_toml()?;

@@ -418,7 +418,7 @@ fn trigger<'py>(
         .iter()
         .map(|f| {
             let d = PyDict::new(py);
-            d.set_item("policy", &f.policy)?;
+            d.set_item("policy", f.policy.as_str())?;
             d.set_item("index", f.index)?;
             d.set_item("trigger_t", f.trigger_t)?;
             d.set_item("exposure_start", f.exposure_start)?;

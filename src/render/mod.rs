@@ -260,15 +260,17 @@ impl RenderJob {
     }
 
     /// A frame exposed `exposure_s` seconds per line while the camera moves as
-    /// `motion` says: the trajectory spans the camera's busy time (exposure
-    /// plus readout). The target is checked against the camera. Defaults as
-    /// [`Self::new`].
+    /// `motion` says: the camera takes a log's own rolling-shutter readout
+    /// where it has none ([`FrameMotion::camera`]), the trajectory spans the
+    /// camera's busy time (exposure plus readout). The target is checked
+    /// against the camera. Defaults as [`Self::new`].
     pub fn for_motion(
         camera: Camera,
         exposure_s: f64,
         motion: FrameMotion<'_>,
         target: Target,
     ) -> Result<Self> {
+        let (camera, _) = motion.camera(camera)?;
         let trajectory = motion.trajectory(&camera, exposure_s)?;
         target.validate_for(&camera)?;
         Ok(Self::new(camera, exposure_s, trajectory, target))

@@ -3,7 +3,8 @@
 //! camera's busy time (exposure plus rolling-shutter readout,
 //! [`crate::camera::Shutter::busy_s`]), so callers (the CLI, Python, the
 //! dataset code, [`super::RenderJob::for_motion`]) never derive the span
-//! themselves.
+//! themselves; and the camera a log's frame is taken with
+//! ([`FrameMotion::camera`]: the log's own rolling-shutter readout applied).
 
 use crate::camera::Camera;
 use crate::error::Result;
@@ -29,6 +30,18 @@ pub enum FrameMotion<'a> {
 }
 
 impl FrameMotion<'_> {
+    /// The camera a frame of this motion is taken with: for a log's motion,
+    /// `camera` with the log's own rolling-shutter readout where the camera
+    /// has none ([`ImuLog::apply_readout`], the one place a log's readout is
+    /// applied); `camera` unchanged for a twist. Returns the camera and
+    /// whether the log's readout was applied.
+    pub fn camera(&self, camera: Camera) -> Result<(Camera, bool)> {
+        match *self {
+            FrameMotion::Twist(_) => Ok((camera, false)),
+            FrameMotion::Log { log, .. } => log.apply_readout(camera),
+        }
+    }
+
     /// The trajectory over a frame of `camera` exposed `exposure_s` s per line:
     /// it spans `camera.shutter.busy_s(exposure_s)` (the first line's exposure
     /// start to the last line's exposure end).
@@ -95,5 +108,40 @@ mod tests {
         assert!((traj.duration() - 0.03).abs() < 1e-15);
         assert!(at(0.48).trajectory(&rolling(), 0.01).is_err());
         assert!(at(0.1).trajectory(&rolling(), 0.0).is_err());
+    }
+
+    /// A log's own readout reaches the job's camera through
+    /// [`RenderJob::for_motion`] (a global shutter takes it, the span grows
+    /// by it); a rolling camera keeps its own; a twist leaves the camera be.
+    #[test]
+    fn a_log_readout_reaches_the_job_once() {
+        use crate::model::log::LogReadout;
+        let s = |t| crate::model::log::GyroSample {
+            t,
+            omega: DVec3::new(0.0, 0.0, 1.0),
+            velocity: None,
+            depth: None,
+        };
+        let log = ImuLog::new((0..100).map(|k| s(k as f64 * 0.005)).collect())
+            .unwrap()
+            .with_readout(Some(LogReadout {
+                readout_s: 0.015,
+                direction: None,
+            }));
+        let motion = FrameMotion::Log {
+            log: &log,
+            at_s: 0.1,
+            use_velocity: false,
+        };
+        let target = Target::checker(0.05, 2.0);
+        let job = RenderJob::for_motion(Camera::thesis(), 0.01, motion, target.clone()).unwrap();
+        assert_eq!(job.camera.shutter.readout_s, 0.015);
+        assert!((job.trajectory.duration() - 0.025).abs() < 1e-15);
+        job.check_timing().unwrap();
+        let job = RenderJob::for_motion(rolling(), 0.01, motion, target).unwrap();
+        assert_eq!(job.camera.shutter.readout_s, 0.02);
+        let tw = FrameMotion::Twist(Twist::new(DVec3::X, DVec3::ZERO));
+        assert!(!tw.camera(Camera::thesis()).unwrap().1);
+        assert!(motion.camera(Camera::thesis()).unwrap().1);
     }
 }

@@ -19,7 +19,7 @@ pub mod search;
 pub mod track;
 
 use crate::camera::Camera;
-use crate::camera::Readout;
+use crate::camera::{Readout, Shutter};
 use crate::error::{show_path, Error, Result};
 use crate::model::flow::flow_distorted;
 use crate::model::log::ImuLog;
@@ -60,6 +60,9 @@ pub struct SyncOutcome {
     pub video_span: (f64, f64),
     /// The gyro log's first and last time, s.
     pub gyro_span: (f64, f64),
+    /// The camera's shutter with the log's own rolling-shutter readout, when
+    /// it was applied ([`ImuLog::apply_readout`]: the camera had none).
+    pub log_shutter: Option<Shutter>,
 }
 
 /// Least RMS motion between frames for an offset to be told at all, px at
@@ -173,9 +176,10 @@ fn measure(video: &Path, g: &Geometry, window: Option<decode::Window>) -> Result
 }
 
 /// Finds the offset between `log` (its own clock, no offset applied) and
-/// `video`, whose frames `camera` took (scaled to the video's size),
-/// decoding about [`plan::DEFAULT_DECODE_FRAMES`] frames of a long clip
-/// ([`sync_decoding`]).
+/// `video`, whose frames `camera` took (scaled to the video's size; with
+/// the log's own rolling-shutter readout where it has none,
+/// [`SyncOutcome::log_shutter`]), decoding about
+/// [`plan::DEFAULT_DECODE_FRAMES`] frames of a long clip ([`sync_decoding`]).
 pub fn sync(video: &Path, log: &ImuLog, camera: &Camera, o: &SyncOptions) -> Result<SyncOutcome> {
     sync_decoding(video, log, camera, o, plan::DEFAULT_DECODE_FRAMES)
 }
@@ -190,6 +194,8 @@ pub fn sync_decoding(
     o: &SyncOptions,
     budget: usize,
 ) -> Result<SyncOutcome> {
+    let (camera, from_log) = log.apply_readout(*camera)?;
+    let log_shutter = from_log.then_some(camera.shutter);
     let info = decode::probe(video)?;
     let frame_dt = 1.0 / info.fps;
     let samples = log.samples();
@@ -333,5 +339,6 @@ pub fn sync_decoding(
         analysis_size: (w, h),
         video_span,
         gyro_span,
+        log_shutter,
     })
 }

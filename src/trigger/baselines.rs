@@ -8,6 +8,7 @@
 //! maximum gain is the camera's business, not the policy's: the experiment
 //! caps `K_ref * gain` there (see `experiment::map`).
 
+pub use super::ae_params::AeParams;
 use super::numbers::parse_pos;
 use super::policy::{LogView, Observation, Policy};
 use super::rules::Fixed;
@@ -34,8 +35,8 @@ impl FixedExposure {
 }
 
 impl Policy for FixedExposure {
-    fn spec(&self) -> &str {
-        self.inner.spec()
+    fn label(&self) -> &str {
+        self.inner.label()
     }
     fn prepare(&mut self, log: &LogView, timing: &CameraTiming) -> Result<()> {
         self.inner.prepare(log, timing)
@@ -47,42 +48,6 @@ impl Policy for FixedExposure {
         let t_ref = obs.timing.exposure;
         let te = self.exposure_s.min(t_ref);
         (te, t_ref / te)
-    }
-}
-
-/// Auto-exposure parameters (`ae:FPS[:cap=Tms][:target=F][:damp=F][:scene=F]`).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct AeParams {
-    /// Longest exposure the auto-exposure may choose, s (default: the camera's).
-    pub cap_s: Option<f64>,
-    /// Target mean level, fraction of the output range (default 0.18, "18 % grey").
-    pub target: f64,
-    /// Damping: the share of the (logarithmic) error corrected per frame, in (0, 1] (default 0.5).
-    pub damping: f64,
-    /// The scene's mean linear radiance (0..1) that predicts a frame's mean
-    /// level (default 0.25, the renderer's background grey, which fills
-    /// about 99 % of the frame behind the board).
-    pub scene_mean: f64,
-}
-
-impl AeParams {
-    /// Default target mean level (18 % grey).
-    pub const TARGET: f64 = 0.18;
-    /// Default damping.
-    pub const DAMPING: f64 = 0.5;
-    /// Default scene mean radiance: the renderer's background grey
-    /// (`render::target::DEFAULT_BACKGROUND`; the experiment's tests check they agree).
-    pub const SCENE_MEAN: f64 = 0.25;
-}
-
-impl Default for AeParams {
-    fn default() -> Self {
-        AeParams {
-            cap_s: None,
-            target: Self::TARGET,
-            damping: Self::DAMPING,
-            scene_mean: Self::SCENE_MEAN,
-        }
     }
 }
 
@@ -135,8 +100,8 @@ impl AutoExposure {
 }
 
 impl Policy for AutoExposure {
-    fn spec(&self) -> &str {
-        self.inner.spec()
+    fn label(&self) -> &str {
+        self.inner.label()
     }
     fn prepare(&mut self, log: &LogView, timing: &CameraTiming) -> Result<()> {
         self.log_p = 0.0;

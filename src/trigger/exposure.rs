@@ -92,7 +92,7 @@ impl Exposure {
 }
 
 impl Policy for Exposure {
-    fn spec(&self) -> &str {
+    fn label(&self) -> &str {
         &self.spec
     }
     fn is_causal(&self) -> bool {
@@ -131,8 +131,8 @@ mod tests {
     /// 1 mm/s over longer ones (a transient due 20 ms after the start).
     struct Foreseeing(Fixed);
     impl Policy for Foreseeing {
-        fn spec(&self) -> &str {
-            self.0.spec()
+        fn label(&self) -> &str {
+            self.0.label()
         }
         fn prepare(&mut self, log: &LogView, timing: &CameraTiming) -> Result<()> {
             self.0.prepare(log, timing)

@@ -33,6 +33,9 @@ pub enum Family {
     AeImu,
     /// `ae-grad:FPS[...]`, gradient auto-exposure (motion-blind).
     AeGrad,
+    /// A user's own policy, known by its label only (`PolicySpec::custom`);
+    /// no policy string parses to it.
+    Custom,
 }
 
 impl Family {
@@ -53,6 +56,7 @@ impl Family {
             Family::AeBlur => "ae-blur",
             Family::AeImu => "ae-imu",
             Family::AeGrad => "ae-grad",
+            Family::Custom => "custom",
         }
     }
 
@@ -96,11 +100,13 @@ pub enum PolicyFamily {
     Mmbm,
     /// Every non-causal one (the oracle; the best fixed exposure in hindsight).
     Oracle,
+    /// A user's own policy ([`Family::Custom`]): its rule is unknown.
+    Custom,
 }
 
 impl PolicyFamily {
     /// The family's name: `fixed`, `fixed-exposure`, `auto-exposure`,
-    /// `gyro-exposure`, `mmbm`, `oracle`.
+    /// `gyro-exposure`, `mmbm`, `oracle`, `custom`.
     pub fn name(self) -> &'static str {
         match self {
             PolicyFamily::Fixed => "fixed",
@@ -109,6 +115,7 @@ impl PolicyFamily {
             PolicyFamily::GyroExposure => "gyro-exposure",
             PolicyFamily::Mmbm => "mmbm",
             PolicyFamily::Oracle => "oracle",
+            PolicyFamily::Custom => "custom",
         }
     }
 }

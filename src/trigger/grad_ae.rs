@@ -67,8 +67,8 @@ impl GradientAe {
 }
 
 impl Policy for GradientAe {
-    fn spec(&self) -> &str {
-        self.inner.spec()
+    fn label(&self) -> &str {
+        self.inner.label()
     }
     fn prepare(&mut self, log: &LogView, timing: &CameraTiming) -> Result<()> {
         self.log_p = 0.0;
@@ -119,7 +119,7 @@ mod tests {
     fn run(spec: &str) -> Vec<crate::trigger::Frame> {
         let t: Vec<f64> = (0..=6000).map(|k| k as f64 / 600.0).collect();
         let m = vec![0.5; t.len()];
-        let mut p = PolicySpec::parse(spec).unwrap().build();
+        let mut p = PolicySpec::parse(spec).unwrap().build().unwrap();
         crate::trigger::run(&t, &m, p.as_mut(), &CameraTiming::default()).unwrap()
     }
 

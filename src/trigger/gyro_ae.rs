@@ -16,48 +16,12 @@
 //! `+exp`. Gains are relative to the camera's nominal gain; the camera caps
 //! them at its maximum (then the frame is darker).
 
+pub use super::ae_params::AeVariant;
 use super::baselines::{AeParams, AutoExposure};
 use super::numbers::parse_pos;
 use super::policy::{LogView, Observation, Policy};
 use super::timing::CameraTiming;
 use crate::error::{Error, Result};
-
-/// How an `ae-*` policy differs from the plain `ae:` auto-exposure.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum AeVariant {
-    /// `ae-blur`: the exposure capped at a blur budget, px.
-    BlurCap {
-        /// The predicted blur an exposure may reach, px.
-        budget_px: f64,
-    },
-    /// `ae-imu`: `K = sqrt((v c + w0) / w)`.
-    ImuTrade {
-        /// `w`: what one unit of relative gain costs, in px of blur.
-        weight_px: f64,
-        /// `w0`: a constant added to `v c`, px.
-        offset_px: f64,
-    },
-    /// `ae-grad`: the product among candidates that maximises the predicted
-    /// summed gradient (see [`super::GradientAe`]).
-    Gradient {
-        /// The scene's brightest linear radiance (0..1], the board's white.
-        white: f64,
-    },
-}
-
-impl AeVariant {
-    /// Default `w` of `ae-imu`, px per unit of relative gain.
-    pub const IMU_WEIGHT_PX: f64 = 0.1;
-    /// Default `w0` of `ae-imu`, px.
-    pub const IMU_OFFSET_PX: f64 = 0.0;
-    /// Default `white` of `ae-grad`: the renderer's board white (1.0).
-    pub const WHITE: f64 = 1.0;
-
-    /// True for the variants that read the gyro (`ae-blur`, `ae-imu`).
-    pub fn reads_gyro(&self) -> bool {
-        !matches!(self, AeVariant::Gradient { .. })
-    }
-}
 
 /// The image speed the gyro predicts at the decision sample, px/s (0 when
 /// the sample is still or the pitch is not positive).
@@ -92,8 +56,8 @@ impl BlurCappedAe {
 }
 
 impl Policy for BlurCappedAe {
-    fn spec(&self) -> &str {
-        self.ae.spec()
+    fn label(&self) -> &str {
+        self.ae.label()
     }
     fn prepare(&mut self, log: &LogView, timing: &CameraTiming) -> Result<()> {
         self.ae.prepare(log, timing)
@@ -145,8 +109,8 @@ impl ImuTradeAe {
 }
 
 impl Policy for ImuTradeAe {
-    fn spec(&self) -> &str {
-        self.ae.spec()
+    fn label(&self) -> &str {
+        self.ae.label()
     }
     fn prepare(&mut self, log: &LogView, timing: &CameraTiming) -> Result<()> {
         self.ae.prepare(log, timing)
@@ -228,7 +192,7 @@ mod tests {
     fn run(spec: &str, m: f64) -> Vec<crate::trigger::Frame> {
         let t: Vec<f64> = (0..=6000).map(|k| k as f64 / 600.0).collect();
         let mm = vec![m; t.len()];
-        let mut p = PolicySpec::parse(spec).unwrap().build();
+        let mut p = PolicySpec::parse(spec).unwrap().build().unwrap();
         crate::trigger::run(&t, &mm, p.as_mut(), &CameraTiming::default()).unwrap()
     }
 

@@ -55,7 +55,7 @@ impl Live {
                 "policy",
                 format!(
                     "'{}' needs the future (the oracle); live triggering takes causal policies only",
-                    policy.spec()
+                    policy.label()
                 ),
             ));
         }
@@ -66,7 +66,7 @@ impl Live {
                     "policy",
                     format!(
                         "'{}': a percentile threshold (pNN) needs the whole log; give the threshold in mm/s for live use",
-                        policy.spec()
+                        policy.label()
                     ),
                 )
             })?;
@@ -85,8 +85,13 @@ impl Live {
         })
     }
 
-    /// The policy string.
-    pub fn spec(&self) -> &str {
+    /// The policy's label (the `policy` column: a built-in policy's string).
+    pub fn label(&self) -> &str {
+        self.policy.label()
+    }
+
+    /// The policy's spec ([`Policy::spec`]), which its frames carry.
+    pub fn spec(&self) -> super::PolicySpec {
         self.policy.spec()
     }
 
@@ -186,7 +191,7 @@ impl Live {
             let (te, gain) = self.policy.exposure(&obs);
             let end = start + te;
             let f = Frame {
-                policy: self.policy.spec().to_string(),
+                policy: self.policy.spec(),
                 index: i,
                 trigger_t: t,
                 exposure_start: start,

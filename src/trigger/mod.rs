@@ -64,12 +64,14 @@
 //! with the camera's pitch and rolling readout, the method and the
 //! [`Policies`]; it evaluates a log's series and runs every policy over it.
 
+mod ae_params;
 mod baselines;
 mod exposure;
 mod family;
 mod grad_ae;
 mod gyro_ae;
 mod latency;
+mod level;
 mod live;
 mod numbers;
 mod pace;
@@ -80,33 +82,38 @@ mod predict;
 mod rules;
 mod run;
 mod session;
+mod spec;
 mod spec_text;
+mod specified;
 mod stats;
 mod stream;
 mod task;
+mod task_model;
 mod timing;
 
-pub use baselines::{AeParams, AutoExposure, FixedExposure};
+pub use ae_params::{AeParams, AeVariant};
+pub use baselines::{AutoExposure, FixedExposure};
 pub use exposure::Exposure;
+pub use family::{Family, PolicyFamily};
 pub use grad_ae::GradientAe;
-pub use gyro_ae::{AeVariant, BlurCappedAe, ImuTradeAe};
+pub use gyro_ae::{BlurCappedAe, ImuTradeAe};
 pub use latency::Latency;
+pub use level::Level;
 pub use live::{Event, Live};
 pub use pace::check_speed;
-pub use parse::{
-    parse_policy, ExposureControl, Family, PolicyFamily, PolicySpec, Rate, DEFAULT_HORIZON_S,
-    MAX_FPS, THESIS_POLICY,
-};
+pub use parse::{parse_policy, DEFAULT_HORIZON_S, MAX_FPS, THESIS_POLICY};
 pub use phase::Phase;
-pub use policy::{Level, LogView, Observation, Policy};
+pub use policy::{LogView, Observation, Policy};
 pub use predict::{Forecast, Oracle};
 pub use rules::{Adaptive, Deadline, Fixed, Gate, Threshold};
 pub use run::{run, run_px};
 pub use session::{Policies, Session, SessionConfig, SessionRun};
+pub use spec::{ExposureControl, PolicySpec, Rate};
 pub use stats::{
     prediction_error, summary, summary_over, write_frames, ErrorStats, Summary, Table51,
     FRAME_HEADER,
 };
 pub use stream::{Stream, StreamControl, StreamEnd, StreamOptions, StreamOutcome, POLL};
-pub use task::{Prediction, Task, TaskModel};
+pub use task::{Prediction, Task};
+pub use task_model::TaskModel;
 pub use timing::{exposure_means, CameraTiming, Frame, Integral};

@@ -3,7 +3,7 @@
 //! its family, rate, threshold, causality and exposure control, and builds
 //! the boxed [`Policy`] that runs.
 
-use super::baselines::{parse_ae, split_exposure, AeParams, AutoExposure, FixedExposure};
+use super::baselines::{parse_ae, split_exposure, AutoExposure, FixedExposure};
 use super::exposure::Exposure;
 use super::grad_ae::{parse_white, GradientAe};
 use super::gyro_ae::{parse_imu, split_keys, AeVariant, BlurCappedAe, ImuTradeAe};
@@ -12,11 +12,12 @@ use super::phase::Phase;
 use super::policy::{Level, Policy};
 use super::predict::{Forecast, Oracle};
 use super::rules::{Adaptive, Deadline, Fixed, Gate, Threshold};
+use super::specified::Specified;
 use super::task::{parse_task, Task, TaskModel};
 use crate::error::{Error, Result};
-use std::sync::Arc;
 
-pub use super::family::{Family, PolicyFamily};
+use super::family::Family;
+use super::spec::{ExposureControl, PolicySpec, Rate};
 
 /// Highest frame rate a policy accepts, frames/s.
 pub const MAX_FPS: f64 = 1000.0;
@@ -80,21 +81,12 @@ each optionally followed by +exp:B[:TMIN] (exposure control: blur budget B px, s
 /// Parses a policy string (grammar in the module docs) and builds the policy.
 /// The policy keeps the string exactly as given for the `policy` column.
 pub fn parse_policy(spec: &str) -> Result<Box<dyn Policy>> {
-    Ok(PolicySpec::parse(spec)?.build())
+    PolicySpec::parse(spec)?.build()
 }
 
 /// The thesis's rule at its threshold (thesis ch. 6): three falling MMBM
 /// samples below 0.4 mm/s.
 pub const THESIS_POLICY: &str = "threshold:0.4";
-
-/// A frame rate with its phase.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Rate {
-    /// Frames per second, in `(0, MAX_FPS]`.
-    pub fps: f64,
-    /// Offset of the first slot after the log's start, s (`@PHASE`; 0 when not given).
-    pub phase: f64,
-}
 
 /// A gate's schedule when its string gives none: 5 fps from the log's start.
 const DEFAULT_GATE_RATE: Rate = Rate {
@@ -108,48 +100,6 @@ const DEFAULT_ADAPTIVE_RATE: Rate = Rate {
 };
 /// The forecast horizon of `oracle`, `forecast` and `phase` when their string gives none, s.
 pub const DEFAULT_HORIZON_S: f64 = 0.2;
-
-/// Exposure control (`+exp:B[:TMIN]`).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ExposureControl {
-    /// Blur budget, px.
-    pub budget_px: f64,
-    /// Shortest exposure, s.
-    pub min_exposure_s: f64,
-}
-
-/// A policy string parsed once: what the experiment, the figures, the report,
-/// `live` and Python ask of a policy without re-reading its text.
-///
-/// It owns the string it was parsed from (shared: a clone is cheap), which
-/// [`Self::as_str`], `Display` and serde write back unchanged; serde reads
-/// and writes a spec as that string, refusing a bad one while deserialising.
-#[derive(Debug, Clone, PartialEq)]
-pub struct PolicySpec {
-    /// The string exactly as given.
-    pub(super) text: Arc<str>,
-    /// Length of the part before `+exp` (the whole string without it).
-    pub(super) base_len: usize,
-    /// The family.
-    pub family: Family,
-    /// The frame rate: the schedule's (`fixed`, `gate`, `gate0`, `deadline`;
-    /// 5 fps when a gate gives none) or the target (`adaptive`, default 2.5).
-    pub rate: Option<Rate>,
-    /// The MMBM threshold (every family but `fixed`; optional for `deadline`).
-    pub threshold: Option<Level>,
-    /// The forecast horizon, s (`oracle`, `forecast`, `phase`; default 0.2).
-    pub horizon: Option<f64>,
-    /// Exposure control, when the string ends in `+exp:B[:TMIN]`.
-    pub exposure: Option<ExposureControl>,
-    /// The fixed exposure of `fixed:FPS@Tms`, s.
-    pub fixed_exposure_s: Option<f64>,
-    /// The auto-exposure of `ae:...` and `ae-*:...`.
-    pub ae: Option<AeParams>,
-    /// What an `ae-*` policy adds to the auto-exposure (`None` for `ae:`).
-    pub ae_variant: Option<AeVariant>,
-    /// The success model of `task:...` (with its stated light).
-    pub task: Option<TaskModel>,
-}
 
 impl PolicySpec {
     /// Parses a policy string (grammar in the module docs of [`crate::trigger`]).
@@ -306,61 +256,13 @@ impl PolicySpec {
         Ok(out)
     }
 
-    /// The string exactly as given (the `policy` column).
-    pub fn as_str(&self) -> &str {
-        &self.text
-    }
-
-    /// The family of docs/spec.md section 10 (the benefit map's grouping).
-    pub fn policy_family(&self) -> PolicyFamily {
-        if !self.is_causal() {
-            PolicyFamily::Oracle
-        } else if self.ae_variant.is_some_and(|v| v.reads_gyro()) {
-            PolicyFamily::GyroExposure
-        } else if self.ae.is_some() {
-            PolicyFamily::AutoExposure
-        } else if self.fixed_exposure_s.is_some() {
-            PolicyFamily::FixedExposure
-        } else if self.is_baseline() {
-            PolicyFamily::Fixed
-        } else if self.family == Family::Fixed {
-            // The fixed rate with `+exp`: exposure from the gyro, no timing.
-            PolicyFamily::GyroExposure
-        } else {
-            PolicyFamily::Mmbm
-        }
-    }
-
-    /// False for the policies that use knowledge of the future (the oracle).
-    pub fn is_causal(&self) -> bool {
-        self.family != Family::Oracle
-    }
-
-    /// True for a plain fixed-rate policy (`fixed:FPS[@PHASE]`), the baseline
-    /// the others are compared with; `fixed:5+exp:2` (exposure control) is not.
-    pub fn is_baseline(&self) -> bool {
-        self.family == Family::Fixed && self.exposure.is_none() && self.fixed_exposure_s.is_none()
-    }
-
-    /// True for the thesis's rule at its threshold ([`THESIS_POLICY`], no exposure control).
-    pub fn is_thesis_rule(&self) -> bool {
-        self.family == Family::Threshold
-            && self.threshold == Some(Level::Abs(0.4))
-            && self.exposure.is_none()
-    }
-
-    /// The threshold in mm/s when it is one (not a percentile).
-    pub fn threshold_mm_s(&self) -> Option<f64> {
-        match self.threshold {
-            Some(Level::Abs(x)) => Some(x),
-            _ => None,
-        }
-    }
-
-    /// The policy, ready to run (its `spec()` is [`Self::as_str`]).
-    pub fn build(&self) -> Box<dyn Policy> {
-        let inner = self.build_base();
-        match self.exposure {
+    /// The policy, ready to run: its [`Policy::spec`] is this spec (which
+    /// every frame it triggers carries), its [`Policy::label`]
+    /// [`Self::as_str`]. Errors for a [`Self::custom`] spec, which names a
+    /// policy it cannot build.
+    pub fn build(&self) -> Result<Box<dyn Policy>> {
+        let inner = self.build_base()?;
+        let inner = match self.exposure {
             Some(e) => Box::new(Exposure::new(
                 &self.text,
                 inner,
@@ -368,15 +270,19 @@ impl PolicySpec {
                 e.min_exposure_s,
             )),
             None => inner,
-        }
+        };
+        Ok(Box::new(Specified {
+            spec: self.clone(),
+            inner,
+        }))
     }
 
-    fn build_base(&self) -> Box<dyn Policy> {
+    fn build_base(&self) -> Result<Box<dyn Policy>> {
         let spec = &self.text[..self.base_len];
         let level = self.threshold.unwrap_or(Level::Abs(0.0));
         let rate = self.rate.unwrap_or(DEFAULT_GATE_RATE);
         let h = self.horizon.unwrap_or(DEFAULT_HORIZON_S);
-        match self.family {
+        Ok(match self.family {
             Family::Fixed => match self.fixed_exposure_s {
                 Some(te) => Box::new(FixedExposure::new(spec, rate.fps, rate.phase, te)),
                 None => Box::new(Fixed::new(spec, rate.fps, rate.phase)),
@@ -417,7 +323,16 @@ impl PolicySpec {
                 rate.fps,
                 self.task.unwrap_or(TaskModel::at_light(1.0)),
             )),
-        }
+            Family::Custom => {
+                return Err(Error::invalid(
+                    "policy",
+                    format!(
+                        "'{}' is a custom policy's label, not a built-in policy; run the custom policy itself",
+                        self.text
+                    ),
+                ))
+            }
+        })
     }
 }
 
@@ -496,8 +411,9 @@ mod tests {
             "ae-grad:5:white=0.9",
         ] {
             let p = spec(s);
-            let b = p.build();
-            assert_eq!(b.spec(), s);
+            let b = p.build().unwrap();
+            assert_eq!(b.label(), s);
+            assert_eq!(b.spec(), p, "{s}");
             assert_eq!(b.is_causal(), p.is_causal(), "{s}");
             assert_eq!(p.to_string(), s);
         }

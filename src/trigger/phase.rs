@@ -398,7 +398,7 @@ impl Clock {
 }
 
 impl Policy for Phase {
-    fn spec(&self) -> &str {
+    fn label(&self) -> &str {
         &self.spec
     }
     fn forecast_exposure_mmbm(&self, obs: &Observation, exposure_s: f64) -> Option<f64> {

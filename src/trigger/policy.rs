@@ -1,8 +1,9 @@
-//! The policy trait, what a policy observes, and thresholds.
+//! The policy trait and what a policy observes.
 
+pub use super::level::Level;
+use super::spec::PolicySpec;
 use super::timing::{CameraTiming, Frame};
-use crate::error::{Error, Result};
-use crate::stats::percentile;
+use crate::error::Result;
 
 /// Tolerance (s) on interval comparisons, against rounding in sums of times.
 pub(crate) const TIME_EPS: f64 = 1e-9;
@@ -81,8 +82,17 @@ impl Observation<'_> {
 /// true triggers a frame when the camera is free (the runner ignores it
 /// otherwise; the built-in policies only return true when it is free).
 pub trait Policy {
-    /// The policy string exactly as given to [`super::parse_policy`].
-    fn spec(&self) -> &str;
+    /// The policy's label, the `policy` column: for a built-in policy the
+    /// policy string exactly as given to [`super::parse_policy`].
+    fn label(&self) -> &str;
+    /// The typed spec the policy was built from, which every frame it
+    /// triggers carries ([`Frame::policy`]): [`PolicySpec::build`]'s
+    /// policies return the spec they were built from; any other policy (a
+    /// user's own, or a rule's constructor called directly) a
+    /// [`PolicySpec::custom`] of its [`Self::label`] (the default).
+    fn spec(&self) -> PolicySpec {
+        PolicySpec::custom(self.label())
+    }
     /// False for policies that use knowledge of the future (the oracle).
     fn is_causal(&self) -> bool {
         true
@@ -109,50 +119,6 @@ pub trait Policy {
     /// uses the MMBM at the decision sample).
     fn forecast_exposure_mmbm(&self, _obs: &Observation, _exposure_s: f64) -> Option<f64> {
         None
-    }
-}
-
-/// A threshold: an absolute MMBM (mm/s) or a percentile of the log's own series.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Level {
-    /// mm/s.
-    Abs(f64),
-    /// Percentile 0..100 of the whole log's MMBM.
-    Percentile(f64),
-}
-
-impl Level {
-    /// Parses `X` (mm/s, >= 0) or `pNN` (0 <= NN <= 100).
-    pub fn parse(s: &str, what: &str) -> Result<Self> {
-        let bad = || {
-            Error::invalid(
-                what,
-                format!(
-                    "'{s}': expected a threshold in mm/s (e.g. 0.4) or a percentile pNN (e.g. p20)"
-                ),
-            )
-        };
-        if let Some(p) = s.strip_prefix(['p', 'P']) {
-            let q: f64 = p.parse().map_err(|_| bad())?;
-            if !(0.0..=100.0).contains(&q) {
-                return Err(bad());
-            }
-            return Ok(Level::Percentile(q));
-        }
-        let x: f64 = s.parse().map_err(|_| bad())?;
-        if !(x.is_finite() && x >= 0.0) {
-            return Err(bad());
-        }
-        Ok(Level::Abs(x))
-    }
-
-    /// The threshold in mm/s for a log whose MMBM series is `mmbm`.
-    pub fn resolve(&self, mmbm: &[f64]) -> Result<f64> {
-        match *self {
-            Level::Abs(x) => Ok(x),
-            Level::Percentile(q) => percentile(mmbm, q)
-                .ok_or_else(|| Error::invalid("percentile threshold", "the MMBM series is empty")),
-        }
     }
 }
 

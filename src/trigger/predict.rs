@@ -67,7 +67,7 @@ fn forward_window_min(t: &[f64], v: &[f64], h: f64) -> Vec<f64> {
 }
 
 impl Policy for Oracle {
-    fn spec(&self) -> &str {
+    fn label(&self) -> &str {
         &self.spec
     }
     fn is_causal(&self) -> bool {
@@ -241,7 +241,7 @@ impl Forecast {
 }
 
 impl Policy for Forecast {
-    fn spec(&self) -> &str {
+    fn label(&self) -> &str {
         &self.spec
     }
     fn prepare(&mut self, log: &LogView, _timing: &CameraTiming) -> Result<()> {

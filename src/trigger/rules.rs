@@ -66,7 +66,7 @@ impl Fixed {
 }
 
 impl Policy for Fixed {
-    fn spec(&self) -> &str {
+    fn label(&self) -> &str {
         &self.spec
     }
     fn prepare(&mut self, log: &LogView, _timing: &CameraTiming) -> Result<()> {
@@ -107,7 +107,7 @@ impl Threshold {
 }
 
 impl Policy for Threshold {
-    fn spec(&self) -> &str {
+    fn label(&self) -> &str {
         &self.spec
     }
     fn prepare(&mut self, log: &LogView, _timing: &CameraTiming) -> Result<()> {
@@ -171,7 +171,7 @@ impl Adaptive {
 }
 
 impl Policy for Adaptive {
-    fn spec(&self) -> &str {
+    fn label(&self) -> &str {
         &self.spec
     }
     fn prepare(&mut self, log: &LogView, _timing: &CameraTiming) -> Result<()> {
@@ -254,8 +254,8 @@ impl Gate {
 }
 
 impl Policy for Gate {
-    fn spec(&self) -> &str {
-        self.fixed.spec()
+    fn label(&self) -> &str {
+        self.fixed.label()
     }
     fn prepare(&mut self, log: &LogView, timing: &CameraTiming) -> Result<()> {
         self.x = self.level.resolve(log.mmbm)?;
@@ -314,7 +314,7 @@ impl Deadline {
 }
 
 impl Policy for Deadline {
-    fn spec(&self) -> &str {
+    fn label(&self) -> &str {
         &self.spec
     }
     fn prepare(&mut self, log: &LogView, _timing: &CameraTiming) -> Result<()> {

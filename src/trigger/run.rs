@@ -111,7 +111,7 @@ pub fn run_px<S: Timed>(
             let (te, gain) = policy.exposure(&obs);
             let end = start + te;
             let mut f = Frame {
-                policy: policy.spec().to_string(),
+                policy: policy.spec(),
                 index: i,
                 trigger_t: t[i],
                 exposure_start: start,
@@ -138,5 +138,90 @@ pub fn pixel_pitch(mm_s: f64, px_s: f64, pitch: f64) -> f64 {
         p
     } else {
         pitch
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::trigger::{Family, PolicyFamily, PolicySpec};
+
+    /// A 20 s log at 200 Hz whose MMBM swings between 0.1 and 0.9 mm/s at
+    /// 1.8 Hz (a walk's rhythm): every family triggers on it.
+    fn log() -> (Vec<f64>, Vec<f64>) {
+        let t: Vec<f64> = (0..4000).map(|i| i as f64 / 200.0).collect();
+        let m = t
+            .iter()
+            .map(|&t| 0.5 + 0.4 * (std::f64::consts::TAU * 1.8 * t).sin())
+            .collect();
+        (t, m)
+    }
+
+    /// Every frame carries the spec its policy was built from, typed: for
+    /// every family the frames' spec equals the spec built, field for field,
+    /// and its family and benefit-map family are the spec's own (no string
+    /// parsed back).
+    #[test]
+    fn frames_carry_the_spec_they_were_built_from() {
+        let (t, m) = log();
+        let timing = CameraTiming::default();
+        for s in [
+            "fixed:5@0.1",
+            "fixed:5@3ms",
+            "fixed:5+exp:0.5",
+            "ae:5:cap=10ms",
+            "ae-blur:5:1",
+            "ae-imu:5:w=0.5",
+            "ae-grad:5",
+            "threshold:0.4",
+            "adaptive:p30:3",
+            "oracle:0.4",
+            "forecast:0.4",
+            "phase:0.6",
+            "gate:0.5",
+            "gate0:0.5:4",
+            "deadline:5:0.3",
+            "task:5:light=1000",
+        ] {
+            let spec = PolicySpec::parse(s).unwrap();
+            let frames = run(&t, &m, spec.build().unwrap().as_mut(), &timing).unwrap();
+            assert!(!frames.is_empty(), "{s}: no frames");
+            for f in &frames {
+                assert_eq!(f.policy, spec, "{s}");
+                assert_eq!(f.policy.family, spec.family, "{s}");
+                assert_eq!(f.policy.policy_family(), spec.policy_family(), "{s}");
+                assert_eq!(f.policy.to_string(), s);
+            }
+        }
+    }
+
+    /// A user's own policy: its frames carry a custom spec of its label,
+    /// written unchanged, in family `custom`; the spec cannot be built.
+    #[test]
+    fn a_custom_policy_keeps_its_label() {
+        struct Every(usize);
+        impl Policy for Every {
+            fn label(&self) -> &str {
+                "every:40 samples"
+            }
+            fn prepare(&mut self, _: &LogView, _: &CameraTiming) -> Result<()> {
+                Ok(())
+            }
+            fn decide(&mut self, obs: &Observation) -> bool {
+                obs.i % self.0 == 0
+            }
+        }
+        let (t, m) = log();
+        let frames = run(&t, &m, &mut Every(40), &CameraTiming::default()).unwrap();
+        assert!(!frames.is_empty());
+        for f in &frames {
+            assert_eq!(f.policy, PolicySpec::custom("every:40 samples"));
+            assert_eq!(f.policy.family, Family::Custom);
+            assert_eq!(f.policy.policy_family(), PolicyFamily::Custom);
+            assert_eq!(f.policy.to_string(), "every:40 samples");
+        }
+        let e = frames[0].policy.build().err().unwrap().to_string();
+        assert!(e.contains("'every:40 samples' is a custom policy"), "{e}");
+        assert!(PolicySpec::parse("custom").is_err());
     }
 }

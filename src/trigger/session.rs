@@ -10,8 +10,8 @@
 //! ([`Session::stream`]).
 
 use super::live::Live;
-use super::parse::PolicySpec;
 use super::run::run_px;
+use super::spec::PolicySpec;
 use super::stream::{Stream, StreamControl, StreamOptions};
 use super::timing::{CameraTiming, Frame};
 use crate::camera::Camera;
@@ -62,7 +62,7 @@ impl Policies {
     ) -> Result<Vec<Vec<Frame>>> {
         self.specs
             .iter()
-            .map(|p| run_px(samples, mmbm_mm_s, px_s, p.build().as_mut(), &self.timing))
+            .map(|p| run_px(samples, mmbm_mm_s, px_s, p.build()?.as_mut(), &self.timing))
             .collect()
     }
 
@@ -71,7 +71,7 @@ impl Policies {
     pub fn live(&self) -> Result<Vec<Live>> {
         self.specs
             .iter()
-            .map(|p| Live::new(p.build(), self.timing))
+            .map(|p| Live::new(p.build()?, self.timing))
             .collect()
     }
 }
@@ -287,7 +287,8 @@ mod tests {
         // pitch_x != pitch_y: the pixel budget takes each sample's px/s.
         let px = px_series(&s, &log, &m);
         for (frames, p) in got.frames.iter().zip(s.policies().specs()) {
-            let want = run_px(&log, &m, Some(&px), p.build().as_mut(), s.timing()).unwrap();
+            let want =
+                run_px(&log, &m, Some(&px), p.build().unwrap().as_mut(), s.timing()).unwrap();
             assert!(!want.is_empty(), "{}", p.as_str());
             assert_eq!(frames, &want);
         }

@@ -3,8 +3,10 @@
 //! text (`FromStr`, serde) and written as the text it was given
 //! (`Display`, serde), and compared with it.
 
+use super::family::Family;
 use super::numbers::check_pos;
-use super::parse::{check_fps, Family, PolicySpec, Rate};
+use super::parse::check_fps;
+use super::spec::{PolicySpec, Rate};
 use crate::error::{Error, Result};
 
 impl PolicySpec {

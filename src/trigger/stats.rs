@@ -1,5 +1,6 @@
 //! Summaries of a run, the thesis Table 5.1 analysis, and the frames CSV.
 
+use super::spec::PolicySpec;
 use super::timing::Frame;
 use crate::error::{Error, Result};
 use crate::stats::percentile;
@@ -13,8 +14,8 @@ pub const FRAME_HEADER: &str =
 /// frames' exposure MMBM (NaN when no frame was kept).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Summary {
-    /// The frames' policy label ([`Frame::policy`]; empty when there are no frames).
-    pub policy: String,
+    /// The frames' policy ([`Frame::policy`]; `None` when there are no frames).
+    pub policy: Option<PolicySpec>,
     /// Frames triggered.
     pub frames: usize,
     /// Frames kept (not discarded by a gate).
@@ -65,7 +66,7 @@ pub fn summary_over(frames: &[Frame], duration_s: f64) -> Summary {
     };
     let trig: Vec<f64> = kept.iter().map(|f| f.mmbm_trigger_mm_s).collect();
     Summary {
-        policy: frames.first().map(|f| f.policy.clone()).unwrap_or_default(),
+        policy: frames.first().map(|f| f.policy.clone()),
         frames: frames.len(),
         kept: kept.len(),
         duration_s,

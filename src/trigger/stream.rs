@@ -474,7 +474,7 @@ impl Stream {
             }
             if self.opts.all && !triggered {
                 let v = serde_json::json!({
-                    "t": s.t, "policy": live.spec(), "trigger": false, "mmbm_mm_s": m,
+                    "t": s.t, "policy": live.label(), "trigger": false, "mmbm_mm_s": m,
                 });
                 text.push_str(&v.to_string());
                 text.push('\n');

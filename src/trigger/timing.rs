@@ -1,6 +1,7 @@
 //! The camera's timing (thesis Fig. 5.1), a triggered [`Frame`], and the
 //! exposure average of the MMBM series ([`Integral`]).
 
+use super::spec::PolicySpec;
 use crate::error::{Error, Result};
 pub use crate::model::log::Integral;
 
@@ -90,14 +91,12 @@ impl CameraTiming {
 /// One triggered frame.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Frame {
-    /// The label of the policy that triggered the frame, its
-    /// [`Policy::spec`](crate::trigger::Policy::spec): for a policy built
-    /// from a [`PolicySpec`](crate::trigger::PolicySpec), the spec's text
-    /// exactly as given. The runner takes any [`Policy`](crate::trigger::Policy),
-    /// so the frame holds the label; the typed spec travels beside the
-    /// frames ([`Policies::specs`](crate::trigger::Policies::specs), in the
-    /// same order as [`Policies::run`](crate::trigger::Policies::run)'s lists).
-    pub policy: String,
+    /// The spec of the policy that triggered the frame, its
+    /// [`Policy::spec`](crate::trigger::Policy::spec): the
+    /// [`PolicySpec`] a built-in policy was built from, a
+    /// [`PolicySpec::custom`] of a user's policy's label. Its `Display` is
+    /// the `policy` column (the policy string exactly as given).
+    pub policy: PolicySpec,
     /// Index of the gyro sample the decision was made on.
     pub index: usize,
     /// Time of that sample, s.

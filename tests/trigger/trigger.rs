@@ -310,7 +310,7 @@ fn gate_discards_and_summaries_exclude() {
 #[test]
 fn summary_and_table51_by_hand() {
     let fr = |t: f64, trig: f64, exp: f64, kept: bool| Frame {
-        policy: "p".into(),
+        policy: mmbm::trigger::PolicySpec::custom("p"),
         index: 0,
         trigger_t: t,
         exposure_start: t,

@@ -17,7 +17,7 @@ fn swinging(spec: &str) -> (Vec<Frame>, Vec<f64>, Vec<f64>) {
         .iter()
         .map(|&s| 1.0 - (2.0 * std::f64::consts::PI * 1.7 * s).cos())
         .collect();
-    let mut p = PolicySpec::parse(spec).unwrap().build();
+    let mut p = PolicySpec::parse(spec).unwrap().build().unwrap();
     let f = run(&t, &m, p.as_mut(), &CameraTiming::default()).unwrap();
     (f, t, m)
 }
@@ -122,7 +122,7 @@ fn families_split_exposure_from_timing() {
     ] {
         let p = PolicySpec::parse(s).unwrap();
         assert_eq!(p.policy_family().name(), fam, "{s}");
-        assert_eq!(p.build().spec(), s);
+        assert_eq!(p.build().unwrap().spec(), p);
     }
     for (s, says) in [
         ("ae-blur:5", "blur budget"),

@@ -139,14 +139,15 @@ impl Sources {
             (dir, textures)
         };
         let mut logs = HashMap::new();
-        let readout_s = cfg.camera().shutter.readout_s;
+        let shutter = cfg.camera().shutter;
+        let readout_s = shutter.readout_s;
         for m in &cfg.motion {
             if let MotionSource::Log(p) = MotionSource::parse(m)? {
                 let bad = |e: String| cfg.key_error("motion", m, &p, e);
                 let s = read_log(&cfg.resolve(&p), GyroOptions::default())
                     .map_err(|e| bad(e.to_string()))?;
                 let span = s.last().map_or(0.0, |l| l.t) - s.first().map_or(0.0, |f| f.t);
-                if span < cfg.exposure_s[1] + readout_s {
+                if span < shutter.busy_s(cfg.exposure_s[1]) {
                     return Err(bad(format!(
                         "the log spans {span:.4} s, shorter than the longest exposure ({} s){}",
                         cfg.exposure_s[1],
@@ -269,8 +270,6 @@ impl Sources {
 pub fn plan(cfg: &DatasetConfig, src: &Sources, i: u64) -> Result<ItemParams> {
     let seed = item_seed(cfg.seed, i);
     let cam = cfg.camera();
-    // A rolling shutter's motion spans its readout too (0: global shutter).
-    let readout_s = cam.shutter.readout_s;
     let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
     let mut draw = |r: [f64; 2]| {
         let u: f64 = rng.gen();
@@ -290,7 +289,8 @@ pub fn plan(cfg: &DatasetConfig, src: &Sources, i: u64) -> Result<ItemParams> {
             let s = src.logs.get(&p).ok_or_else(|| {
                 Error::invalid("motion", format!("log {} was not opened", p.display()))
             })?;
-            let (a, b) = (s[0].t, s[s.len() - 1].t - exposure_s - readout_s);
+            // A rolling shutter's motion spans its readout too (0: global shutter).
+            let (a, b) = (s[0].t, s[s.len() - 1].t - cam.shutter.busy_s(exposure_s));
             (
                 a + (b - a) * u_start,
                 s.iter().all(|x| x.velocity.is_some()),
@@ -326,12 +326,13 @@ fn camera(p: &ItemParams) -> Result<Camera> {
     Ok(cam)
 }
 
-/// The samples an item's motion is a window of.
-fn samples(p: &ItemParams, readout_s: f64, src: &Sources) -> Result<ImuLog> {
+/// The samples an item's motion is a window of: a simulated walk outlasts
+/// the frame's busy time `busy_s` (s, [`crate::camera::Shutter::busy_s`]).
+fn samples(p: &ItemParams, busy_s: f64, src: &Sources) -> Result<ImuLog> {
     match MotionSource::parse(&p.motion)? {
         MotionSource::Sim(g) => ImuLog::new(simulate(
             &GaitConfig::preset(g),
-            SIM_SETTLE_S + 1.0 + p.exposure_s + readout_s + 0.5,
+            SIM_SETTLE_S + 1.0 + busy_s + 0.5,
             600.0,
             p.seed,
         )?),
@@ -418,7 +419,7 @@ pub fn make(p: &ItemParams, src: &Sources, dir: &Path) -> Result<ItemMeasures> {
             n.seed = p.seed;
         }
     }
-    let s = samples(p, cam.shutter.readout_s, src)?;
+    let s = samples(p, cam.shutter.busy_s(p.exposure_s), src)?;
     // The motion spans the camera's busy time (readout plus exposure).
     let traj = FrameMotion::Log {
         log: &s,

@@ -174,7 +174,7 @@ pub fn headlines(
                 });
             }
             for r in records.iter().filter(|r| r.walk == w.name) {
-                let Some(pi) = policies.iter().position(|p| p.as_str() == r.frame.policy) else {
+                let Some(pi) = policies.iter().position(|p| *p == r.frame.policy) else {
                     continue;
                 };
                 if !r.frame.kept {
@@ -219,7 +219,7 @@ pub fn headlines(
             });
             let recs = records
                 .iter()
-                .filter(|r| r.frame.policy == p.as_str() && ws.iter().any(|w| w.name == r.walk));
+                .filter(|r| r.frame.policy == *p && ws.iter().any(|w| w.name == r.walk));
             let (mut rendered, mut kept) = (0, 0);
             for r in recs {
                 kept += usize::from(r.frame.kept);
@@ -448,9 +448,8 @@ mod tests {
         FrameRecord {
             walk: format!("w-s{seed}"),
             seed,
-            policy: policy.parse().unwrap(),
             frame: Frame {
-                policy: policy.into(),
+                policy: policy.parse().unwrap(),
                 index: 0,
                 trigger_t: t,
                 exposure_start: t,

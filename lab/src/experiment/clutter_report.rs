@@ -34,7 +34,7 @@ fn rows(walks: &[Walk], records: &[FrameRecord]) -> Vec<Row> {
         for (p, _) in &w.runs {
             let ms: Vec<_> = records
                 .iter()
-                .filter(|r| r.walk == w.name && r.seed == w.seed && r.policy == *p)
+                .filter(|r| r.walk == w.name && r.seed == w.seed && r.frame.policy == *p)
                 .filter_map(|r| r.measure.as_ref())
                 .collect();
             let reps: Vec<f64> = ms

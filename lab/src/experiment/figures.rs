@@ -78,7 +78,7 @@ pub fn write_all(
             .map(|(p, _)| {
                 let v = records
                     .iter()
-                    .filter(|r| r.walk == w.name && r.frame.policy == p.as_str())
+                    .filter(|r| r.walk == w.name && r.frame.policy == *p)
                     .filter_map(|r| r.measure.as_ref().map(|m| m.blur_px))
                     .collect();
                 (p.to_string(), v)

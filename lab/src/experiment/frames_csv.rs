@@ -87,7 +87,7 @@ impl<'a> FrameRow<'a> {
         let m = r.measure.as_ref();
         let v = |get: fn(&FrameMeasure) -> f64| Measured(m.map(get));
         FrameRow {
-            policy: r.policy.as_str(),
+            policy: r.frame.policy.as_str(),
             trigger_t: Shown(f.trigger_t),
             blur_px: v(|m| m.blur_px),
             jnbm: v(|m| m.jnbm),
@@ -118,7 +118,7 @@ impl<'a> FrameRow<'a> {
             jnbm_2d: v(|m| m.jnbm_2d),
             cpbd_2d: v(|m| m.cpbd_2d),
             gain: Shown(f.gain),
-            family: r.policy.policy_family().name(),
+            family: r.frame.policy.policy_family().name(),
             blobs_false: m.map(|m| m.blobs_false),
             corner_repeatability: v(|m| m.corner_rep),
         }
@@ -151,7 +151,7 @@ mod tests {
     /// tiny and huge magnitudes, NaN, infinity) and a skipped frame.
     fn records() -> Vec<FrameRecord> {
         let frame = Frame {
-            policy: "deadline:5:0.4".into(),
+            policy: "deadline:5:0.4".parse().unwrap(),
             index: 7,
             trigger_t: 0.1 + 0.2,
             exposure_start: 1.0,
@@ -188,16 +188,14 @@ mod tests {
             FrameRecord {
                 walk: "slow".into(),
                 seed: 3,
-                policy: "deadline:5:0.4".parse().unwrap(),
                 frame: frame.clone(),
                 measure: Some(measure),
             },
             FrameRecord {
                 walk: "fast".into(),
                 seed: u64::MAX,
-                policy: "fixed:5+exp:2:0.02".parse().unwrap(),
                 frame: Frame {
-                    policy: "fixed:5+exp:2:0.02".into(),
+                    policy: "fixed:5+exp:2:0.02".parse().unwrap(),
                     trigger_t: f64::NAN,
                     exposure_end: f64::INFINITY,
                     kept: false,
@@ -264,5 +262,20 @@ mod tests {
         w.serialize(FrameRow::new(&records()[1], "fast")).unwrap();
         let own = String::from_utf8(w.into_inner().unwrap()).unwrap();
         assert_eq!(own.lines().next(), Some(FRAMES_HEADER));
+    }
+
+    /// A custom policy's frame: its label in the `policy` column and family
+    /// `custom`, both from the frame's spec.
+    #[test]
+    fn a_custom_policy_is_written_by_its_label() {
+        let mut r = records().remove(1);
+        r.frame.policy = crate::trigger::PolicySpec::custom("mine:1, \"quoted\"");
+        let text = frames_csv(&[r], "fast").unwrap();
+        let mut rd = csv::Reader::from_reader(text.as_bytes());
+        let header: Vec<String> = rd.headers().unwrap().iter().map(String::from).collect();
+        let row = rd.records().next().unwrap().unwrap();
+        let col = |name: &str| row[header.iter().position(|h| h == name).unwrap()].to_string();
+        assert_eq!(col("policy"), "mine:1, \"quoted\"");
+        assert_eq!(col("family"), "custom");
     }
 }

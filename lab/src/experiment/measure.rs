@@ -9,7 +9,7 @@ use crate::error::{Error, Result};
 use crate::io::images::to_rgb8;
 use crate::render::{self, Backend, FrameMotion, Quality, RenderJob, Target, Trajectory};
 
-use crate::trigger::{Frame, PolicySpec};
+use crate::trigger::Frame;
 use std::time::Instant;
 
 /// A 2-D point: board coordinates (m) or pixel coordinates (px).
@@ -75,8 +75,6 @@ pub struct FrameRecord {
     pub walk: String,
     /// The walk's simulation seed (0 for a log).
     pub seed: u64,
-    /// The policy that triggered the frame (its text is `frame.policy`).
-    pub policy: PolicySpec,
     /// The trigger decision and exposure.
     pub frame: Frame,
     /// Measurements on the rendered frame.

@@ -83,7 +83,7 @@ pub fn policy_stats(walks: &[Walk], records: &[FrameRecord]) -> Vec<PolicyStats>
         for (p, frames) in &w.runs {
             let rs: Vec<_> = records
                 .iter()
-                .filter(|r| r.walk == w.name && r.frame.policy == p.as_str())
+                .filter(|r| r.walk == w.name && r.frame.policy == *p)
                 .filter_map(|r| r.measure.as_ref())
                 .collect();
             let blur: Vec<f64> = rs.iter().map(|m| m.blur_px).collect();

@@ -151,12 +151,11 @@ pub fn run(cfg: &ExperimentConfig, out: &Path, progress: bool) -> Result<Outcome
 
     let mut records = Vec::new();
     for (wi, w) in walks.iter().enumerate() {
-        for (pi, (spec, frames)) in w.runs.iter().enumerate() {
+        for (pi, (_, frames)) in w.runs.iter().enumerate() {
             for (fi, f) in frames.iter().enumerate() {
                 records.push(FrameRecord {
                     walk: w.name.clone(),
                     seed: w.seed,
-                    policy: spec.clone(),
                     frame: f.clone(),
                     measure: measures.remove(&(wi, pi, fi)),
                 });

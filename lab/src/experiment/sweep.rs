@@ -52,7 +52,8 @@ pub fn exposure_sweep(
         let (mut count, mut ok, mut blur) = (0usize, 0usize, 0.0);
         for (k, &fi) in picks.iter().enumerate() {
             let f = &frames[fi];
-            if f.exposure_start + e + cam.shutter.readout_s > last {
+            // The camera is busy for the exposure plus its readout.
+            if f.exposure_start + cam.shutter.busy_s(e) > last {
                 continue;
             }
             // The same trigger, exposed for `e` at the nominal gain.

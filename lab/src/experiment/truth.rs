@@ -150,9 +150,8 @@ mod tests {
         FrameRecord {
             walk: "w".into(),
             seed: 1,
-            policy: "fixed:5".parse().unwrap(),
             frame: Frame {
-                policy: "fixed:5".into(),
+                policy: "fixed:5".parse().unwrap(),
                 index: 0,
                 trigger_t: 0.0,
                 exposure_start: 0.0,
