@@ -18,3 +18,5 @@ mod experiment;
 mod experiment_map;
 #[path = "experiment/policy_config.rs"]
 mod policy_config;
+#[path = "experiment/speed.rs"]
+mod speed;
