@@ -199,13 +199,17 @@ fn masked(cam: &Camera, x: f64, y: f64) -> bool {
 /// bound below, times 1.1 for safety.
 pub fn max_path_px(cam: &Camera, target: &Target, traj: &Trajectory) -> f64 {
     let poses = inv_poses(traj, 256);
+    let start = start_pose(&poses);
     let (nx, ny) = (33, 25);
     let mut m: f64 = 0.0;
     for j in 0..ny {
         for i in 0..nx {
             let x = cam.width as f64 * i as f64 / (nx - 1) as f64;
             let y = cam.height as f64 * j as f64 / (ny - 1) as f64;
-            if let Some((l, _, _)) = path_disp(cam, target, &poses, x, y) {
+            // The path in px only (track::path_px: path_disp's number).
+            let path =
+                scene_point(cam, target, &start, x, y).and_then(|p| track::path_px(cam, &poses, p));
+            if let Some((l, _)) = path {
                 m = m.max(l);
             }
         }
