@@ -20,3 +20,5 @@ mod experiment_map;
 mod policy_config;
 #[path = "experiment/vo.rs"]
 mod vo;
+#[path = "experiment/speed.rs"]
+mod speed;

@@ -23,3 +23,5 @@ mod render_props;
 mod render_texture;
 #[path = "render/shaders.rs"]
 mod shaders;
+#[path = "render/speed.rs"]
+mod speed;

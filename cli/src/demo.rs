@@ -20,6 +20,9 @@ read from the map's cell at 20,000 e-/s (the same frames, seeds, window and verd
 over 2-s blocks of the walks; then the experiment's own frames (its seed, judged whole: a different sample); --full pools seeds 1-5 over the slow (35 s), moderate (16 s) and fast (5 s)
 walks.
 
+Time on 2 idle cores (estimated from CPU time on 2026-12-03, docs/performance.md): about 4 min 35 s; --full about
+1 h 40 min.
+
 Examples:
   mmbm demo
   mmbm demo --out /tmp/report --seed 7

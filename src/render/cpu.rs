@@ -228,18 +228,37 @@ pub fn render(
     analytic: bool,
     threads: Option<usize>,
 ) -> Vec<f32> {
-    let (w, h) = (p.dims[0], p.dims[1]);
+    render_window(
+        p,
+        homs,
+        tex,
+        analytic,
+        threads,
+        [0, 0, p.dims[0], p.dims[1]],
+    )
+}
+
+/// [`render`] of the pixels `[x0, y0, w, h]` only (inside the image), row-major:
+/// each pixel is the same number as in the whole image's render.
+pub fn render_window(
+    p: &RenderParams,
+    homs: &[GpuHomography],
+    tex: Option<&MipTexture>,
+    analytic: bool,
+    threads: Option<usize>,
+    [x0, y0, w, h]: [u32; 4],
+) -> Vec<f32> {
     let inv = 1.0 / p.dims[3] as f32;
     // Once a stop is requested (crate::cancel) the pixels left are skipped;
     // the caller checks the token and drops the image.
     let stop = crate::cancel::current();
     let run = || {
-        let mut out = vec![0.0f32; (w * h * 3) as usize];
+        let mut out = vec![0.0f32; (w as usize) * (h as usize) * 3];
         out.par_chunks_mut(3).enumerate().for_each(|(idx, o)| {
             if stop.is_cancelled() {
                 return;
             }
-            let (i, j) = (idx as u32 % w, idx as u32 / w);
+            let (i, j) = (x0 + idx as u32 % w, y0 + idx as u32 / w);
             let s = if let (true, Some(t)) = (analytic, tex) {
                 super::exact::pixel_sum(p, homs, t, line_base(p, i, j), i, j)
             } else if analytic {

@@ -199,13 +199,17 @@ fn masked(cam: &Camera, x: f64, y: f64) -> bool {
 /// bound below, times 1.1 for safety.
 pub fn max_path_px(cam: &Camera, target: &Target, traj: &Trajectory) -> f64 {
     let poses = inv_poses(traj, 256);
+    let start = start_pose(&poses);
     let (nx, ny) = (33, 25);
     let mut m: f64 = 0.0;
     for j in 0..ny {
         for i in 0..nx {
             let x = cam.width as f64 * i as f64 / (nx - 1) as f64;
             let y = cam.height as f64 * j as f64 / (ny - 1) as f64;
-            if let Some((l, _, _)) = path_disp(cam, target, &poses, x, y) {
+            // The path in px only (track::path_px: path_disp's number).
+            let path =
+                scene_point(cam, target, &start, x, y).and_then(|p| track::path_px(cam, &poses, p));
+            if let Some((l, _)) = path {
                 m = m.max(l);
             }
         }
@@ -266,6 +270,53 @@ pub fn blur_maps(
         speed_px_s: vals.iter().map(|v| (v.0 as f64 / dur) as f32).collect(),
         speed_mm_s: vals.iter().map(|v| (v.2 / dur) as f32).collect(),
     }
+}
+
+/// The blur maps' steps for a largest image path of `max_path_px` px
+/// ([`super::render_frame`]'s maps): a step per quarter pixel, 64 to 4096.
+pub fn steps_for(max_path_px: f64) -> usize {
+    ((max_path_px / 0.25).ceil() as usize).clamp(64, 4096)
+}
+
+/// The sensor means of the path length and the displacement (px) of
+/// [`blur_maps`] (`blur_maps(..).means()`'s `path_px` and `disp_px`, the
+/// same numbers, bit for bit) without keeping the maps and without the
+/// millimetre paths. A rolling shutter takes [`blur_maps`] itself.
+pub fn path_means(
+    cam: &Camera,
+    target: &Target,
+    traj: &Trajectory,
+    exposure_s: f64,
+    steps: usize,
+) -> (f64, f64) {
+    if !cam.shutter.is_global() {
+        let m = blur_maps(cam, target, traj, exposure_s, steps).means();
+        return (m.path_px, m.disp_px);
+    }
+    let poses = inv_poses(traj, steps.max(1));
+    let start = start_pose(&poses);
+    let w = cam.width as usize;
+    let stop = crate::cancel::current();
+    let vals: Vec<(f32, f32)> = (0..w * cam.height as usize)
+        .into_par_iter()
+        .map(|idx| {
+            let (i, j) = (idx % w, idx / w);
+            let track = (!stop.is_cancelled())
+                .then(|| scene_point(cam, target, &start, i as f64 + 0.5, j as f64 + 0.5))
+                .flatten()
+                .and_then(|x| track::path_px(cam, &poses, x));
+            track.map_or((f32::NAN, f32::NAN), |(l, d)| (l as f32, d as f32))
+        })
+        .collect();
+    // As BlurMaps::means: the finite pixels, in order, f64 accumulation.
+    let (mut s, mut n) = ([0.0f64; 2], 0usize);
+    for v in vals.iter().filter(|v| v.0.is_finite()) {
+        s[0] += v.0 as f64;
+        s[1] += v.1 as f64;
+        n += 1;
+    }
+    let d = n.max(1) as f64;
+    (s[0] / d, s[1] / d)
 }
 
 /// [`blur_maps`] with a rolling shutter: one pose table per line (row or

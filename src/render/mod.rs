@@ -16,7 +16,8 @@
 //! The GPU kernel is `render.wgsl` (`gpu`); its CPU twin (`cpu`) is
 //! used when no adapter exists (announced once on stderr). [`maps`] gives the
 //! per-pixel blur ground truth (path length, displacement, speed), `psf` the
-//! point-spread function at a pixel.
+//! point-spread function at a pixel; [`render_window`] renders a window of
+//! a frame (the same pixels, none outside it).
 
 pub mod clip;
 pub mod clip_panorama;
@@ -36,6 +37,7 @@ pub mod sharp;
 #[doc(hidden)]
 pub mod target;
 pub mod texture;
+mod window;
 
 pub use crate::gpu::Backend;
 pub use crate::model::trajectory::{Pose, Trajectory};
@@ -46,6 +48,7 @@ pub use poster::Background;
 pub use psf::{psf, Psf};
 pub use sharp::{render_sharp_at, SharpAt};
 pub use target::{project, Target, TargetKind, DEFAULT_BACKGROUND};
+pub use window::{render_window, Window};
 
 use crate::camera::Camera;
 use crate::error::{Error, Result};
@@ -351,8 +354,18 @@ pub fn render_frame(job: &RenderJob) -> Result<RenderOutput> {
     render_frame_stream(job, 0)
 }
 
-/// [`render_frame`] with the noise drawn from RNG stream `stream`.
-fn render_frame_stream(job: &RenderJob, stream: u64) -> Result<RenderOutput> {
+/// What one frame's pass needs: the kernel's parameters, its homography
+/// table, the integrator, the instants per pixel and the largest image path.
+struct Pass {
+    params: layout::RenderParams,
+    homs: Vec<layout::GpuHomography>,
+    analytic: bool,
+    n: u32,
+    lmax: f64,
+}
+
+/// Checks `job` (target, motion, timing, caps) and builds its pass.
+fn prepare(job: &RenderJob) -> Result<Pass> {
     let cam = &job.camera;
     job.target.validate_for(cam)?;
     // The camera must stay in front of the target for the whole exposure.
@@ -429,6 +442,25 @@ fn render_frame_stream(job: &RenderJob, stream: u64) -> Result<RenderOutput> {
             homs.extend(maps);
         }
     }
+    Ok(Pass {
+        params,
+        homs,
+        analytic,
+        n,
+        lmax,
+    })
+}
+
+/// [`render_frame`] with the noise drawn from RNG stream `stream`.
+fn render_frame_stream(job: &RenderJob, stream: u64) -> Result<RenderOutput> {
+    let cam = &job.camera;
+    let Pass {
+        params,
+        homs,
+        analytic,
+        n,
+        lmax,
+    } = prepare(job)?;
     let tex = kernel::texture_of(&job.target);
     let (rgb, backend_used) = match job.backend.resolve("render", "renderer", &ANNOUNCED)? {
         Resolved::Gpu(ctx) => (
@@ -458,7 +490,7 @@ fn render_frame_stream(job: &RenderJob, stream: u64) -> Result<RenderOutput> {
         noise.apply(&mut rgb, job.exposure_s, stream)?;
     }
     let maps = job.with_maps.then(|| {
-        let steps = ((lmax / 0.25).ceil() as usize).clamp(64, 4096);
+        let steps = maps::steps_for(lmax);
         maps::blur_maps(cam, &job.target, &job.trajectory, job.exposure_s, steps)
     });
     crate::cancel::check()?;

@@ -103,14 +103,31 @@ pub fn track(cam: &Camera, poses: &[(DMat3, DVec3)], x: DVec3) -> Option<Vec<(f6
 /// ([`LineTrack::world_to_camera`]: the sum of its chords); `None` when it
 /// goes behind the camera.
 pub fn path(cam: &Camera, poses: &[(DMat3, DVec3)], x: DVec3) -> Option<(f64, f64, f64)> {
+    chords::<true>(cam, poses, x)
+}
+
+/// [`path`]'s path length and displacement (px), the same numbers, without
+/// the path on the sensor in mm (half the work: no millimetre chords).
+pub fn path_px(cam: &Camera, poses: &[(DMat3, DVec3)], x: DVec3) -> Option<(f64, f64)> {
+    chords::<false>(cam, poses, x).map(|(len, disp, _)| (len, disp))
+}
+
+/// [`path`]; the millimetre path only when `MM` (else 0).
+fn chords<const MM: bool>(
+    cam: &Camera,
+    poses: &[(DMat3, DVec3)],
+    x: DVec3,
+) -> Option<(f64, f64, f64)> {
     let first = project(cam, &poses[0], x)?;
     let mut prev = first;
     let (mut len, mut len_mm) = (0.0, 0.0);
     for p in &poses[1..] {
         let q = project(cam, p, x)?;
         len += ((q.0 - prev.0).powi(2) + (q.1 - prev.1).powi(2)).sqrt();
-        let (a, b) = (cam.pixel_to_mm(q.0, q.1), cam.pixel_to_mm(prev.0, prev.1));
-        len_mm += (a.0 - b.0).hypot(a.1 - b.1);
+        if MM {
+            let (a, b) = (cam.pixel_to_mm(q.0, q.1), cam.pixel_to_mm(prev.0, prev.1));
+            len_mm += (a.0 - b.0).hypot(a.1 - b.1);
+        }
         prev = q;
     }
     Some((

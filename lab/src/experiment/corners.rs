@@ -67,7 +67,13 @@ pub fn repeatability(sharp: &[(f64, f64)], frame: &[(f64, f64)], radius: f64) ->
 /// at pose `pose`): linear RGB. Without motion the analytic integrator
 /// takes one instant per pixel, so this costs a fraction of the frame's render.
 pub fn sharp_at(job: &RenderJob, pose: Pose) -> Result<Vec<f32>> {
-    let still = RenderJob {
+    Ok(render::render_frame(&still_at(job, pose)?)?.rgb)
+}
+
+/// The job of [`sharp_at`]: `job`'s camera without noise, held at `pose`
+/// for the whole exposure, without blur maps.
+pub fn still_at(job: &RenderJob, pose: Pose) -> Result<RenderJob> {
+    Ok(RenderJob {
         camera: Camera {
             noise: None,
             ..job.camera
@@ -75,8 +81,7 @@ pub fn sharp_at(job: &RenderJob, pose: Pose) -> Result<Vec<f32>> {
         trajectory: Trajectory::from_poses(job.trajectory.duration(), vec![pose, pose])?,
         with_maps: false,
         ..job.clone()
-    };
-    Ok(render::render_frame(&still)?.rgb)
+    })
 }
 
 /// 8-bit luma of linear RGB (`w` x `h`), as [`crate::assess::luma`] of its sRGB image.

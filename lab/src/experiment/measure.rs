@@ -5,7 +5,7 @@ use super::config::ExperimentConfig;
 use super::crop::{pattern_crop, pitch_px};
 use super::walk::Walk;
 use crate::camera::Camera;
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::io::images::to_rgb8;
 use crate::render::{self, Backend, FrameMotion, Quality, RenderJob, Target, Trajectory};
 
@@ -282,15 +282,20 @@ pub fn render_and_measure(
         }
     }
     let target = cfg.scene_target(&cfg.target, distance)?;
-    let job = bulk_job(cam, exposure, &traj, &target, quality, seed);
+    let mut job = bulk_job(cam, exposure, &traj, &target, quality, seed);
+    // Only the maps' sensor means are read: they are computed without the
+    // maps (render::maps::path_means, the same numbers).
+    job.with_maps = false;
     let t0 = Instant::now();
     let out = render::render_frame(&job)?;
     let render_ms = t0.elapsed().as_secs_f64() * 1e3;
-    let maps = out
-        .maps
-        .as_ref()
-        .ok_or_else(|| Error::invalid("render", "no blur maps"))?;
-    let means = maps.means();
+    let (blur_px, disp_px) = render::maps::path_means(
+        &cam,
+        &target,
+        &traj,
+        exposure,
+        render::maps::steps_for(out.max_path_px),
+    );
     let (blur_h_px, blur_v_px) = axis_blur(&cam, &target, &traj);
     let rgb8 = to_rgb8(cam.width, cam.height, &out.rgb)?;
     // True blob centres at mid-exposure (the centroid of a smear).
@@ -326,8 +331,8 @@ pub fn render_and_measure(
         backend: out.backend_used.clone(),
         measure: FrameMeasure {
             distance_m: distance,
-            blur_px: means.path_px,
-            disp_px: means.disp_px,
+            blur_px,
+            disp_px,
             blur_h_px,
             blur_v_px,
             jnbm: img.jnbm,

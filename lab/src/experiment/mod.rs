@@ -32,7 +32,7 @@ pub(crate) mod walk;
 
 pub use benefit_map::report::{answer as map_answer, timing_verdict};
 pub use benefit_map::verdict::{cell_verdict, three_lines, Verdict};
-pub use benefit_map::{BenefitMap, Cell, CellPolicy};
+pub use benefit_map::{benefit_map_with, BenefitMap, Cell, CellPolicy, Renders};
 pub use config::{ExperimentConfig, MapSection, WalkTimes, DEMO_POLICIES};
 pub use headline_view::{headline_cell, headlines_of};
 pub use matches::TRACK_MIN;

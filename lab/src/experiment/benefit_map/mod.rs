@@ -32,6 +32,7 @@ use crate::render::Quality;
 use crate::stats::percentile;
 use crate::trigger::{Frame, PolicyFamily, PolicySpec};
 use rayon::prelude::*;
+pub use render::Renders;
 use render::{judge_at_lights, FrameFeatures, Judged, Light};
 
 /// One policy in one cell.
@@ -225,11 +226,23 @@ struct Block {
     vo: Vec<f64>,
 }
 
-/// Runs the map (None when `map.lights_e_per_s` is empty).
+/// Runs the map (None when `map.lights_e_per_s` is empty): each frame's
+/// judged window rendered once for all lights ([`Renders::Shared`]).
 pub fn benefit_map(
     cfg: &ExperimentConfig,
     quality: Quality,
     progress: bool,
+) -> Result<Option<BenefitMap>> {
+    benefit_map_with(cfg, quality, progress, Renders::Shared)
+}
+
+/// [`benefit_map`] with the frames rendered as `renders` says (the numbers
+/// do not depend on it; [`Renders::PerLight`] is the slow reference).
+pub fn benefit_map_with(
+    cfg: &ExperimentConfig,
+    quality: Quality,
+    progress: bool,
+    renders_how: Renders,
 ) -> Result<Option<BenefitMap>> {
     let m = &cfg.map;
     if m.lights_e_per_s.is_empty() {
@@ -329,6 +342,7 @@ pub fn benefit_map(
                                 quality,
                                 (renders + j) as u32,
                                 &lights,
+                                renders_how,
                             )
                         })
                         .collect::<Result<_>>()?;

@@ -9,7 +9,7 @@ use super::super::walk::Walk;
 use crate::camera::{Camera, Noise};
 use crate::error::Result;
 use crate::io::images::to_rgb8;
-use crate::render::{self, Background, Quality, Target};
+use crate::render::{self, Background, Quality, Target, Window};
 use crate::trigger::Frame;
 
 /// The window judged at each light: the blob grid padded by this many blob pitches.
@@ -71,6 +71,19 @@ pub struct Judged {
     pub corner_rep: f64,
 }
 
+/// How the map renders a frame for its lights.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Renders {
+    /// The judged window only, once for all lights (the frame and its sharp
+    /// reference: [`render::render_window`]); what the map runs.
+    #[default]
+    Shared,
+    /// The whole frame and the whole sharp reference, again for each light,
+    /// the window cut from them: the reference [`Renders::Shared`] must equal
+    /// number for number (tests).
+    PerLight,
+}
+
 /// What the matches between consecutive kept frames need of one frame.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FrameFeatures {
@@ -81,13 +94,15 @@ pub struct FrameFeatures {
 }
 
 /// Renders `frame` of `walk` on `target` (`blobs` or `blobs:0.5`, with
-/// `surround` behind it) once with the noiseless camera `cam` and returns,
+/// `surround` behind it) with the noiseless camera `cam` and returns,
 /// for each of `lights`, the blob verdict, the false alarms and the corner
 /// repeatability against the sharp frame at mid-exposure (noiseless, the
 /// same window). `seed` seeds the render's sampling lattice and the noise
-/// (RNG stream `seed * 64 + light index`). With them, the frame's
-/// described corners at each light and the board's blob centres
-/// ([`FrameFeatures`]) for the matches to the next kept frame.
+/// (RNG stream `seed * 64 + light index`). `renders` says whether the
+/// lights share one render of the window ([`Renders::Shared`]) or each
+/// renders the whole frame ([`Renders::PerLight`]); the numbers are the same.
+/// With them, the frame's described corners at each light and the board's
+/// blob centres ([`FrameFeatures`]) for the matches to the next kept frame.
 #[allow(clippy::too_many_arguments)]
 pub fn judge_at_lights(
     target: &str,
@@ -98,6 +113,7 @@ pub fn judge_at_lights(
     quality: Quality,
     seed: u32,
     lights: &[Light],
+    renders: Renders,
 ) -> Result<(Vec<Judged>, FrameFeatures)> {
     let cam = Camera { noise: None, ..cam };
     let exposure = frame.exposure_s();
@@ -106,7 +122,6 @@ pub fn judge_at_lights(
     target.surround = surround;
     let mut job = bulk_job(cam, exposure, &traj, &target, quality, seed);
     job.with_maps = false;
-    let out = render::render_frame(&job)?;
     // True blob centres at mid-exposure, as the experiment's measure.
     let mid = traj.pose_at(0.5 * cam.shutter.busy_s(exposure));
     let board_px: Vec<Option<(f64, f64)>> = target
@@ -117,59 +132,56 @@ pub fn judge_at_lights(
         .collect();
     let expected: Vec<(f64, f64)> = board_px.iter().flatten().copied().collect();
     // Noise, extraction and corners on a window around the board (the blob
-    // grid padded by WINDOW_PITCHES pitches), not the whole frame: the noise
-    // is most of the cost.
-    let (w, h) = (cam.width as usize, cam.height as usize);
-    let pad = WINDOW_PITCHES * super::super::crop::pitch_px(&expected);
-    let lo = |v: f64| (v - pad).floor().max(0.0) as usize;
-    let (xs, ys) = (expected.iter().map(|p| p.0), expected.iter().map(|p| p.1));
-    let x0 = lo(xs.clone().fold(f64::INFINITY, f64::min)).min(w - 1);
-    let y0 = lo(ys.clone().fold(f64::INFINITY, f64::min)).min(h - 1);
-    let x1 =
-        ((xs.fold(f64::NEG_INFINITY, f64::max) + pad).ceil().max(0.0) as usize).clamp(x0 + 1, w);
-    let y1 =
-        ((ys.fold(f64::NEG_INFINITY, f64::max) + pad).ceil().max(0.0) as usize).clamp(y0 + 1, h);
-    let (cw, ch) = if expected.is_empty() {
-        (w, h)
-    } else {
-        (x1 - x0, y1 - y0)
+    // grid padded by WINDOW_PITCHES pitches), not the whole frame.
+    let win = judged_window(&cam, &expected);
+    let still = corners::still_at(&job, mid)?;
+    // The noiseless frame and its sharp reference in the window: rendered
+    // once (shared) or for each light from the whole frame.
+    let whole = |j: &render::RenderJob| -> Result<Vec<f32>> {
+        Ok(win.cut(cam.width, &render::render_frame(j)?.rgb))
     };
-    let (x0, y0) = if expected.is_empty() {
-        (0, 0)
-    } else {
-        (x0, y0)
-    };
-    let cut = |rgb: &[f32]| {
-        let mut window = Vec::with_capacity(cw * ch * 3);
-        for y in y0..y0 + ch {
-            window.extend_from_slice(&rgb[3 * (y * w + x0)..3 * (y * w + x0 + cw)]);
+    let shared = match renders {
+        Renders::Shared => {
+            let sharp = render::render_window(&still, win)?;
+            Some((
+                render::render_window(&job, win)?,
+                corners::corners(&corners::luma(win.w, win.h, &sharp)?),
+            ))
         }
-        window
+        Renders::PerLight => None,
     };
-    let window = cut(&out.rgb);
-    let sharp = cut(&corners::sharp_at(&job, mid)?);
-    let sharp_corners = corners::corners(&corners::luma(cw as u32, ch as u32, &sharp)?);
+    let (cw, ch) = (win.w, win.h);
     let shifted: Vec<(f64, f64)> = expected
         .iter()
-        .map(|&(x, y)| (x - x0 as f64, y - y0 as f64))
+        .map(|&(x, y)| (x - f64::from(win.x0), y - f64::from(win.y0)))
         .collect();
     let mut ok = Vec::with_capacity(lights.len());
     let mut per_light = Vec::with_capacity(lights.len());
     for (k, light) in lights.iter().enumerate() {
-        let mut rgb = window.clone();
+        let own;
+        let (mut rgb, sharp_corners) = match &shared {
+            Some((window, sharp_corners)) => (window.clone(), sharp_corners),
+            None => {
+                own = corners::corners(&corners::luma(cw, ch, &whole(&still)?)?);
+                (whole(&job)?, &own)
+            }
+        };
         light
             .for_gain(frame.gain)
             .apply(&mut rgb, exposure, u64::from(seed) * 64 + k as u64)?;
-        let img = to_rgb8(cw as u32, ch as u32, &rgb)?;
+        let img = to_rgb8(cw, ch, &rgb)?;
         let b = blob_metrics(&img, &shifted);
         let gray = crate::assess::luma(&img);
         let found = corners::corners(&gray);
-        per_light.push(matches::features(&gray, &found, (x0 as f64, y0 as f64))?);
+        per_light.push(matches::features(
+            &gray,
+            &found,
+            (f64::from(win.x0), f64::from(win.y0)),
+        )?);
         ok.push(Judged {
             ok: b.ok,
             false_alarms: b.false_alarms,
-            corner_rep: corners::repeatability_strongest(&sharp_corners, &found)
-                .unwrap_or(f64::NAN),
+            corner_rep: corners::repeatability_strongest(sharp_corners, &found).unwrap_or(f64::NAN),
         });
     }
     Ok((
@@ -179,6 +191,36 @@ pub fn judge_at_lights(
             per_light,
         },
     ))
+}
+
+/// The window judged around the board: the projected blob centres
+/// `expected` (px) padded by [`WINDOW_PITCHES`] blob pitches, inside the
+/// image; the whole image when no centre projects.
+pub fn judged_window(cam: &Camera, expected: &[(f64, f64)]) -> Window {
+    let (w, h) = (cam.width as usize, cam.height as usize);
+    if expected.is_empty() {
+        return Window {
+            x0: 0,
+            y0: 0,
+            w: cam.width,
+            h: cam.height,
+        };
+    }
+    let pad = WINDOW_PITCHES * super::super::crop::pitch_px(expected);
+    let lo = |v: f64| (v - pad).floor().max(0.0) as usize;
+    let (xs, ys) = (expected.iter().map(|p| p.0), expected.iter().map(|p| p.1));
+    let x0 = lo(xs.clone().fold(f64::INFINITY, f64::min)).min(w - 1);
+    let y0 = lo(ys.clone().fold(f64::INFINITY, f64::min)).min(h - 1);
+    let x1 =
+        ((xs.fold(f64::NEG_INFINITY, f64::max) + pad).ceil().max(0.0) as usize).clamp(x0 + 1, w);
+    let y1 =
+        ((ys.fold(f64::NEG_INFINITY, f64::max) + pad).ceil().max(0.0) as usize).clamp(y0 + 1, h);
+    Window {
+        x0: x0 as u32,
+        y0: y0 as u32,
+        w: (x1 - x0) as u32,
+        h: (y1 - y0) as u32,
+    }
 }
 
 #[cfg(test)]
