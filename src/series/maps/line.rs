@@ -176,12 +176,12 @@ impl Line {
             bad: vec![false; n],
         };
         let mut is = vec![0.0f64; n];
-        for m in 0..n {
+        for (m, inv) in is.iter_mut().enumerate() {
             let r = ray(m);
             t.rx[m] = r.0;
             t.ry[m] = r.1;
             match self.inv_depth(DVec3::new(r.0, r.1, 1.0)) {
-                Some(x) if r.0.is_finite() && r.1.is_finite() => is[m] = x,
+                Some(x) if r.0.is_finite() && r.1.is_finite() => *inv = x,
                 _ => t.bad[m] = true,
             }
         }
@@ -278,7 +278,7 @@ mod tests {
                 let t = line.pinhole_tracks(&cam, ray, n);
                 let mut out = vec![[f32::NAN; 5]; n];
                 line.pinhole(&cam, ray, &mut out);
-                for m in 0..n {
+                for (m, o) in out.iter().enumerate() {
                     let r = DVec3::new(ray(m).0, ray(m).1, 1.0);
                     let point = ScenePoint {
                         ray: r,
@@ -295,7 +295,7 @@ mod tests {
                     let f = |x: f64| x as f32;
                     assert_eq!(&px[..3], &[f(want.disp.0), f(want.disp.1), f(want.len_px)]);
                     let close = |a: f32, b: f32| (a - b).abs() <= 1e-6 * (1.0 + a.abs());
-                    assert!(px.iter().zip(&out[m]).all(|(a, b)| close(*a, *b)));
+                    assert!(px.iter().zip(o).all(|(a, b)| close(*a, *b)));
                 }
             }
         }
