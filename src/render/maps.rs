@@ -10,9 +10,8 @@
 
 use super::target::Target;
 use crate::camera::Camera;
-use crate::model::track::{self, LineTrack};
+use crate::model::track::{self, LineTrack, ScenePoint, Step};
 use crate::model::trajectory::{Pose, Trajectory};
-use glam::{DMat3, DVec3};
 use rayon::prelude::*;
 
 /// Per-pixel blur maps, row-major, top row first.
@@ -92,10 +91,11 @@ impl BlurMaps {
 /// A pixel without a track: path, displacement (px) and path (mm) NaN.
 const NO_TRACK: (f32, f32, f64) = (f32::NAN, f32::NAN, f64::NAN);
 
-/// Poses at `steps + 1` uniform times over the whole trajectory, as
-/// (world-to-camera rotation, centre) ([`LineTrack::whole`]).
-fn inv_poses(traj: &Trajectory, steps: usize) -> Vec<(DMat3, DVec3)> {
-    LineTrack::whole(traj, steps).world_to_camera()
+/// The window of the whole trajectory in `steps` chords
+/// ([`LineTrack::whole`]): its start pose and its steps relative to it.
+fn whole(traj: &Trajectory, steps: usize) -> (Pose, Vec<Step>) {
+    let line = LineTrack::whole(traj, steps);
+    (line.start, line.relative())
 }
 
 /// Image track (pixel coordinates) of the scene point seen at `(x, y)` at
@@ -108,7 +108,8 @@ pub fn track(
     y: f64,
     steps: usize,
 ) -> Option<Vec<(f64, f64)>> {
-    track_from(cam, target, &inv_poses(traj, steps), x, y)
+    let (start, steps) = whole(traj, steps);
+    track::track(cam, &steps, &scene_point(cam, target, &start, x, y)?)
 }
 
 /// [`track()`] for many pixel positions `points` (px), the poses computed once.
@@ -119,70 +120,37 @@ pub fn tracks(
     points: &[(f64, f64)],
     steps: usize,
 ) -> Vec<Option<Vec<(f64, f64)>>> {
-    let poses = inv_poses(traj, steps);
+    let (start, steps) = whole(traj, steps);
     points
         .iter()
-        .map(|&(x, y)| track_from(cam, target, &poses, x, y))
+        .map(|&(x, y)| track::track(cam, &steps, &scene_point(cam, target, &start, x, y)?))
         .collect()
 }
 
-/// The scene point seen at pixel position `(x, y)` from pose `start`:
-/// `None` beyond the lens's radial limit or where the ray misses the target.
-fn scene_point(cam: &Camera, target: &Target, start: &Pose, x: f64, y: f64) -> Option<DVec3> {
+/// The scene point seen at pixel position `(x, y)` from pose `start`
+/// (relative to it, [`ScenePoint::from_world`]): `None` beyond the lens's
+/// radial limit or where the ray misses the target.
+fn scene_point(cam: &Camera, target: &Target, start: &Pose, x: f64, y: f64) -> Option<ScenePoint> {
     if masked(cam, x, y) {
         return None;
     }
-    target.intersect(cam, start, x, y)
-}
-
-fn track_from(
-    cam: &Camera,
-    target: &Target,
-    poses: &[(DMat3, DVec3)],
-    x: f64,
-    y: f64,
-) -> Option<Vec<(f64, f64)>> {
-    track::track(
-        cam,
-        poses,
-        scene_point(cam, target, &start_pose(poses), x, y)?,
-    )
+    let p = target.intersect(cam, start, x, y)?;
+    Some(ScenePoint::from_world(start, p))
 }
 
 /// Path length and end-to-start displacement (px) and path length on the
-/// sensor (mm) of the scene point seen at `(x, y)` at exposure start.
+/// sensor (mm) of the scene point seen at `(x, y)` from pose `start`, over
+/// `steps` relative to it ([`track::path`]).
 fn path_disp(
     cam: &Camera,
     target: &Target,
-    poses: &[(DMat3, DVec3)],
-    x: f64,
-    y: f64,
-) -> Option<(f64, f64, f64)> {
-    path_disp_from(cam, target, &start_pose(poses), poses, x, y)
-}
-
-/// The pose at exposure start of a table of [`inv_poses`]: the identity for
-/// a trajectory that starts at the world frame (every one but a clip's,
-/// whose frames start where the camera had turned to,
-/// [`super::clip`]).
-fn start_pose(poses: &[(DMat3, DVec3)]) -> Pose {
-    match poses.first() {
-        Some((r, c)) => (glam::DQuat::from_mat3(r).inverse(), *c),
-        None => (glam::DQuat::IDENTITY, DVec3::ZERO),
-    }
-}
-
-/// [`path_disp`] for the scene point seen at `(x, y)` from pose `start`
-/// ([`track::path`]).
-fn path_disp_from(
-    cam: &Camera,
-    target: &Target,
     start: &Pose,
-    poses: &[(DMat3, DVec3)],
+    steps: &[Step],
     x: f64,
     y: f64,
 ) -> Option<(f64, f64, f64)> {
-    track::path(cam, poses, scene_point(cam, target, start, x, y)?)
+    let p = track::path(cam, steps, &scene_point(cam, target, start, x, y)?)?;
+    Some((p.len_px, p.disp_px(), p.len_mm))
 }
 
 /// True for a pixel position beyond the lens's radial distortion limit: no ray.
@@ -198,8 +166,7 @@ fn masked(cam: &Camera, x: f64, y: f64) -> bool {
 /// spanning the sensor edge to edge, 256 time steps, at least the rotation
 /// bound below, times 1.1 for safety.
 pub fn max_path_px(cam: &Camera, target: &Target, traj: &Trajectory) -> f64 {
-    let poses = inv_poses(traj, 256);
-    let start = start_pose(&poses);
+    let (start, poses) = whole(traj, 256);
     let (nx, ny) = (33, 25);
     let mut m: f64 = 0.0;
     for j in 0..ny {
@@ -207,10 +174,10 @@ pub fn max_path_px(cam: &Camera, target: &Target, traj: &Trajectory) -> f64 {
             let x = cam.width as f64 * i as f64 / (nx - 1) as f64;
             let y = cam.height as f64 * j as f64 / (ny - 1) as f64;
             // The path in px only (track::path_px: path_disp's number).
-            let path =
-                scene_point(cam, target, &start, x, y).and_then(|p| track::path_px(cam, &poses, p));
-            if let Some((l, _)) = path {
-                m = m.max(l);
+            let path = scene_point(cam, target, &start, x, y)
+                .and_then(|p| track::path_px(cam, &poses, &p));
+            if let Some(p) = path {
+                m = m.max(p.len_px);
             }
         }
     }
@@ -242,7 +209,7 @@ pub fn blur_maps(
     if !cam.shutter.is_global() {
         return blur_maps_rolling(cam, target, traj, exposure_s, steps);
     }
-    let poses = inv_poses(traj, steps.max(1));
+    let (start, poses) = whole(traj, steps.max(1));
     let (w, h) = (cam.width as usize, cam.height as usize);
     let dur = traj.duration();
     // Once a stop is requested (crate::cancel) the pixels left are NaN; the
@@ -255,7 +222,7 @@ pub fn blur_maps(
                 return NO_TRACK;
             }
             let (i, j) = (idx % w, idx / w);
-            match path_disp(cam, target, &poses, i as f64 + 0.5, j as f64 + 0.5) {
+            match path_disp(cam, target, &start, &poses, i as f64 + 0.5, j as f64 + 0.5) {
                 Some((l, d, mm)) => (l as f32, d as f32, mm),
                 None => NO_TRACK,
             }
@@ -293,8 +260,7 @@ pub fn path_means(
         let m = blur_maps(cam, target, traj, exposure_s, steps).means();
         return (m.path_px, m.disp_px);
     }
-    let poses = inv_poses(traj, steps.max(1));
-    let start = start_pose(&poses);
+    let (start, poses) = whole(traj, steps.max(1));
     let w = cam.width as usize;
     let stop = crate::cancel::current();
     let vals: Vec<(f32, f32)> = (0..w * cam.height as usize)
@@ -304,8 +270,10 @@ pub fn path_means(
             let track = (!stop.is_cancelled())
                 .then(|| scene_point(cam, target, &start, i as f64 + 0.5, j as f64 + 0.5))
                 .flatten()
-                .and_then(|x| track::path_px(cam, &poses, x));
-            track.map_or((f32::NAN, f32::NAN), |(l, d)| (l as f32, d as f32))
+                .and_then(|x| track::path_px(cam, &poses, &x));
+            track.map_or((f32::NAN, f32::NAN), |p| {
+                (p.len_px as f32, p.disp_px() as f32)
+            })
         })
         .collect();
     // As BlurMaps::means: the finite pixels, in order, f64 accumulation.
@@ -341,18 +309,11 @@ fn blur_maps_rolling(
             }
             // The line's window and poses: the one per-pixel track's.
             let line = LineTrack::line(traj, &cam.shutter, cam, l, te, steps);
-            let (start, poses) = (line.start, line.world_to_camera());
+            let (start, poses) = (line.start, line.relative());
             (0..len)
                 .map(|m| {
                     let (i, j) = if rows { (m, l) } else { (l, m) };
-                    match path_disp_from(
-                        cam,
-                        target,
-                        &start,
-                        &poses,
-                        i as f64 + 0.5,
-                        j as f64 + 0.5,
-                    ) {
+                    match path_disp(cam, target, &start, &poses, i as f64 + 0.5, j as f64 + 0.5) {
                         Some((a, d, mm)) => (a as f32, d as f32, mm),
                         None => NO_TRACK,
                     }

@@ -33,6 +33,13 @@ fn maps(
 /// The renderer's maps (`render --maps`: path and displacement magnitude)
 /// on the trajectory the frame's maps use, with as many chords, agree per
 /// pixel to f32 rounding: pinhole and a wide-angle lens, several frames.
+/// Both follow the one per-pixel track (`model::track::path`); what this
+/// still checks is what each side builds for it: the frames job's
+/// trajectory and line windows from the log against the renderer's, the
+/// frames' scene point (`MapRays`' undistorted ray at infinity) against
+/// the renderer's (the ray through the lens meeting the target), and the
+/// pinhole line's vectorised track (`Line::pinhole`) against the
+/// renderer's per-pixel one.
 #[test]
 fn maps_equal_render_maps_per_pixel() {
     let Some((log, frames)) = shared("running_phone") else {

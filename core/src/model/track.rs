@@ -7,14 +7,19 @@
 //! shutter every line starts at once.
 //!
 //! [`LineTrack`] is the one owner of a line's window and of the instants a
-//! track is sampled at (`steps + 1`, uniform, `steps` chords): the
-//! renderer's blur maps (`render::maps`) project each pixel's scene point
-//! through its poses ([`path`]); the frames' maps
-//! (`series::maps`) take the same poses relative to the line's start.
+//! track is sampled at (`steps + 1`, uniform, `steps` chords), and
+//! [`ScenePoint`] with [`project`], [`track`] and [`path`] the one owner of
+//! the per-pixel track: the pixel's scene point in homogeneous form in the
+//! line's start frame (a finite point or one at infinity), projected
+//! through the lens at each of the line's poses relative to its start
+//! ([`LineTrack::relative`]), and its chords. The renderer's blur maps
+//! (`render::maps`, the point where the pixel's ray meets the target) and
+//! the frames' maps (`series::maps`, a ray and an inverse depth from the
+//! log's plane) both call them.
 
 use super::trajectory::{Pose, Trajectory};
 use crate::camera::{Camera, Shutter};
-use glam::{DMat3, DVec3};
+use glam::{DMat3, DQuat, DVec3};
 
 /// One line's exposure window on a trajectory and the camera's poses over it.
 #[derive(Debug, Clone, PartialEq)]
@@ -69,20 +74,82 @@ impl LineTrack {
         }
     }
 
-    /// The poses as (world-to-camera rotation, centre), for [`path`].
-    pub fn world_to_camera(&self) -> Vec<(DMat3, DVec3)> {
+    /// The poses relative to the line's start, as rotations (start frame
+    /// to each instant's) and the start's centre in each instant's frame
+    /// (m): what the GPU maps upload.
+    pub fn relative_quats(&self) -> Vec<(DQuat, DVec3)> {
+        let (qs, cs) = self.start;
         self.poses
             .iter()
-            .map(|(q, c)| (DMat3::from_quat(q.inverse()), *c))
+            .map(|&(q, c)| {
+                let inv = q.inverse();
+                (inv * qs, inv * (cs - c))
+            })
+            .collect()
+    }
+
+    /// [`LineTrack::relative_quats`] as matrices: the [`Step`]s of
+    /// [`project`], [`track`] and [`path`].
+    pub fn relative(&self) -> Vec<Step> {
+        self.relative_quats()
+            .into_iter()
+            .map(|(q, b)| (DMat3::from_quat(q), b))
             .collect()
     }
 }
 
-/// The pixel position (px) of the world point `x` seen from `pose`
-/// (world-to-camera rotation, centre) through `cam`'s lens; `None` behind
-/// the camera.
-pub fn project(cam: &Camera, pose: &(DMat3, DVec3), x: DVec3) -> Option<(f64, f64)> {
-    let pc = pose.0 * (x - pose.1);
+/// One instant's pose relative to a line's start: the rotation from the
+/// start's camera frame to the instant's, and the offset of the start's
+/// centre in the instant's frame (m) ([`LineTrack::relative`]).
+pub type Step = (DMat3, DVec3);
+
+/// The scene point a pixel sees at its line's start, in homogeneous form in
+/// the start's camera frame: the point is `ray / inv_depth` (m), and
+/// `inv_depth = 0` is a point at infinity (rotation only). Seen from an
+/// instant `(M, b)` ([`Step`]) it lies along `M ray + b inv_depth`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ScenePoint {
+    /// A direction to the point in the start's camera frame (any length).
+    pub ray: DVec3,
+    /// The inverse of the point's distance in units of `ray` (0: at infinity).
+    pub inv_depth: f64,
+}
+
+impl ScenePoint {
+    /// The world point `x` (m) seen from `start` (camera-to-world rotation,
+    /// centre): its start-frame position, `inv_depth` 1.
+    pub fn from_world(start: &Pose, x: DVec3) -> Self {
+        ScenePoint {
+            ray: start.0.inverse() * (x - start.1),
+            inv_depth: 1.0,
+        }
+    }
+}
+
+/// Path length (px), end-minus-start displacement (px) and path length on
+/// the sensor (mm) of a scene point's track (the sum of its chords).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TrackPath {
+    /// Sum of the track's chords, px.
+    pub len_px: f64,
+    /// End minus start position, px (x right, y down).
+    pub disp: (f64, f64),
+    /// Sum of the chords on the sensor, mm (0 from [`path_px`]).
+    pub len_mm: f64,
+}
+
+impl TrackPath {
+    /// The displacement's magnitude, px.
+    pub fn disp_px(&self) -> f64 {
+        (self.disp.0.powi(2) + self.disp.1.powi(2)).sqrt()
+    }
+}
+
+/// The pixel position (px) of `point` seen from `step` (relative to the
+/// point's start frame) through `cam`'s lens; `None` behind the camera.
+#[inline]
+pub fn project(cam: &Camera, step: &Step, point: &ScenePoint) -> Option<(f64, f64)> {
+    let pc = step.0 * point.ray + step.1 * point.inv_depth;
     (pc.z > 1e-12).then(|| {
         if cam.distortion.is_none() {
             cam.mm_to_pixel(cam.focal_mm * pc.x / pc.z, cam.focal_mm * pc.y / pc.z)
@@ -92,49 +159,44 @@ pub fn project(cam: &Camera, pose: &(DMat3, DVec3), x: DVec3) -> Option<(f64, f6
     })
 }
 
-/// The track (px) of the world point `x` at each of `poses`
-/// ([`LineTrack::world_to_camera`]); `None` when it goes behind the camera.
-pub fn track(cam: &Camera, poses: &[(DMat3, DVec3)], x: DVec3) -> Option<Vec<(f64, f64)>> {
-    poses.iter().map(|p| project(cam, p, x)).collect()
+/// The track (px) of `point` at each of `steps` ([`LineTrack::relative`]);
+/// `None` when it goes behind the camera.
+pub fn track(cam: &Camera, steps: &[Step], point: &ScenePoint) -> Option<Vec<(f64, f64)>> {
+    steps.iter().map(|s| project(cam, s, point)).collect()
 }
 
-/// Path length (px), end-to-start displacement magnitude (px) and path
-/// length on the sensor (mm) of the world point `x`'s track over `poses`
-/// ([`LineTrack::world_to_camera`]: the sum of its chords); `None` when it
-/// goes behind the camera.
-pub fn path(cam: &Camera, poses: &[(DMat3, DVec3)], x: DVec3) -> Option<(f64, f64, f64)> {
-    chords::<true>(cam, poses, x)
+/// The path of `point`'s track over `steps` ([`LineTrack::relative`]): px,
+/// displacement and mm; `None` when it goes behind the camera.
+pub fn path(cam: &Camera, steps: &[Step], point: &ScenePoint) -> Option<TrackPath> {
+    chords::<true>(cam, steps, point)
 }
 
-/// [`path`]'s path length and displacement (px), the same numbers, without
-/// the path on the sensor in mm (half the work: no millimetre chords).
-pub fn path_px(cam: &Camera, poses: &[(DMat3, DVec3)], x: DVec3) -> Option<(f64, f64)> {
-    chords::<false>(cam, poses, x).map(|(len, disp, _)| (len, disp))
+/// [`path`] without the path on the sensor in mm (`len_mm` 0; half the
+/// work: no millimetre chords), the same px numbers.
+pub fn path_px(cam: &Camera, steps: &[Step], point: &ScenePoint) -> Option<TrackPath> {
+    chords::<false>(cam, steps, point)
 }
 
 /// [`path`]; the millimetre path only when `MM` (else 0).
-fn chords<const MM: bool>(
-    cam: &Camera,
-    poses: &[(DMat3, DVec3)],
-    x: DVec3,
-) -> Option<(f64, f64, f64)> {
-    let first = project(cam, &poses[0], x)?;
+fn chords<const MM: bool>(cam: &Camera, steps: &[Step], point: &ScenePoint) -> Option<TrackPath> {
+    let first = project(cam, steps.first()?, point)?;
     let mut prev = first;
     let (mut len, mut len_mm) = (0.0, 0.0);
-    for p in &poses[1..] {
-        let q = project(cam, p, x)?;
-        len += ((q.0 - prev.0).powi(2) + (q.1 - prev.1).powi(2)).sqrt();
+    for s in &steps[1..] {
+        let q = project(cam, s, point)?;
+        let (du, dv) = (q.0 - prev.0, q.1 - prev.1);
+        len += (du * du + dv * dv).sqrt();
         if MM {
             let (a, b) = (cam.pixel_to_mm(q.0, q.1), cam.pixel_to_mm(prev.0, prev.1));
             len_mm += (a.0 - b.0).hypot(a.1 - b.1);
         }
         prev = q;
     }
-    Some((
-        len,
-        ((prev.0 - first.0).powi(2) + (prev.1 - first.1).powi(2)).sqrt(),
+    Some(TrackPath {
+        len_px: len,
+        disp: (prev.0 - first.0, prev.1 - first.1),
         len_mm,
-    ))
+    })
 }
 
 #[cfg(test)]
@@ -169,20 +231,95 @@ mod tests {
         assert!((angle(&w.poses[3]) - 0.03).abs() < 1e-12);
     }
 
+    /// The relative steps of a twist's whole trajectory.
+    fn steps(omega: DVec3, v: DVec3, t: f64, n: usize) -> Vec<Step> {
+        let traj = Trajectory::from_twist(Twist::new(omega, v), t).unwrap();
+        LineTrack::whole(&traj, n).relative()
+    }
+
     /// A point on the optical axis 2 m ahead, the camera moving 0.1 m
     /// sideways: the pinhole track moves by f x / z = 0.1 * focal / 2 on
-    /// the sensor, a straight path (length equals displacement).
+    /// the sensor, a straight path (length equals displacement), to the
+    /// left; a point behind the camera has no track.
     #[test]
     fn a_sideways_move_tracks_a_straight_path() {
         let cam = Camera::thesis();
-        let traj = Trajectory::from_twist(Twist::new(DVec3::ZERO, DVec3::new(1.0, 0.0, 0.0)), 0.1)
-            .unwrap();
-        let poses = LineTrack::whole(&traj, 8).world_to_camera();
-        let (len, disp, len_mm) = path(&cam, &poses, DVec3::new(0.0, 0.0, 2.0)).unwrap();
+        let st = steps(DVec3::ZERO, DVec3::new(1.0, 0.0, 0.0), 0.1, 8);
+        let start = (DQuat::IDENTITY, DVec3::ZERO);
+        let p = path(
+            &cam,
+            &st,
+            &ScenePoint::from_world(&start, DVec3::new(0.0, 0.0, 2.0)),
+        )
+        .unwrap();
         let mm = 0.1 * cam.focal_mm / 2.0;
-        assert!((len_mm - mm).abs() < 1e-9, "{len_mm} vs {mm}");
-        assert!((len - mm / cam.pitch_x_mm).abs() < 1e-6);
-        assert!((len - disp).abs() < 1e-9);
-        assert!(path(&cam, &poses, DVec3::new(0.0, 0.0, -2.0)).is_none());
+        assert!((p.len_mm - mm).abs() < 1e-9, "{} vs {mm}", p.len_mm);
+        assert!((p.len_px - mm / cam.pitch_x_mm).abs() < 1e-6);
+        assert!((p.len_px - p.disp_px()).abs() < 1e-9);
+        assert!((p.disp.0 + mm / cam.pitch_x_mm).abs() < 1e-6 && p.disp.1.abs() < 1e-9);
+        let behind = ScenePoint::from_world(&start, DVec3::new(0.0, 0.0, -2.0));
+        assert!(path(&cam, &st, &behind).is_none());
+        assert!(track(&cam, &st, &behind).is_none());
+    }
+
+    /// A plane at depth Z moving sideways at v for T: every pixel's path is
+    /// f v T / Z (px: f in px), the same for a point given by its ray and
+    /// inverse depth (`ray (x, y, 1)`, `inv_depth 1 / Z`) as for the world
+    /// point; a point at infinity does not move.
+    #[test]
+    fn a_plane_at_depth_z_moves_f_v_t_over_z() {
+        let cam = Camera::thesis();
+        let (v, t, z) = (0.4, 0.05, 3.0);
+        let st = steps(DVec3::ZERO, DVec3::new(0.0, v, 0.0), t, 16);
+        let f_px = cam.fy_px();
+        for (x, y) in [(0.0, 0.0), (0.2, -0.1), (-0.3, 0.25)] {
+            let p = ScenePoint {
+                ray: DVec3::new(x, y, 1.0),
+                inv_depth: 1.0 / z,
+            };
+            let got = path(&cam, &st, &p).unwrap();
+            let want = f_px * v * t / z;
+            assert!(
+                (got.len_px - want).abs() < 1e-9 * want,
+                "{} vs {want}",
+                got.len_px
+            );
+            assert!((got.disp.1 + want).abs() < 1e-9 * want && got.disp.0.abs() < 1e-9);
+            let world = ScenePoint::from_world(&(DQuat::IDENTITY, DVec3::ZERO), p.ray * z);
+            let w = path(&cam, &st, &world).unwrap();
+            assert!((w.len_px - got.len_px).abs() < 1e-9 * want);
+            let far = ScenePoint {
+                inv_depth: 0.0,
+                ..p
+            };
+            assert!(path(&cam, &st, &far).unwrap().len_px.abs() < 1e-12);
+        }
+    }
+
+    /// A pure yaw at omega for T, the point at infinity on the optical
+    /// axis: its track is an arc of f omega T px (f in px), in chords of
+    /// f tan; the centre pixel's path converges to it.
+    #[test]
+    fn a_pure_yaw_at_infinity_moves_f_omega_t() {
+        let cam = Camera::thesis();
+        let (w, t) = (0.3, 0.02);
+        let st = steps(DVec3::new(0.0, w, 0.0), DVec3::ZERO, t, 64);
+        let p = ScenePoint {
+            ray: DVec3::Z,
+            inv_depth: 0.0,
+        };
+        let got = path(&cam, &st, &p).unwrap();
+        // On the axis the image moves by f tan(angle): f tan(omega T) in all.
+        let want = cam.fx_px() * (w * t).tan();
+        assert!(
+            (got.len_px - want).abs() < 1e-9 * want,
+            "{} vs {want}",
+            got.len_px
+        );
+        assert!((got.len_px - cam.fx_px() * w * t).abs() < 1e-4 * want);
+        assert!((got.disp_px() - want).abs() < 1e-9 * want);
+        // Turned past 90 degrees the point goes behind the camera.
+        let st = steps(DVec3::new(0.0, 2.0, 0.0), DVec3::ZERO, 1.0, 8);
+        assert!(path(&cam, &st, &p).is_none());
     }
 }
