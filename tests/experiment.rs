@@ -18,7 +18,7 @@ mod experiment;
 mod experiment_map;
 #[path = "experiment/policy_config.rs"]
 mod policy_config;
-#[path = "experiment/vo.rs"]
-mod vo;
 #[path = "experiment/speed.rs"]
 mod speed;
+#[path = "experiment/vo.rs"]
+mod vo;
