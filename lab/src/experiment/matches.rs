@@ -1,7 +1,7 @@
 //! The odometry task as odometry consumes it: feature matches between
 //! consecutive kept frames (docs/spec.md section 11).
 //!
-//! Each frame's FAST-9 corners ([`super::corners::corners`], strongest
+//! Each frame's FAST-9 corners (the experiment's `corners::corners`, strongest
 //! first; at most [`MAX_FEATURES`], those at least [`EDGE_PX`] px inside the
 //! image) are described by 256-bit BRIEF descriptors
 //! ([`imageproc::binary_descriptors::brief::brief`], with the fixed test pairs
@@ -90,7 +90,7 @@ pub fn test_pairs() -> &'static Vec<TestPair> {
 }
 
 /// Describes the corners `corners` (px in `gray`, strongest first, as
-/// [`super::corners::corners`] gives them) of the window `gray`, whose
+/// the experiment's `corners::corners` gives them) of the window `gray`, whose
 /// top-left pixel is at `offset` px in the full frame.
 pub fn features(gray: &GrayImage, corners: &[(f64, f64)], offset: (f64, f64)) -> Result<Features> {
     let (w, h) = gray.dimensions();
@@ -120,12 +120,12 @@ pub fn features(gray: &GrayImage, corners: &[(f64, f64)], offset: (f64, f64)) ->
     })
 }
 
-/// The FAST-9 corners the matches describe ([`super::corners::corners`]).
+/// The FAST-9 corners the matches describe (the experiment's `corners::corners`).
 pub fn corners(gray: &GrayImage) -> Vec<(f64, f64)> {
     super::corners::corners(gray)
 }
 
-/// [`features`] of `gray`'s own FAST-9 corners ([`super::corners::corners`]),
+/// [`features`] of `gray`'s own FAST-9 corners (the experiment's `corners::corners`),
 /// at offset zero.
 pub fn describe(gray: &GrayImage) -> Result<Features> {
     features(gray, &corners(gray), (0.0, 0.0))

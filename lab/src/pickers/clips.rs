@@ -5,7 +5,7 @@
 //! recorded of the same motion (noise, bias, a known clock offset; seeded).
 //!
 //! Truth per frame (px): the renderer's blur maps' mean path length over
-//! the pixels that see the scene ([`FrameTruth::mean_px`]). In the
+//! the pixels that see the scene ([`mmbm::render::clip::FrameTruth::mean_px`]). In the
 //! **defocus** stretch the rendered frame is also convolved with a disc of
 //! diameter `D` px and its truth is the motion's mean path plus `D` (the
 //! extent of a point's image, motion then defocus). In the **optical

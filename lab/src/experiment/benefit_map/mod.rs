@@ -236,7 +236,7 @@ pub fn benefit_map(
     benefit_map_with(cfg, quality, progress, Renders::Shared)
 }
 
-/// [`benefit_map`] with the frames rendered as `renders` says (the numbers
+/// `benefit_map` (the crate's default: shared renders) with the frames rendered as `renders` says (the numbers
 /// do not depend on it; [`Renders::PerLight`] is the slow reference).
 pub fn benefit_map_with(
     cfg: &ExperimentConfig,
