@@ -20,8 +20,7 @@ read from the map's cell at 20,000 e-/s (the same frames, seeds, window and verd
 over 2-s blocks of the walks; then the experiment's own frames (its seed, judged whole: a different sample); --full pools seeds 1-5 over the slow (35 s), moderate (16 s) and fast (5 s)
 walks.
 
-Time on 2 idle cores (estimated from CPU time on 2026-12-03, docs/performance.md): about 4 min 35 s; --full about
-1 h 40 min.
+Time on the 2-core VM (measured 2026-12-03, docs/performance.md): about 5 min; --full about 2 h 36 min.
 
 Examples:
   mmbm demo

@@ -4,7 +4,9 @@
 /// The `q`-th percentile (0..100, clamped) with linear interpolation between
 /// order statistics: rank `q / 100 * (n - 1)` of the sorted values (NumPy's
 /// default, `method="linear"`). NaN values sort last (`f64::total_cmp`).
-/// `None` for an empty slice.
+/// Infinite values are order statistics like any other: a rank on one of
+/// them, or between a finite value and `+inf`, is that infinity (never the
+/// NaN that `inf - inf` would give). `None` for an empty slice.
 pub fn percentile(x: &[f64], q: f64) -> Option<f64> {
     if x.is_empty() {
         return None;
@@ -14,7 +16,14 @@ pub fn percentile(x: &[f64], q: f64) -> Option<f64> {
     let r = (q / 100.0).clamp(0.0, 1.0) * (v.len() - 1) as f64;
     let lo = r.floor() as usize;
     let hi = r.ceil() as usize;
-    Some(v[lo] + (r - lo as f64) * (v[hi] - v[lo]))
+    let (a, b, f) = (v[lo], v[hi], r - lo as f64);
+    Some(if f == 0.0 || a == b || a.is_infinite() {
+        a
+    } else if b.is_infinite() {
+        b
+    } else {
+        a + f * (b - a)
+    })
 }
 
 /// The arithmetic mean; `None` for an empty slice.
@@ -74,6 +83,17 @@ pub fn spearman(x: &[f64], y: &[f64]) -> Option<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn percentile_keeps_infinities() {
+        let inf = f64::INFINITY;
+        // Ranks 0, 1 and 1.5 of [1, 2, inf]: 1, 2 and (between 2 and inf) inf.
+        assert_eq!(percentile(&[1.0, 2.0, inf], 0.0), Some(1.0));
+        assert_eq!(percentile(&[1.0, 2.0, inf], 50.0), Some(2.0));
+        assert_eq!(percentile(&[inf, 1.0, 2.0], 75.0), Some(inf));
+        assert_eq!(percentile(&[inf, inf], 50.0), Some(inf));
+        assert_eq!(percentile(&[-inf, 0.0], 50.0), Some(-inf));
+    }
 
     #[test]
     fn percentile_interpolates_like_numpy() {

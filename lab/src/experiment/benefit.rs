@@ -130,8 +130,13 @@ pub fn baseline(policies: &[PolicySpec]) -> Option<usize> {
         .or_else(|| policies.iter().position(|p| p.is_baseline()))
 }
 
-fn estimate(value: f64, mut draws: Vec<f64>) -> Estimate {
-    draws.retain(|x| x.is_finite());
+/// `value` with the 2.5th and 97.5th percentiles of the bootstrap `draws`.
+/// A ratio's draw is `+inf` where the resampled baseline got no sharp frame
+/// and the policy some: it is kept (it is the resample's ratio, and dropping
+/// it would pull the interval down); NaN draws (neither got any) carry no
+/// comparison and are dropped. Both bounds NaN when no draw is left.
+pub(crate) fn estimate(value: f64, mut draws: Vec<f64>) -> Estimate {
+    draws.retain(|x| !x.is_nan());
     if draws.is_empty() {
         return Estimate {
             value,
@@ -478,6 +483,22 @@ mod tests {
                 ..FrameMeasure::default()
             }),
         }
+    }
+
+    #[test]
+    fn infinite_draws_are_kept_nan_draws_dropped() {
+        let inf = f64::INFINITY;
+        // 40 resamples: 38 finite ratios 1..=38, two where the baseline got
+        // nothing (+inf), two where neither did (NaN, dropped).
+        let mut draws: Vec<f64> = (1..=38).map(f64::from).collect();
+        draws.extend([inf, inf, f64::NAN, f64::NAN]);
+        let e = estimate(2.0, draws);
+        // Rank 0.025 x 39 = 0.975 lies between 1 and 2: 1.975; rank
+        // 0.975 x 39 = 38.025 between the two infinities: inf.
+        assert!((e.lo - 1.975).abs() < 1e-12, "{e:?}");
+        assert_eq!(e.hi, inf);
+        let none = estimate(f64::NAN, vec![f64::NAN; 3]);
+        assert!(none.lo.is_nan() && none.hi.is_nan());
     }
 
     #[test]

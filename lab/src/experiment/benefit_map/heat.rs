@@ -183,6 +183,7 @@ fn short(e: &Option<Estimate>) -> String {
             format!("{:.2}x [{:.2}, {:.2}]", e.value, e.lo, e.hi)
         }
         Some(e) if e.value.is_finite() => format!("{:.2}x", e.value),
+        Some(e) if e.value == f64::INFINITY => "unbounded".into(),
         _ => "n/a".into(),
     }
 }

@@ -21,7 +21,7 @@ pub(crate) mod render;
 pub(crate) mod report;
 pub(crate) mod verdict;
 
-use super::benefit::{bootstrap_indices, Estimate, WalkBlocks};
+use super::benefit::{bootstrap_indices, estimate, Estimate, WalkBlocks};
 use super::config::ExperimentConfig;
 use super::matches::{inliers as match_inliers, true_homography, TRACK_MIN};
 use super::walk::{make_walk, Walk};
@@ -29,7 +29,6 @@ use crate::camera::Noise;
 use crate::error::Result;
 use crate::metric::Scene;
 use crate::render::Quality;
-use crate::stats::percentile;
 use crate::trigger::{Frame, PolicyFamily, PolicySpec};
 use rayon::prelude::*;
 pub use render::Renders;
@@ -560,14 +559,8 @@ fn cell(
     }
 }
 
-/// A point estimate and the 95 % percentile interval of its finite `draws`
-/// (NaN bounds when none is finite).
+/// A point estimate and the 95 % percentile interval of its `draws`
+/// ([`estimate`]: infinite ratios kept, NaN ones dropped).
 fn interval(value: f64, draws: impl Iterator<Item = f64>) -> Estimate {
-    let mut draws: Vec<f64> = draws.filter(|x| x.is_finite()).collect();
-    draws.sort_by(f64::total_cmp);
-    Estimate {
-        value,
-        lo: percentile(&draws, 2.5).unwrap_or(f64::NAN),
-        hi: percentile(&draws, 97.5).unwrap_or(f64::NAN),
-    }
+    estimate(value, draws.collect())
 }

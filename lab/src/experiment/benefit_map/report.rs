@@ -7,7 +7,7 @@ use super::super::benefit::{Estimate, BLOCK_S, BOOTSTRAP_SEED, RESAMPLES};
 use super::super::corners::{FAST_THRESHOLD, MATCH_PX, NMS_RADIUS, REPEAT_OK};
 use super::super::matches::{BRIEF_BITS, INLIER_PX, MAX_FEATURES, RATIO, TRACK_MIN};
 pub use super::heat::heat_map_png;
-use super::verdict::column;
+use super::verdict::{column, ratio_text};
 use super::{BenefitMap, Cell};
 use std::path::Path;
 
@@ -15,14 +15,7 @@ use std::path::Path;
 pub const DIM_LIGHT: f64 = 1_000.0;
 
 fn ci(e: &Estimate) -> String {
-    if !e.value.is_finite() {
-        return "n/a (the baseline gets no sharp frame)".into();
-    }
-    if e.lo.is_finite() {
-        format!("{:.2}x [{:.2}, {:.2}]", e.value, e.lo, e.hi)
-    } else {
-        format!("{:.2}x", e.value)
-    }
+    ratio_text(e)
 }
 
 fn opt(e: &Option<Estimate>) -> String {

@@ -6,7 +6,10 @@
 //! baselines the map compares it with: the best fixed exposure in hindsight,
 //! the best auto-exposure and the best `gyro-exposure` policy (the smallest
 //! ratio). It **pays** when every ratio's 95 % interval lies above 1, it
-//! **loses** when one lies below 1, and it **ties** otherwise.
+//! **loses** when one lies below 1, and it **ties** otherwise. A baseline
+//! that gets no sharp frame where the policy gets some is a ratio of `+inf`
+//! with the interval `[inf, inf]` (above 1); where neither gets one the
+//! ratio is NaN and neither above nor below 1.
 
 use super::super::benefit::Estimate;
 use super::{BenefitMap, Cell};
@@ -53,6 +56,23 @@ pub fn cell_verdict(c: &Cell) -> Option<(Verdict, &'static str, Estimate, usize)
     Some((verdict, strongest.0, strongest.1, strongest.2))
 }
 
+/// A ratio with its interval as the report writes it: `1.26x [1.14, 1.40]`
+/// (an upper bound `inf` where some resamples leave the baseline without a
+/// sharp frame); `unbounded` where the baseline gets no sharp frame at all
+/// and the policy some (it pays against that baseline: its interval is
+/// `[inf, inf]`); `n/a` where neither gets one.
+pub fn ratio_text(e: &Estimate) -> String {
+    if e.value == f64::INFINITY {
+        "unbounded (the baseline gets none)".into()
+    } else if !e.value.is_finite() {
+        "n/a (neither gets any)".into()
+    } else if e.lo.is_finite() {
+        format!("{:.2}x [{:.2}, {:.2}]", e.value, e.lo, e.hi)
+    } else {
+        format!("{:.2}x", e.value)
+    }
+}
+
 /// The three lines: pays, ties, loses (each naming its cells with the ratio
 /// to the strongest baseline, its interval and that baseline).
 pub fn three_lines(m: &BenefitMap) -> [String; 3] {
@@ -69,13 +89,11 @@ pub fn three_lines(m: &BenefitMap) -> [String; 3] {
             Verdict::Loses => 2,
         };
         parts[k].push(format!(
-            "{} e-/s, {}: `{}` {:.2}x [{:.2}, {:.2}] over {name} (`{}`)",
+            "{} e-/s, {}: `{}` {} over {name} (`{}`)",
             c.light,
             column(c),
             b.policy,
-            e.value,
-            e.lo,
-            e.hi,
+            ratio_text(&e),
             c.policies[bi].policy
         ));
     }
@@ -191,11 +209,45 @@ mod tests {
             seconds: 0.0,
         };
         let [pays, ties, loses] = three_lines(&m);
+        assert!(!pays.contains("NaN") && !pays.contains("inf"), "{pays}");
         assert!(pays.contains("in 1 of 2 cells: 1000 e-/s, moderate, half board: `deadline:5` 1.20x [1.10, 1.30] over gyro-aware exposure (`ae-blur:5:1`)"), "{pays}");
         assert_eq!(ties, "It ties in no cell of 2.");
         assert!(
             loses.starts_with("It loses in 1 of 2 cells: 1000 e-/s"),
             "{loses}"
         );
+    }
+
+    #[test]
+    fn a_baseline_without_sharp_frames_is_beaten_not_tied() {
+        let inf = f64::INFINITY;
+        let mut c = cell((1.5, 2.5), (1.1, 1.3));
+        c.ae = Some(2);
+        c.vs_ae = Some(Estimate {
+            value: inf,
+            lo: inf,
+            hi: inf,
+        });
+        let (v, name, e, _) = cell_verdict(&c).unwrap();
+        assert_eq!((v, name), (Verdict::Pays, "gyro-aware exposure"));
+        assert!((e.value - 1.2).abs() < 1e-12);
+        // Neither gets a sharp frame: no comparison, so no longer a pay.
+        c.vs_ae = Some(Estimate {
+            value: f64::NAN,
+            lo: f64::NAN,
+            hi: f64::NAN,
+        });
+        assert_eq!(cell_verdict(&c).unwrap().0, Verdict::Ties);
+        // Only the infinite ratio: it is the strongest, and written as such.
+        c.vs_hindsight = None;
+        c.vs_gyro = None;
+        c.vs_ae = Some(Estimate {
+            value: inf,
+            lo: inf,
+            hi: inf,
+        });
+        let (v, _, e, _) = cell_verdict(&c).unwrap();
+        assert_eq!(v, Verdict::Pays);
+        assert_eq!(ratio_text(&e), "unbounded (the baseline gets none)");
     }
 }
