@@ -218,3 +218,43 @@ fn readme_cli_example_prints_what_it_quotes() {
     }
     assert!(d.path().join("frames.csv").exists());
 }
+
+/// The README's `<!-- full-map -->` block quotes the three opening lines of
+/// the whole map's committed report (`demo --full`'s map, docs/results/) word
+/// for word: where gyro-driven capture pays, ties and loses.
+#[test]
+fn readme_quotes_the_full_maps_three_lines() {
+    let readme = read(Path::new("README.md"));
+    let quoted: Vec<&str> = readme
+        .lines()
+        .skip_while(|l| *l != "<!-- full-map -->")
+        .take_while(|l| *l != "<!-- /full-map -->")
+        .filter(|l| l.starts_with("- "))
+        .collect();
+    let source = readme
+        .lines()
+        .skip_while(|l| *l != "<!-- /full-map -->")
+        .find_map(|l| {
+            l.split("](")
+                .filter_map(|p| p.split(')').next())
+                .find(|p| p.starts_with("docs/results/") && p.ends_with("/report.md"))
+        })
+        .expect("the README links the full map's report after the block");
+    let report = read(Path::new(source));
+    let opening: Vec<&str> = report
+        .lines()
+        .skip_while(|l| !l.starts_with("- "))
+        .take_while(|l| l.starts_with("- "))
+        .collect();
+    assert_eq!(opening.len(), 3, "{source}: three opening lines");
+    assert_eq!(
+        quoted, opening,
+        "README.md's full-map block against {source}"
+    );
+    for (line, start) in opening
+        .iter()
+        .zip(["- Gyro-driven capture", "- It ties", "- It loses"])
+    {
+        assert!(line.starts_with(start), "{line}");
+    }
+}

@@ -30,11 +30,12 @@ pub(crate) mod sweep;
 pub(crate) mod truth;
 pub(crate) mod walk;
 
-pub use benefit_map::report::{answer as map_answer, timing_verdict};
+pub use benefit_map::heat::heat_map_png;
+pub use benefit_map::report::{answer as map_answer, map_md, timing_verdict};
 pub use benefit_map::verdict::{cell_verdict, three_lines, Verdict};
 pub use benefit_map::{benefit_map_with, BenefitMap, Cell, CellPolicy, Renders};
 pub use config::{ExperimentConfig, MapSection, WalkTimes, DEMO_POLICIES};
-pub use headline_view::{headline_cell, headlines_of};
+pub use headline_view::{headline_cell, headline_view_md, headlines_of};
 pub use matches::TRACK_MIN;
 pub use report::{table_6, Outcome};
 pub use run::{run, writes};
