@@ -3,15 +3,18 @@
 //! same frames, windows, verdict and report section as `demo --full`. Writes
 //! `OUT/report.md` (the three lines, the map with the timing, second-task and
 //! goal sections, the headline read from the map, the configuration) and
-//! `OUT/benefit_map.png`; prints the wall time.
+//! `OUT/benefit_map.png` (the report states the map's time); prints the
+//! map's answer lines.
 //!
 //! ```text
 //! cargo run --release -p mmbm-lab --example full_map -- OUT
 //! ```
+use mmbm::error::Error;
+use mmbm::io::atomic::write_atomic;
 use mmbm::render::Quality;
 use mmbm_lab::experiment::{
-    benefit_map_with, headline_view_md, heat_map_png, map_answer, map_md, three_lines,
-    ExperimentConfig, Renders,
+    benefit_map_with, headline_view_md, heat_map_png, map_answer, opening_md, ExperimentConfig,
+    Renders,
 };
 use std::path::PathBuf;
 
@@ -25,7 +28,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     cfg.validate()?;
     let map = benefit_map_with(&cfg, Quality::Default, true, Renders::Shared)?
         .ok_or("demo --full has a map")?;
-    std::fs::create_dir_all(&out)?;
+    std::fs::create_dir_all(&out).map_err(|e| Error::io(&out, e))?;
     let figure = "benefit_map.png";
     heat_map_png(&out.join(figure), &map)?;
     let mut s = String::from("# The benefit map of `mmbm demo --full`\n\n");
@@ -36,22 +39,18 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         map.lights.len(),
         map.seconds
     );
-    for line in three_lines(&map) {
-        s += &format!("- {line}\n");
-    }
-    s += "\n";
-    s += &map_md(&map, Some(figure));
+    s += &opening_md(&map, Some(figure));
     if let Some(view) = headline_view_md(&cfg, &map) {
         s += &view;
     }
     s += "\n## Configuration\n\n```toml\n";
     s += &cfg.to_toml();
     s += "```\n";
-    // Written whole or not at all.
-    let tmp = out.join(".report.md.tmp");
-    std::fs::write(&tmp, s)?;
-    std::fs::rename(&tmp, out.join("report.md"))?;
-    for line in map_answer(&map, &out.join("report.md")) {
+    let report = out.join("report.md");
+    write_atomic(&report, |w| {
+        w.write_all(s.as_bytes()).map_err(|e| Error::io(&report, e))
+    })?;
+    for line in map_answer(&map, &report) {
         println!("{line}");
     }
     Ok(())

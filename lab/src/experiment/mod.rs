@@ -31,7 +31,7 @@ pub(crate) mod truth;
 pub(crate) mod walk;
 
 pub use benefit_map::heat::heat_map_png;
-pub use benefit_map::report::{answer as map_answer, map_md, timing_verdict};
+pub use benefit_map::report::{answer as map_answer, opening_md, timing_verdict};
 pub use benefit_map::verdict::{cell_verdict, three_lines, Verdict};
 pub use benefit_map::{benefit_map_with, BenefitMap, Cell, CellPolicy, Renders};
 pub use config::{ExperimentConfig, MapSection, WalkTimes, DEMO_POLICIES};

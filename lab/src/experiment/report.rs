@@ -415,11 +415,7 @@ pub fn report_md(
         .map(|w| w.runs.iter().map(|(p, _)| p.clone()).collect())
         .unwrap_or_default();
     if let Some(m) = &o.map {
-        for line in super::benefit_map::verdict::three_lines(m) {
-            s += &format!("- {line}\n");
-        }
-        s += "\n";
-        s += &super::benefit_map::report::map_md(
+        s += &super::benefit_map::report::opening_md(
             m,
             figs.iter()
                 .find(|f| f.as_str() == MAP_FIGURE)

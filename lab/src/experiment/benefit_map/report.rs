@@ -42,6 +42,17 @@ pub fn timing_verdict(c: &Cell) -> &'static str {
     }
 }
 
+/// The report's opening: the three lines of [`super::verdict::three_lines`]
+/// as a list, then the map's section (`map_md`, with the timing, second-task and goal sections).
+pub fn opening_md(m: &BenefitMap, figure: Option<&str>) -> String {
+    let mut s = String::new();
+    for line in super::verdict::three_lines(m) {
+        s += &format!("- {line}\n");
+    }
+    s += "\n";
+    s + &map_md(m, figure)
+}
+
 /// The map's section of the report.
 pub fn map_md(m: &BenefitMap, figure: Option<&str>) -> String {
     let mut s =
