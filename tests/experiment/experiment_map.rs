@@ -195,8 +195,12 @@ fn the_demo_configurations() {
     assert_eq!(d.walk_duration_s(mmbm::sim::Gait::Moderate), 16.0);
     assert_eq!(d.map.seeds.len(), 5);
     let f = ExperimentConfig::demo_full();
-    assert_eq!(f.walks, ["slow", "moderate", "fast"]);
-    assert_eq!(f.map.gaits.len(), 3);
+    // The experiment's own frames are the demo's; the map is the whole one.
+    assert_eq!(f.walks, d.walks);
+    assert_eq!((f.seed_list(), &f.policies), (d.seed_list(), &d.policies));
+    assert!(f.sweep_exposures_s.is_empty());
+    assert_eq!(f.map.gaits, ["slow", "moderate", "fast"]);
+    assert_eq!(f.map.seeds, [1, 2, 3, 4, 5]);
     assert_eq!(f.map.boards, ["blobs:0.5", "blobs"]);
     assert!(f.map.lights_e_per_s.contains(&500.0) && f.map.lights_e_per_s.contains(&100_000.0));
     assert_eq!(
