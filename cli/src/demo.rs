@@ -17,15 +17,16 @@ at 20,000 e-/s, the board in front of a textured poster (clutter and corners). T
 benefit map (light x gait x board against the best fixed exposure, auto-exposure and gyro-aware exposure; sharp
 frames/s by the blob verdict and VO frames/s), then the headline: sharp frames per second per policy against fixed:5,
 read from the map's cell at 20,000 e-/s (the same frames, seeds, window and verdict), with 95 % bootstrap intervals
-over 2-s blocks of the walks; then the experiment's own frames (its seed, judged whole: a different sample); --full pools seeds 1-5 over the slow (35 s), moderate (16 s) and fast (5 s)
-walks.
+over 2-s blocks of the walks; then the experiment's own frames (its seed, judged whole: a different sample). --full runs the whole map: the slow
+(35 s), moderate (16 s) and fast (5 s) walks, both boards, six lights from 500 to 100,000 e-/s, seeds 1-5; the
+experiment's own frames stay the demo's.
 
-Time on the 2-core VM (measured 2026-12-03, docs/performance.md): about 5 min; --full about 2 h 36 min.
+Time on the 2-core VM (docs/performance.md): about 5 min (measured 2026-12-03); --full about 1 h 21 min (2026-12-04).
 
 Examples:
   mmbm demo
   mmbm demo --out /tmp/report --seed 7
-  mmbm demo --full --out report-5-seeds"
+  mmbm demo --full --out report-full-map"
 )]
 pub struct DemoArgs {
     /// Output directory.
@@ -34,7 +35,7 @@ pub struct DemoArgs {
     /// Simulation seed.
     #[arg(long, default_value_t = 1, conflicts_with = "full")]
     pub seed: u64,
-    /// Run seeds 1 to 5 and pool them (the multi-seed numbers of docs/experiment.md).
+    /// The whole benefit map: three gaits, both boards, six lights, seeds 1 to 5 (docs/experiment.md).
     #[arg(long)]
     pub full: bool,
     /// No progress bar.

@@ -80,8 +80,7 @@ pub struct ExperimentConfig {
     pub map: MapSection,
 }
 
-/// The policies of `mmbm demo`'s experiment (`demo --full` runs the
-/// defaults): the thesis's Table 6.2 (the fixed rate and its three
+/// The policies of `mmbm demo`'s experiment (`demo --full`'s too): the thesis's Table 6.2 (the fixed rate and its three
 /// thresholds), the learned phase predictor and its oracle, and trigger
 /// timing with exposure control.
 pub const DEMO_POLICIES: [&str; 7] = [
