@@ -92,8 +92,9 @@ pub const LIGHT_MAX_PIXEL_UM: f64 = 1000.0;
 /// Largest mean (electrons) whose shot noise is drawn from the exact
 /// Poisson sampler; above it, from the normal approximation `N(mu, mu)`
 /// rounded and clamped at 0, which is bounded in time for every mean (the
-/// exact sampler of `rand_distr` 0.4 loses its precision beyond about
-/// 1e15 and spins near 1e305). The difference between the two
+/// exact samplers lose their precision at huge means, and the one of
+/// `rand_distr` 0.4, which the noise used before 0.6, spins near 1e305;
+/// 0.6 refuses means above 1.8e19). The difference between the two
 /// distributions is of the order of the skewness `1/sqrt(mu)`, at most
 /// 3.2e-5 here, and a mean this large is clipped at any real full well.
 pub const MAX_EXACT_POISSON_MEAN_E: f64 = 1e9;

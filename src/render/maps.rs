@@ -169,7 +169,11 @@ pub fn max_path_px(cam: &Camera, target: &Target, traj: &Trajectory) -> f64 {
     let (start, poses) = whole(traj, 256);
     let (nx, ny) = (33, 25);
     let mut m: f64 = 0.0;
-    for j in 0..ny {
+    // A camera that does not move (e.g. a sharp reference): every grid path
+    // is 0 px but for rounding in the interpolated steps (under 1e-9 px, a
+    // test), so the grid is skipped; the samples it sets are the same.
+    let still = traj.is_still();
+    for j in (0..ny).filter(|_| !still) {
         for i in 0..nx {
             let x = cam.width as f64 * i as f64 / (nx - 1) as f64;
             let y = cam.height as f64 * j as f64 / (ny - 1) as f64;
@@ -340,5 +344,65 @@ fn blur_maps_rolling(
         speed_px_s: path.iter().map(|&p| (p as f64 / te) as f32).collect(),
         path_px: path,
         disp_px: disp,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::{DQuat, DVec3};
+
+    /// A camera that does not move: every grid point's path, computed point
+    /// by point over the 256 steps, is under 1e-9 px (rounding in the
+    /// interpolated steps), so skipping the grid changes no sample count.
+    #[test]
+    fn a_still_camera_skips_the_grid_with_the_same_samples() {
+        let cam = Camera::thesis().with_resolution(160, 120);
+        let target = Target::parse("blobs", 2.0).unwrap();
+        let pose = (
+            DQuat::from_rotation_y(0.1) * DQuat::from_rotation_x(-0.05),
+            DVec3::new(0.01, -0.02, 0.0),
+        );
+        let still = Trajectory::from_poses(0.07, vec![pose, pose]).unwrap();
+        assert!(still.is_still());
+        let (start, steps) = whole(&still, 256);
+        let (mut seen, mut grid) = (0, 0.0f64);
+        for j in 0..25 {
+            for i in 0..33 {
+                let (x, y) = (160.0 * i as f64 / 32.0, 120.0 * j as f64 / 24.0);
+                if let Some(p) = scene_point(&cam, &target, &start, x, y)
+                    .and_then(|p| track::path_px(&cam, &steps, &p))
+                {
+                    grid = grid.max(p.len_px);
+                    seen += 1;
+                }
+            }
+        }
+        assert!(seen > 100, "the board fills the view: {seen} points");
+        assert!(grid < 1e-9, "{grid}");
+        let m = max_path_px(&cam, &target, &still);
+        assert!(m < 1e-6, "{m}");
+        for q in [
+            crate::render::Quality::Default,
+            crate::render::Quality::Fast,
+        ] {
+            assert_eq!(
+                q.instants_for(m).unwrap(),
+                q.instants_for(grid * 1.1).unwrap()
+            );
+            assert_eq!(
+                q.samples_for(m).unwrap(),
+                q.samples_for(grid * 1.1).unwrap()
+            );
+        }
+        // A moving camera still measures its grid.
+        let moving = Trajectory::from_poses(
+            0.07,
+            vec![pose, (pose.0 * DQuat::from_rotation_y(0.01), pose.1)],
+        )
+        .unwrap();
+        assert!(!moving.is_still());
+        let m = max_path_px(&cam, &target, &moving);
+        assert!(m > 1.0, "{m}");
     }
 }

@@ -13,8 +13,9 @@
 
 use crate::error::{Error, Result};
 use crate::limits::MAX_EXACT_POISSON_MEAN_E;
-use rand::{rngs::StdRng, SeedableRng};
-use rand_distr::{Distribution, Normal, Poisson};
+// The noise's own `rand` (0.10) and `rand_distr` (0.6): see core/Cargo.toml.
+use rand10::{rngs::StdRng, SeedableRng};
+use rand_distr06::{Distribution, Normal, Poisson};
 use serde::{Deserialize, Serialize};
 
 /// The noise parameters of a sensor.
@@ -142,7 +143,7 @@ impl Noise {
 /// normal approximation `N(mu, mu)` rounded and clamped at 0; 0 for a mean
 /// of 0 (or NaN), and `f64::MAX` (clipped at the full well by the caller)
 /// for an infinite one.
-pub fn shot_noise<R: rand::Rng + ?Sized>(mu: f64, rng: &mut R) -> Result<f64> {
+pub fn shot_noise<R: rand10::Rng + ?Sized>(mu: f64, rng: &mut R) -> Result<f64> {
     if mu.is_nan() || mu <= 0.0 {
         Ok(0.0)
     } else if mu == f64::INFINITY {
@@ -152,7 +153,7 @@ pub fn shot_noise<R: rand::Rng + ?Sized>(mu: f64, rng: &mut R) -> Result<f64> {
             .map_err(|e| Error::invalid("noise", format!("mean {mu} e-: {e}")))?
             .sample(rng))
     } else {
-        let z: f64 = rng.sample(rand_distr::StandardNormal);
+        let z: f64 = rand_distr06::StandardNormal.sample(rng);
         Ok((mu + mu.sqrt() * z).round().max(0.0))
     }
 }

@@ -97,6 +97,15 @@ impl Trajectory {
         })
     }
 
+    /// True when the camera does not move: a table whose poses are all the
+    /// same (e.g. a sharp reference), or a twist of zero.
+    pub fn is_still(&self) -> bool {
+        match &self.kind {
+            Kind::Twist(tw) => tw.omega == DVec3::ZERO && tw.velocity == DVec3::ZERO,
+            Kind::Table(p) => p.windows(2).all(|w| w[0] == w[1]),
+        }
+    }
+
     /// Integrates a gyro log over `[t0, t0 + duration]` (s, log clock after
     /// `GyroOptions`): `w` (and `v` when `use_velocity`) linearly interpolated
     /// between samples, quaternion exponential midpoint steps at 1/16 of the
