@@ -166,14 +166,34 @@ fn masked(cam: &Camera, x: f64, y: f64) -> bool {
 /// spanning the sensor edge to edge, 256 time steps, at least the rotation
 /// bound below, times 1.1 for safety.
 pub fn max_path_px(cam: &Camera, target: &Target, traj: &Trajectory) -> f64 {
+    // A camera that does not move (e.g. a sharp reference): every grid path
+    // is 0 px but for rounding in the interpolated steps (under 1e-9 px, a
+    // test), so neither the steps nor the grid are computed; the samples it
+    // sets are the same.
+    let m = if traj.is_still() {
+        0.0
+    } else {
+        grid_max_path_px(cam, target, traj)
+    };
+    // Points that leave the view still smear the pixels they cross: bound the
+    // image motion of rotation by the angle turned times the focal length in
+    // px at the sensor corner (where d(pixel)/d(angle) is largest).
+    let r = cam.sensor_rect();
+    let corner2 = r.u0.abs().max(r.u1.abs()).powi(2) + r.v0.abs().max(r.v1.abs()).powi(2);
+    let gain = cam.fx_px().max(cam.fy_px()) * (1.0 + corner2 / (cam.focal_mm * cam.focal_mm));
+    let table = traj.table(4096);
+    let angle: f64 = table.windows(2).map(|w| w[0].0.angle_between(w[1].0)).sum();
+    m.max(angle * gain) * 1.1
+}
+
+/// [`max_path_px`]'s grid: the longest path (px) of the points seen at a
+/// 33 x 25 grid over the sensor at exposure start, over 256 time steps (0
+/// when none is seen).
+fn grid_max_path_px(cam: &Camera, target: &Target, traj: &Trajectory) -> f64 {
     let (start, poses) = whole(traj, 256);
     let (nx, ny) = (33, 25);
     let mut m: f64 = 0.0;
-    // A camera that does not move (e.g. a sharp reference): every grid path
-    // is 0 px but for rounding in the interpolated steps (under 1e-9 px, a
-    // test), so the grid is skipped; the samples it sets are the same.
-    let still = traj.is_still();
-    for j in (0..ny).filter(|_| !still) {
+    for j in 0..ny {
         for i in 0..nx {
             let x = cam.width as f64 * i as f64 / (nx - 1) as f64;
             let y = cam.height as f64 * j as f64 / (ny - 1) as f64;
@@ -185,15 +205,7 @@ pub fn max_path_px(cam: &Camera, target: &Target, traj: &Trajectory) -> f64 {
             }
         }
     }
-    // Points that leave the view still smear the pixels they cross: bound the
-    // image motion of rotation by the angle turned times the focal length in
-    // px at the sensor corner (where d(pixel)/d(angle) is largest).
-    let r = cam.sensor_rect();
-    let corner2 = r.u0.abs().max(r.u1.abs()).powi(2) + r.v0.abs().max(r.v1.abs()).powi(2);
-    let gain = cam.fx_px().max(cam.fy_px()) * (1.0 + corner2 / (cam.focal_mm * cam.focal_mm));
-    let table = traj.table(4096);
-    let angle: f64 = table.windows(2).map(|w| w[0].0.angle_between(w[1].0)).sum();
-    m.max(angle * gain) * 1.1
+    m
 }
 
 /// Computes the maps with `steps` time steps (chords of the track; choose
@@ -380,6 +392,7 @@ mod tests {
         }
         assert!(seen > 100, "the board fills the view: {seen} points");
         assert!(grid < 1e-9, "{grid}");
+        assert_eq!(grid_max_path_px(&cam, &target, &still), grid);
         let m = max_path_px(&cam, &target, &still);
         assert!(m < 1e-6, "{m}");
         for q in [

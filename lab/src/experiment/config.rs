@@ -80,9 +80,9 @@ pub struct ExperimentConfig {
     pub map: MapSection,
 }
 
-/// The policies of `mmbm demo`'s experiment (`demo --full`'s too): the thesis's Table 6.2 (the fixed rate and its three
-/// thresholds), the learned phase predictor and its oracle, and trigger
-/// timing with exposure control.
+/// The policies of `mmbm demo`'s experiment (`demo --full`'s too): the
+/// thesis's Table 6.2 (the fixed rate and its three thresholds), the learned
+/// phase predictor and its oracle, and trigger timing with exposure control.
 pub const DEMO_POLICIES: [&str; 7] = [
     "fixed:5",
     "threshold:0.8",
