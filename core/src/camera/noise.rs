@@ -110,31 +110,87 @@ impl Noise {
     /// RNG (seeded by seed, stream and chunk number), in parallel.
     pub fn apply(&self, pixels: &mut [f32], exposure_s: f64, stream: u64) -> Result<()> {
         use rayon::prelude::*;
-        self.validate()?;
-        let read = Normal::new(0.0, self.read_noise_e)
-            .map_err(|e| Error::invalid("noise.read_noise_e", e.to_string()))?;
-        let (k, max_dn) = (self.gain(), self.max_dn());
-        let scale = self.phi_e_per_s * exposure_s;
-        let base = self.seed ^ stream.wrapping_mul(0x9E37_79B9_7F4A_7C15);
+        let draw = Draw::new(self, exposure_s, stream)?;
+        let max_dn = self.max_dn();
         pixels
             .par_chunks_mut(Self::CHUNK)
             .enumerate()
             .try_for_each(|(c, chunk)| {
-                let mut rng = StdRng::seed_from_u64(
-                    base ^ (c as u64 + 1).wrapping_mul(0xD1B5_4A32_D192_ED03),
-                );
+                let mut rng = draw.rng(c);
                 for p in chunk.iter_mut() {
-                    let mu = scale * (*p as f64).clamp(0.0, f64::MAX);
-                    let shot = shot_noise(mu, &mut rng)?;
-                    let e = (shot + read.sample(&mut rng)).clamp(0.0, self.full_well_e);
-                    *p = ((k * e).round().clamp(0.0, max_dn) / max_dn) as f32;
+                    *p = (draw.dn(*p, &mut rng)? / max_dn) as f32;
                 }
                 Ok(())
             })
     }
 
+    /// The digital numbers of [`Noise::apply`]: the same draws (same seed,
+    /// stream and chunks), returned as codes `0..=2^bits - 1` instead of
+    /// `DN / (2^bits - 1)`, so `apply` gives `dn as f64 / max_dn` as f32 of these.
+    pub fn apply_dn(&self, pixels: &[f32], exposure_s: f64, stream: u64) -> Result<Vec<u16>> {
+        use rayon::prelude::*;
+        let draw = Draw::new(self, exposure_s, stream)?;
+        let mut out = vec![0u16; pixels.len()];
+        pixels
+            .par_chunks(Self::CHUNK)
+            .zip(out.par_chunks_mut(Self::CHUNK))
+            .enumerate()
+            .try_for_each(|(c, (chunk, codes))| {
+                let mut rng = draw.rng(c);
+                for (p, d) in chunk.iter().zip(codes.iter_mut()) {
+                    // An integer in 0..=65535 (bits <= 16): exact as u16.
+                    *d = draw.dn(*p, &mut rng)? as u16;
+                }
+                Ok(())
+            })?;
+        Ok(out)
+    }
+
     /// Values per RNG chunk of [`Noise::apply`].
     pub const CHUNK: usize = 16384;
+}
+
+/// One call of [`Noise::apply`] / [`Noise::apply_dn`]: the sensor's
+/// constants and the RNG seeding, shared by both so their draws are the same.
+struct Draw {
+    read: Normal<f64>,
+    /// Gain, DN/e-.
+    k: f64,
+    max_dn: f64,
+    full_well_e: f64,
+    /// Electrons of a white pixel in this exposure.
+    scale: f64,
+    /// The stream's seed (chunk seeds are derived from it).
+    base: u64,
+}
+
+impl Draw {
+    fn new(noise: &Noise, exposure_s: f64, stream: u64) -> Result<Self> {
+        noise.validate()?;
+        Ok(Draw {
+            read: Normal::new(0.0, noise.read_noise_e)
+                .map_err(|e| Error::invalid("noise.read_noise_e", e.to_string()))?,
+            k: noise.gain(),
+            max_dn: noise.max_dn(),
+            full_well_e: noise.full_well_e,
+            scale: noise.phi_e_per_s * exposure_s,
+            base: noise.seed ^ stream.wrapping_mul(0x9E37_79B9_7F4A_7C15),
+        })
+    }
+
+    /// The RNG of chunk `c` (of [`Noise::CHUNK`] values).
+    fn rng(&self, c: usize) -> StdRng {
+        StdRng::seed_from_u64(self.base ^ (c as u64 + 1).wrapping_mul(0xD1B5_4A32_D192_ED03))
+    }
+
+    /// The digital number (an integer in `0..=max_dn`, as f64) of a pixel of linear radiance `p`.
+    #[inline]
+    fn dn(&self, p: f32, rng: &mut StdRng) -> Result<f64> {
+        let mu = self.scale * (p as f64).clamp(0.0, f64::MAX);
+        let shot = shot_noise(mu, rng)?;
+        let e = (shot + self.read.sample(rng)).clamp(0.0, self.full_well_e);
+        Ok((self.k * e).round().clamp(0.0, self.max_dn))
+    }
 }
 
 /// The electrons of a pixel whose mean is `mu` e- (shot noise), bounded in
@@ -290,5 +346,33 @@ mod tests {
         .validate()
         .unwrap_err();
         assert!(e.to_string().contains("noise.read_noise_e"), "{e}");
+    }
+
+    /// `apply_dn` draws what `apply` draws: `apply` gives `dn / max_dn`, value
+    /// for value, over several chunks, bit depths and lights (dark, where Knuth's
+    /// sampler runs, and bright, past the normal approximation's threshold of
+    /// the sampler's own switch), and clipped values at both ends.
+    #[test]
+    fn apply_dn_is_apply_in_codes() {
+        let n = 2 * Noise::CHUNK + 123;
+        let px: Vec<f32> = (0..n)
+            .map(|i| ((i * 7919) % 1000) as f32 / 900.0 - 0.05)
+            .collect();
+        for (phi, bits, t) in [(300.0, 8u32, 0.01), (50_000.0, 12, 0.07), (1e6, 16, 0.2)] {
+            let noise = Noise {
+                bits,
+                seed: 3,
+                ..Noise::at_light(phi)
+            };
+            let mut a = px.clone();
+            noise.apply(&mut a, t, 5).unwrap();
+            let dn = noise.apply_dn(&px, t, 5).unwrap();
+            let max = noise.max_dn();
+            assert!(dn.iter().all(|&d| f64::from(d) <= max));
+            assert!(dn.contains(&0), "{phi}: some code clipped at 0");
+            for (x, d) in a.iter().zip(&dn) {
+                assert_eq!(x.to_bits(), ((f64::from(*d) / max) as f32).to_bits());
+            }
+        }
     }
 }

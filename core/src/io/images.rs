@@ -245,6 +245,32 @@ pub fn to_rgb8(width: u32, height: u32, rgb: &[f32]) -> Result<image::RgbImage> 
     })
 }
 
+/// [`to_rgb8`] of the linear values `dn / max_dn` (the digital numbers of
+/// [`crate::camera::Noise::apply_dn`], `max_dn = 2^bits - 1`), byte for byte,
+/// through a table of the `max_dn + 1` codes instead of a power per value.
+pub fn dn_to_rgb8(width: u32, height: u32, dn: &[u16], max_dn: u16) -> Result<image::RgbImage> {
+    let table: Vec<u8> = (0..=max_dn)
+        .map(|d| linear_to_srgb8((f64::from(d) / f64::from(max_dn)) as f32))
+        .collect();
+    let bytes = dn
+        .iter()
+        .map(|&d| {
+            table.get(usize::from(d)).copied().ok_or_else(|| {
+                Error::invalid(
+                    "frame",
+                    format!("digital number {d} above the largest, {max_dn}"),
+                )
+            })
+        })
+        .collect::<Result<Vec<u8>>>()?;
+    image::RgbImage::from_raw(width, height, bytes).ok_or_else(|| {
+        Error::invalid(
+            "frame",
+            format!("{} values are not a {width}x{height} RGB image", dn.len()),
+        )
+    })
+}
+
 /// 2x2 box downsampling of linear RGB (for the montage).
 pub fn half(width: u32, height: u32, rgb: &[f32]) -> Vec<f32> {
     let (w2, h2) = ((width / 2) as usize, (height / 2) as usize);
@@ -276,6 +302,39 @@ mod tests {
         assert_eq!(half(2, 2, &rgb), vec![0.25; 3]);
         assert!(to_rgb8(2, 2, &rgb).is_ok());
         assert!(to_rgb8(3, 2, &rgb).is_err());
+    }
+
+    /// Every code of 1, 8, 12 and 16 bits gives the byte `to_rgb8` gives its value.
+    #[test]
+    fn dn_to_rgb8_is_to_rgb8_of_the_codes() {
+        for bits in [1u32, 8, 12, 16] {
+            let max = ((1u32 << bits) - 1) as u16;
+            let codes: Vec<u16> = (0..=max).collect();
+            let lin: Vec<f32> = codes
+                .iter()
+                .map(|&d| (f64::from(d) / f64::from(max)) as f32)
+                .collect();
+            let n = codes.len() as u32;
+            // One row of RGB pixels: the codes padded with zeros to a multiple of 3.
+            let pad = (3 - codes.len() % 3) % 3;
+            let codes: Vec<u16> = codes
+                .into_iter()
+                .chain(std::iter::repeat_n(0, pad))
+                .collect();
+            let lin: Vec<f32> = lin
+                .into_iter()
+                .chain(std::iter::repeat_n(0.0, pad))
+                .collect();
+            let w = (n + pad as u32) / 3;
+            assert_eq!(
+                dn_to_rgb8(w, 1, &codes, max).unwrap(),
+                to_rgb8(w, 1, &lin).unwrap(),
+                "{bits} bits"
+            );
+        }
+        let e = dn_to_rgb8(1, 1, &[0, 256, 0], 255).unwrap_err().to_string();
+        assert!(e.contains("256"), "{e}");
+        assert!(dn_to_rgb8(2, 1, &[0, 1, 2], 255).is_err());
     }
 
     #[test]

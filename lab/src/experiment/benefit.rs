@@ -79,6 +79,20 @@ pub struct Estimate {
     pub hi: f64,
 }
 
+/// A bound of a ratio's interval as the reports write it: two decimals, and
+/// more (up to six) where two would print `1.00` for a bound that is not 1,
+/// so that a bound reads on the side of 1 where the verdicts place it
+/// (`[0.99, 0.998]`, not `[0.99, 1.00]`, for an interval below 1).
+pub fn bound_text(x: f64) -> String {
+    let mut d = 2;
+    let mut t = format!("{x:.2}");
+    while d < 6 && x != 1.0 && x.is_finite() && t.parse::<f64>() == Ok(1.0) {
+        d += 1;
+        t = format!("{x:.d$}");
+    }
+    t
+}
+
 /// One policy's headline on one gait (all its seeds pooled).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Headline {
@@ -352,8 +366,11 @@ pub fn headline_md_titled(
             };
             s += &format!(
                 "- {g}: the best causal policy, `{}`, gets {:.2}x the sharp frames per second of `{b}` \
-                 (95 % CI {:.2}-{:.2}): it {goal}.\n",
-                h.policy, r.value, r.lo, r.hi
+                 (95 % CI {}-{}): it {goal}.\n",
+                h.policy,
+                r.value,
+                bound_text(r.lo),
+                bound_text(r.hi)
             );
         }
         // The ceiling: at the baseline's rate no policy gets more frames.
@@ -422,6 +439,24 @@ pub fn headline_md_titled(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Two decimals unless a bound that is not 1 would print as `1.00`.
+    #[test]
+    fn bounds_near_one_show_their_side() {
+        for (x, want) in [
+            (0.5, "0.50"),
+            (1.0, "1.00"),
+            (1.2345, "1.23"),
+            (0.996, "0.996"),
+            (1.004, "1.004"),
+            (0.9996, "0.9996"),
+            (0.999_999_9, "1.000000"),
+            (0.994, "0.99"),
+            (f64::INFINITY, "inf"),
+        ] {
+            assert_eq!(bound_text(x), want, "{x}");
+        }
+    }
     use crate::experiment::measure::FrameMeasure;
     use crate::io::gyro::GyroSample;
     use crate::trigger::Frame;

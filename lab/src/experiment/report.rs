@@ -261,8 +261,12 @@ impl Outcome {
                 .max_by(|a, b| a.1.value.total_cmp(&b.1.value));
             if let Some((h, r)) = best {
                 out.push(format!(
-                    "{g}: best causal policy `{}`: {:.2} sharp frames/s, {:.2}x the fixed rate [95 % CI {:.2}, {:.2}]",
-                    h.policy, h.sharp_fps.value, r.value, r.lo, r.hi
+                    "{g}: best causal policy `{}`: {:.2} sharp frames/s, {:.2}x the fixed rate [95 % CI {}, {}]",
+                    h.policy,
+                    h.sharp_fps.value,
+                    r.value,
+                    super::benefit::bound_text(r.lo),
+                    super::benefit::bound_text(r.hi)
                 ));
             }
         }

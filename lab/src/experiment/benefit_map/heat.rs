@@ -180,7 +180,12 @@ fn colour_bar<DB: DrawingBackend>(
 fn short(e: &Option<Estimate>) -> String {
     match e {
         Some(e) if e.value.is_finite() && e.lo.is_finite() => {
-            format!("{:.2}x [{:.2}, {:.2}]", e.value, e.lo, e.hi)
+            format!(
+                "{:.2}x [{}, {}]",
+                e.value,
+                super::super::benefit::bound_text(e.lo),
+                super::super::benefit::bound_text(e.hi)
+            )
         }
         Some(e) if e.value.is_finite() => format!("{:.2}x", e.value),
         Some(e) if e.value == f64::INFINITY => "unbounded".into(),

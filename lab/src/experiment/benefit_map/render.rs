@@ -8,7 +8,7 @@ use super::super::measure::{blob_metrics, bulk_job, frame_motion};
 use super::super::walk::Walk;
 use crate::camera::{Camera, Noise};
 use crate::error::Result;
-use crate::io::images::to_rgb8;
+use crate::io::images::dn_to_rgb8;
 use crate::render::{self, Background, Quality, Target, Window};
 use crate::trigger::Frame;
 
@@ -159,17 +159,18 @@ pub fn judge_at_lights(
     let mut per_light = Vec::with_capacity(lights.len());
     for (k, light) in lights.iter().enumerate() {
         let own;
-        let (mut rgb, sharp_corners) = match &shared {
-            Some((window, sharp_corners)) => (window.clone(), sharp_corners),
+        let (rgb, sharp_corners) = match &shared {
+            Some((window, sharp_corners)) => (std::borrow::Cow::Borrowed(window), sharp_corners),
             None => {
                 own = corners::corners(&corners::luma(cw, ch, &whole(&still)?)?);
-                (whole(&job)?, &own)
+                (std::borrow::Cow::Owned(whole(&job)?), &own)
             }
         };
-        light
-            .for_gain(frame.gain)
-            .apply(&mut rgb, exposure, u64::from(seed) * 64 + k as u64)?;
-        let img = to_rgb8(cw, ch, &rgb)?;
+        // The noisy frame's codes, to 8-bit sRGB through a table: the bytes
+        // `to_rgb8` gives the noisy linear frame (`Noise::apply`).
+        let sensor = light.for_gain(frame.gain);
+        let dn = sensor.apply_dn(&rgb, exposure, u64::from(seed) * 64 + k as u64)?;
+        let img = dn_to_rgb8(cw, ch, &dn, sensor.max_dn() as u16)?;
         let b = blob_metrics(&img, &shifted);
         let gray = crate::assess::luma(&img);
         let found = corners::corners(&gray);

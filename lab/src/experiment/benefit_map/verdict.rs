@@ -11,7 +11,7 @@
 //! with the interval `[inf, inf]` (above 1); where neither gets one the
 //! ratio is NaN and neither above nor below 1.
 
-use super::super::benefit::Estimate;
+use super::super::benefit::{bound_text, Estimate};
 use super::{BenefitMap, Cell};
 
 /// A cell's verdict.
@@ -67,7 +67,12 @@ pub fn ratio_text(e: &Estimate) -> String {
     } else if !e.value.is_finite() {
         "n/a (neither gets any)".into()
     } else if e.lo.is_finite() {
-        format!("{:.2}x [{:.2}, {:.2}]", e.value, e.lo, e.hi)
+        format!(
+            "{:.2}x [{}, {}]",
+            e.value,
+            bound_text(e.lo),
+            bound_text(e.hi)
+        )
     } else {
         format!("{:.2}x", e.value)
     }
