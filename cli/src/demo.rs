@@ -21,7 +21,7 @@ over 2-s blocks of the walks; then the experiment's own frames (its seed, judged
 (35 s), moderate (16 s) and fast (5 s) walks, both boards, six lights from 500 to 100,000 e-/s, seeds 1-5; the
 experiment's own frames stay the demo's.
 
-Time on the 2-core VM (docs/performance.md): about 3 min (measured 2026-12-04); --full about 56 min (2026-12-04).
+Time on the 2-core VM (docs/performance.md): about 3 min (measured 2026-12-04); --full about 51 min (2026-12-04).
 
 Examples:
   mmbm demo
