@@ -349,9 +349,9 @@ mod tests {
     }
 
     /// `apply_dn` draws what `apply` draws: `apply` gives `dn / max_dn`, value
-    /// for value, over several chunks, bit depths and lights (dark, where Knuth's
-    /// sampler runs, and bright, past the normal approximation's threshold of
-    /// the sampler's own switch), and clipped values at both ends.
+    /// for value, over several chunks, bit depths and lights (dark, where the
+    /// means fall below 12 e- and Knuth's sampler runs, and bright, where
+    /// Ahrens-Dieter's does and the full well clips), and values clipped at 0.
     #[test]
     fn apply_dn_is_apply_in_codes() {
         let n = 2 * Noise::CHUNK + 123;
