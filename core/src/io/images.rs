@@ -237,10 +237,17 @@ pub fn read_rgb8(path: &Path) -> Result<image::RgbImage> {
 /// Linear RGB (interleaved) to an 8-bit sRGB image.
 pub fn to_rgb8(width: u32, height: u32, rgb: &[f32]) -> Result<image::RgbImage> {
     let bytes: Vec<u8> = rgb.iter().map(|&x| linear_to_srgb8(x)).collect();
+    rgb8_image(width, height, bytes)
+}
+
+/// The RGB8 image of `bytes` (one per value), or an error when they are not
+/// `width x height x 3`.
+fn rgb8_image(width: u32, height: u32, bytes: Vec<u8>) -> Result<image::RgbImage> {
+    let n = bytes.len();
     image::RgbImage::from_raw(width, height, bytes).ok_or_else(|| {
         Error::invalid(
             "frame",
-            format!("{} values are not a {width}x{height} RGB image", rgb.len()),
+            format!("{n} values are not a {width}x{height} RGB image"),
         )
     })
 }
@@ -263,12 +270,7 @@ pub fn dn_to_rgb8(width: u32, height: u32, dn: &[u16], max_dn: u16) -> Result<im
             })
         })
         .collect::<Result<Vec<u8>>>()?;
-    image::RgbImage::from_raw(width, height, bytes).ok_or_else(|| {
-        Error::invalid(
-            "frame",
-            format!("{} values are not a {width}x{height} RGB image", dn.len()),
-        )
-    })
+    rgb8_image(width, height, bytes)
 }
 
 /// 2x2 box downsampling of linear RGB (for the montage).
