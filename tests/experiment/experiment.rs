@@ -158,3 +158,44 @@ fn several_seeds_are_pooled_in_the_headline() {
     assert!(md.contains("seeds [3, 4]"), "{md}");
     assert!(md.contains("| moderate | threshold:0.4 |"), "{md}");
 }
+
+/// The report's render-quality note compares the two presets' renders, not
+/// their noise: at a dim light (noise of several codes) the `fast` preset's
+/// frame is within 0.5/255 on average of `default`'s (the noise, drawn
+/// anew once any pixel's mean changes, would differ by far more).
+#[test]
+fn quality_note_is_the_renders_own_difference() {
+    let d = tempfile::tempdir().unwrap();
+    let light = 1_000.0;
+    let cfg = ExperimentConfig {
+        walks: vec!["moderate".into()],
+        duration_s: Some(2.0),
+        policies: vec!["fixed:5".parse().unwrap()],
+        quality: "fast".into(),
+        max_frames_per_policy: 2,
+        sweep_exposures_s: Vec::new(),
+        camera: mmbm::camera::CameraFile {
+            noise: Some(mmbm::camera::Noise {
+                seed: 1,
+                gain_dn_per_e: Some(255.0 / (light * 0.07)),
+                ..mmbm::camera::Noise::at_light(light)
+            }),
+            ..Default::default()
+        },
+        ..ExperimentConfig::default()
+    };
+    experiment::run(&cfg, d.path(), false).unwrap();
+    let report = std::fs::read_to_string(d.path().join("report.md")).unwrap();
+    let note = report
+        .lines()
+        .find(|l| l.starts_with("- Render quality preset `fast`"))
+        .unwrap_or_else(|| panic!("no quality note in\n{report}"));
+    assert!(note.contains("without sensor noise"), "{note}");
+    let mean: f64 = note
+        .split("mean |difference| ")
+        .nth(1)
+        .and_then(|r| r.split('/').next())
+        .and_then(|v| v.parse().ok())
+        .unwrap_or_else(|| panic!("no mean difference in {note}"));
+    assert!((0.0..0.5).contains(&mean), "{note}");
+}

@@ -316,7 +316,7 @@ pub fn quality_note(cfg: &ExperimentConfig, check: Option<(f64, f64, f64)>) -> S
     match check {
         Some((mean, p99, blur)) => format!(
             "- Render quality preset `{}`: measured against the `default` preset on the central 160 x 120 window of the most blurred \
-             baseline frame ({blur:.1} px mean blur), mean |difference| {:.2}/255 and 99th percentile {:.2}/255 (linear 0..1 values x 255). \
+             baseline frame ({blur:.1} px mean blur), both without sensor noise, mean |difference| {:.2}/255 and 99th percentile {:.2}/255 (linear 0..1 values x 255). \
              `default` itself is within mean 0.5/255 and p99 3/255 of the exact integral (tests/render_exact.rs).\n",
             cfg.quality,
             mean * 255.0,

@@ -203,7 +203,10 @@ pub fn run(cfg: &ExperimentConfig, out: &Path, progress: bool) -> Result<Outcome
 }
 
 /// Renders the central 160 x 120 window of the most blurred planned frame of
-/// the first policy with the configured preset and with `default`: `(mean, p99, blur_px)` of the difference.
+/// the first policy with the configured preset and with `default`, both
+/// without sensor noise: `(mean, p99, blur_px)` of the difference. (With
+/// noise the two would differ by the noise: any change of a pixel's mean can
+/// change how many draws its Poisson sample takes, and so every later draw.)
 fn quality_check(
     cfg: &ExperimentConfig,
     walks: &[Walk],
@@ -224,7 +227,10 @@ fn quality_check(
     let frame = &walks[wi].runs[pi].1[fi];
     // The central 160 x 120 window (same focal length and pitch), where the
     // board is: the default preset is slow at full resolution on lavapipe.
-    let cam = cfg.camera().with_resolution(160, 120);
+    let cam = crate::camera::Camera {
+        noise: None,
+        ..cfg.camera().with_resolution(160, 120)
+    };
     let a = render_and_measure(cfg, &walks[wi], frame, cam, quality, 0)?;
     let b = render_and_measure(cfg, &walks[wi], frame, cam, Quality::Default, 0)?;
     let (mean, p99) = image_difference(&a.rgb, &b.rgb);
