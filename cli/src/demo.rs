@@ -18,10 +18,10 @@ benefit map (light x gait x board against the best fixed exposure, auto-exposure
 frames/s by the blob verdict and VO frames/s), then the headline: sharp frames per second per policy against fixed:5,
 read from the map's cell at 20,000 e-/s (the same frames, seeds, window and verdict), with 95 % bootstrap intervals
 over 2-s blocks of the walks; then the experiment's own frames (its seed, judged whole: a different sample). --full runs the whole map: the slow
-(35 s), moderate (16 s) and fast (5 s) walks, both boards, six lights from 500 to 100,000 e-/s, seeds 1-5; the
-experiment's own frames stay the demo's.
+(35 s), moderate (16 s) and fast (5 s) walks, both boards, six lights from 500 to 100,000 e-/s, seeds 1-5, at the
+fast render preset (the report measures it against default); the experiment's own frames stay the demo's.
 
-Time on the 2-core VM (docs/performance.md): about 3 min (measured 2026-12-04); --full about 51 min (2026-12-04).
+Time on the 2-core VM (docs/performance.md): about 2 min (measured 2026-12-04); --full about 31 min (2026-12-04).
 
 Examples:
   mmbm demo

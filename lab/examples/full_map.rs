@@ -26,8 +26,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     );
     let cfg = ExperimentConfig::demo_full();
     cfg.validate()?;
-    let map = benefit_map_with(&cfg, Quality::Default, true, Renders::Shared)?
-        .ok_or("demo --full has a map")?;
+    let quality: Quality = cfg.quality.parse()?;
+    let map =
+        benefit_map_with(&cfg, quality, true, Renders::Shared)?.ok_or("demo --full has a map")?;
     std::fs::create_dir_all(&out).map_err(|e| Error::io(&out, e))?;
     let figure = "benefit_map.png";
     heat_map_png(&out.join(figure), &map)?;

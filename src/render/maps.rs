@@ -9,6 +9,7 @@
 //! the lens, the chords) is [`crate::model::track`]'s.
 
 use super::target::Target;
+use super::Window;
 use crate::camera::Camera;
 use crate::model::track::{self, LineTrack, ScenePoint, Step};
 use crate::model::trajectory::{Pose, Trajectory};
@@ -166,6 +167,28 @@ fn masked(cam: &Camera, x: f64, y: f64) -> bool {
 /// spanning the sensor edge to edge, 256 time steps, at least the rotation
 /// bound below, times 1.1 for safety.
 pub fn max_path_px(cam: &Camera, target: &Target, traj: &Trajectory) -> f64 {
+    max_path_px_in(cam, target, traj, None)
+}
+
+/// [`max_path_px`] over the pixels of `window` only (None, or a window that
+/// is the whole image: the whole sensor, the same number): the grid's points
+/// span the window edge to edge, no farther apart than the whole sensor's
+/// grid (at least 2 x 2 points), and the rotation bound is the image motion
+/// of each step's rotation at the window's largest distances from the
+/// principal point, axis by axis. About the optical axis the image moves in
+/// proportion to the radius, so a window near the centre needs fewer
+/// instants for the same spacing between them.
+pub fn max_path_px_in(
+    cam: &Camera,
+    target: &Target,
+    traj: &Trajectory,
+    window: Option<Window>,
+) -> f64 {
+    let window = window.filter(|w| (w.x0, w.y0, w.w, w.h) != (0, 0, cam.width, cam.height));
+    let grid = match window {
+        None => Grid::whole(cam),
+        Some(win) => Grid::over(cam, win),
+    };
     // A camera that does not move (e.g. a sharp reference): every grid path
     // is 0 px but for rounding in the interpolated steps (under 1e-9 px, a
     // test), so neither the steps nor the grid are computed; the samples it
@@ -173,30 +196,101 @@ pub fn max_path_px(cam: &Camera, target: &Target, traj: &Trajectory) -> f64 {
     let m = if traj.is_still() {
         0.0
     } else {
-        grid_max_path_px(cam, target, traj)
+        grid_max_path_px(cam, target, traj, &grid)
     };
     // Points that leave the view still smear the pixels they cross: bound the
-    // image motion of rotation by the angle turned times the focal length in
-    // px at the sensor corner (where d(pixel)/d(angle) is largest).
-    let r = cam.sensor_rect();
-    let corner2 = r.u0.abs().max(r.u1.abs()).powi(2) + r.v0.abs().max(r.v1.abs()).powi(2);
-    let gain = cam.fx_px().max(cam.fy_px()) * (1.0 + corner2 / (cam.focal_mm * cam.focal_mm));
+    // image motion of rotation over the pixels.
     let table = traj.table(4096);
-    let angle: f64 = table.windows(2).map(|w| w[0].0.angle_between(w[1].0)).sum();
-    m.max(angle * gain) * 1.1
+    let rot = match window {
+        // The whole sensor: the angle turned times the focal length in px at
+        // the sensor corner (where d(pixel)/d(angle) is largest).
+        None => {
+            let r = cam.sensor_rect();
+            let corner2 = r.u0.abs().max(r.u1.abs()).powi(2) + r.v0.abs().max(r.v1.abs()).powi(2);
+            let gain =
+                cam.fx_px().max(cam.fy_px()) * (1.0 + corner2 / (cam.focal_mm * cam.focal_mm));
+            let angle: f64 = table.windows(2).map(|w| w[0].0.angle_between(w[1].0)).sum();
+            angle * gain
+        }
+        // A window: each step's rotation (camera axes) through the image
+        // motion of a rotation at normalised image point (x, y), component
+        // by component at the window's largest |x| and |y| (so about the
+        // optical axis the bound grows with the radius, not the focal length).
+        Some(win) => {
+            let (x0, y0) = (f64::from(win.x0), f64::from(win.y0));
+            let (x1, y1) = (x0 + f64::from(win.w), y0 + f64::from(win.h));
+            let (mut xm, mut ym) = (0.0f64, 0.0f64);
+            for (x, y) in [(x0, y0), (x1, y0), (x0, y1), (x1, y1)] {
+                let (u, v) = cam.pixel_to_mm(x, y);
+                xm = xm.max(u.abs() / cam.focal_mm);
+                ym = ym.max(v.abs() / cam.focal_mm);
+            }
+            let f = cam.fx_px().max(cam.fy_px());
+            table
+                .windows(2)
+                .map(|w| {
+                    let q = w[0].0.inverse() * w[1].0;
+                    // The short way round (q and -q are the same rotation).
+                    let d = if q.w < 0.0 { -q } else { q }.to_scaled_axis().abs();
+                    let du = xm * ym * d.x + (1.0 + xm * xm) * d.y + ym * d.z;
+                    let dv = (1.0 + ym * ym) * d.x + xm * ym * d.y + xm * d.z;
+                    f * du.hypot(dv)
+                })
+                .sum()
+        }
+    };
+    m.max(rot) * 1.1
 }
 
-/// [`max_path_px`]'s grid: the longest path (px) of the points seen at a
-/// 33 x 25 grid over the sensor at exposure start, over 256 time steps (0
-/// when none is seen).
-fn grid_max_path_px(cam: &Camera, target: &Target, traj: &Trajectory) -> f64 {
+/// The points of [`max_path_px_in`]'s grid: `nx` x `ny` spanning
+/// `[x0, x0 + w] x [y0, y0 + h]` (px) edge to edge.
+struct Grid {
+    x0: f64,
+    y0: f64,
+    w: f64,
+    h: f64,
+    nx: u32,
+    ny: u32,
+}
+
+impl Grid {
+    /// The whole sensor's grid: 33 x 25 points edge to edge.
+    fn whole(cam: &Camera) -> Grid {
+        Grid {
+            x0: 0.0,
+            y0: 0.0,
+            w: cam.width as f64,
+            h: cam.height as f64,
+            nx: 33,
+            ny: 25,
+        }
+    }
+
+    /// The grid over `win`: as dense as the whole sensor's 33 x 25 grid or denser, at least 2 x 2.
+    fn over(cam: &Camera, win: Window) -> Grid {
+        let (w, h) = (f64::from(win.w), f64::from(win.h));
+        let n =
+            |len: f64, sensor: f64, cells: f64| (len / (sensor / cells)).ceil().max(1.0) as u32 + 1;
+        Grid {
+            x0: f64::from(win.x0),
+            y0: f64::from(win.y0),
+            w,
+            h,
+            nx: n(w, cam.width as f64, 32.0),
+            ny: n(h, cam.height as f64, 24.0),
+        }
+    }
+}
+
+/// [`max_path_px_in`]'s grid: the longest path (px) of the points seen at
+/// `grid`'s points at exposure start, over 256 time steps (0 when none is seen).
+fn grid_max_path_px(cam: &Camera, target: &Target, traj: &Trajectory, grid: &Grid) -> f64 {
     let (start, poses) = whole(traj, 256);
-    let (nx, ny) = (33, 25);
     let mut m: f64 = 0.0;
-    for j in 0..ny {
-        for i in 0..nx {
-            let x = cam.width as f64 * i as f64 / (nx - 1) as f64;
-            let y = cam.height as f64 * j as f64 / (ny - 1) as f64;
+    for j in 0..grid.ny {
+        for i in 0..grid.nx {
+            let x = grid.x0 + grid.w * i as f64 / (grid.nx - 1) as f64;
+            let y = grid.y0 + grid.h * j as f64 / (grid.ny - 1) as f64;
             // The path in px only (track::path_px: path_disp's number).
             let path = scene_point(cam, target, &start, x, y)
                 .and_then(|p| track::path_px(cam, &poses, &p));
@@ -392,7 +486,10 @@ mod tests {
         }
         assert!(seen > 100, "the board fills the view: {seen} points");
         assert!(grid < 1e-9, "{grid}");
-        assert_eq!(grid_max_path_px(&cam, &target, &still), grid);
+        assert_eq!(
+            grid_max_path_px(&cam, &target, &still, &Grid::whole(&cam)),
+            grid
+        );
         let m = max_path_px(&cam, &target, &still);
         assert!(m < 1e-6, "{m}");
         for q in [

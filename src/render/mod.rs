@@ -6,7 +6,8 @@
 //! the same for every pixel), at each one the homography from pixel to target
 //! coordinates (`kernel`); `N` is chosen from the trajectory so that
 //! consecutive instants are at most `quality.max_spacing_px()` apart on the
-//! image (from the largest image path length over the sensor). Area, per
+//! image (from the largest image path length over the sensor, or over the
+//! job's [`RenderJob::spacing_window`]). Area, per
 //! [`Integrator`]: `analytic` (the default without defocus) averages the
 //! target over the pixel's footprint in closed form at each instant (the
 //! checker and the blob board in `cpu`, images' bilinear interpolant in
@@ -242,6 +243,12 @@ pub struct RenderJob {
     pub with_maps: bool,
     /// Area integration.
     pub integrator: Integrator,
+    /// The pixels whose image paths set the number of instants
+    /// ([`maps::max_path_px_in`]); None (the default): the whole sensor. A
+    /// caller that keeps only a window (the benefit map) sets it to that
+    /// window: the spacing between instants holds there, not necessarily
+    /// outside it. Must lie inside the image.
+    pub spacing_window: Option<Window>,
 }
 
 impl RenderJob {
@@ -259,6 +266,7 @@ impl RenderJob {
             seed: 0,
             with_maps: true,
             integrator: Integrator::Auto,
+            spacing_window: None,
         }
     }
 
@@ -384,7 +392,10 @@ fn prepare(job: &RenderJob) -> Result<Pass> {
         ));
     }
     job.check_timing()?;
-    let lmax = maps::max_path_px(cam, &job.target, &job.trajectory);
+    if let Some(w) = job.spacing_window {
+        w.check("spacing_window", cam.width, cam.height)?;
+    }
+    let lmax = maps::max_path_px_in(cam, &job.target, &job.trajectory, job.spacing_window);
     let defocus = cam.lens.is_some();
     let analytic = match job.integrator {
         Integrator::Analytic if defocus => {

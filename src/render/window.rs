@@ -1,6 +1,7 @@
 //! Rendering a window of a frame: the pixels `[x0, y0, w, h]` of
 //! [`render_frame`](super::render_frame)'s image, each the same number (the
-//! same pass: instants from the whole sensor's largest path, the same
+//! same pass: instants from the job's largest path, over the whole sensor or
+//! its [`spacing_window`](super::RenderJob::spacing_window), the same
 //! homographies and pixel integrals), without the pixels outside. A caller
 //! that judges only a window (the benefit map: the board and its
 //! surroundings) pays only for it on the CPU; a GPU renders the whole frame
@@ -24,6 +25,25 @@ pub struct Window {
 }
 
 impl Window {
+    /// Refuses a window that is empty or not inside a `width` x `height`
+    /// image, naming it as `what` (e.g. `window`).
+    pub fn check(&self, what: &str, width: u32, height: u32) -> Result<()> {
+        if self.w > 0
+            && self.h > 0
+            && u64::from(self.x0) + u64::from(self.w) <= u64::from(width)
+            && u64::from(self.y0) + u64::from(self.h) <= u64::from(height)
+        {
+            return Ok(());
+        }
+        Err(Error::invalid(
+            what,
+            format!(
+                "[{}, {}, {} x {}] is empty or outside the {width} x {height} image",
+                self.x0, self.y0, self.w, self.h
+            ),
+        ))
+    }
+
     /// The window's pixels cut from a whole `width`-wide interleaved RGB image.
     pub fn cut(&self, width: u32, rgb: &[f32]) -> Vec<f32> {
         let (w, x0) = (width as usize, self.x0 as usize);
@@ -48,19 +68,7 @@ pub fn render_window(job: &RenderJob, win: Window) -> Result<Vec<f32>> {
             "a window is rendered without sensor noise (the noise is drawn over the whole image)",
         ));
     }
-    if win.w == 0
-        || win.h == 0
-        || u64::from(win.x0) + u64::from(win.w) > u64::from(cam.width)
-        || u64::from(win.y0) + u64::from(win.h) > u64::from(cam.height)
-    {
-        return Err(Error::invalid(
-            "window",
-            format!(
-                "[{}, {}, {} x {}] is empty or outside the {} x {} image",
-                win.x0, win.y0, win.w, win.h, cam.width, cam.height
-            ),
-        ));
-    }
+    win.check("window", cam.width, cam.height)?;
     let Pass {
         params,
         homs,

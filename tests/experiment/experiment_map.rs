@@ -202,6 +202,11 @@ fn the_demo_configurations() {
     assert_eq!(f.map.gaits, ["slow", "moderate", "fast"]);
     assert_eq!(f.map.seeds, [1, 2, 3, 4, 5]);
     assert_eq!(f.map.boards, ["blobs:0.5", "blobs"]);
+    // The whole map at the fast preset (its render difference in the report); the demo at default.
+    assert_eq!(
+        (d.quality.as_str(), f.quality.as_str()),
+        ("default", "fast")
+    );
     assert!(f.map.lights_e_per_s.contains(&500.0) && f.map.lights_e_per_s.contains(&100_000.0));
     assert_eq!(
         [35.0, 16.0, 5.0],

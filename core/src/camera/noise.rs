@@ -13,9 +13,10 @@
 
 use crate::error::{Error, Result};
 use crate::limits::MAX_EXACT_POISSON_MEAN_E;
-// The noise's own `rand` (0.10) and `rand_distr` (0.6): see core/Cargo.toml.
-use rand10::{rngs::StdRng, SeedableRng};
+// The noise's own `rand` (0.10), `rand_distr` (0.6) and RNG (Xoshiro256++): see core/Cargo.toml.
+use rand10::SeedableRng;
 use rand_distr06::{Distribution, Normal, Poisson};
+use rand_xoshiro::Xoshiro256PlusPlus;
 use serde::{Deserialize, Serialize};
 
 /// The noise parameters of a sensor.
@@ -107,7 +108,7 @@ impl Noise {
     /// (0 for a frame; another value for a second image of the same frame,
     /// e.g. its sharp twin). Deterministic for a given seed and stream: the
     /// values are cut into chunks of [`Noise::CHUNK`], each drawn from its own
-    /// RNG (seeded by seed, stream and chunk number), in parallel.
+    /// RNG (Xoshiro256++, seeded by seed, stream and chunk number), in parallel.
     pub fn apply(&self, pixels: &mut [f32], exposure_s: f64, stream: u64) -> Result<()> {
         use rayon::prelude::*;
         let draw = Draw::new(self, exposure_s, stream)?;
@@ -179,13 +180,15 @@ impl Draw {
     }
 
     /// The RNG of chunk `c` (of [`Noise::CHUNK`] values).
-    fn rng(&self, c: usize) -> StdRng {
-        StdRng::seed_from_u64(self.base ^ (c as u64 + 1).wrapping_mul(0xD1B5_4A32_D192_ED03))
+    fn rng(&self, c: usize) -> Xoshiro256PlusPlus {
+        Xoshiro256PlusPlus::seed_from_u64(
+            self.base ^ (c as u64 + 1).wrapping_mul(0xD1B5_4A32_D192_ED03),
+        )
     }
 
     /// The digital number (an integer in `0..=max_dn`, as f64) of a pixel of linear radiance `p`.
     #[inline]
-    fn dn(&self, p: f32, rng: &mut StdRng) -> Result<f64> {
+    fn dn(&self, p: f32, rng: &mut Xoshiro256PlusPlus) -> Result<f64> {
         let mu = self.scale * (p as f64).clamp(0.0, f64::MAX);
         let shot = shot_noise(mu, rng)?;
         let e = (shot + self.read.sample(rng)).clamp(0.0, self.full_well_e);
@@ -280,14 +283,17 @@ mod tests {
     #[test]
     fn shot_noise_is_exact_below_and_bounded_above() {
         for mu in [0.5, 11.9, 12.0, 1400.0, 2e4, 1e6, MAX_EXACT_POISSON_MEAN_E] {
-            let (mut a, mut b) = (StdRng::seed_from_u64(3), StdRng::seed_from_u64(3));
+            let (mut a, mut b) = (
+                Xoshiro256PlusPlus::seed_from_u64(3),
+                Xoshiro256PlusPlus::seed_from_u64(3),
+            );
             let p = Poisson::new(mu).unwrap();
             for _ in 0..200 {
                 assert_eq!(shot_noise(mu, &mut a).unwrap(), p.sample(&mut b), "{mu}");
             }
         }
         let start = std::time::Instant::now();
-        let mut rng = StdRng::seed_from_u64(5);
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(5);
         for mu in [1.0000001e9, 1e12, 1e15, 1e200, 1e305, 1.7e308, f64::MAX] {
             let n = 20_000;
             // Each draw in standard units: (draw - mu) / sqrt(mu).

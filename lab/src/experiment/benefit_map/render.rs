@@ -134,6 +134,9 @@ pub fn judge_at_lights(
     // Noise, extraction and corners on a window around the board (the blob
     // grid padded by WINDOW_PITCHES pitches), not the whole frame.
     let win = judged_window(&cam, &expected);
+    // The instants are spaced for the window's own image paths (the
+    // renderer's rule, applied to the pixels judged).
+    job.spacing_window = Some(win);
     let still = corners::still_at(&job, mid)?;
     // The noiseless frame and its sharp reference in the window: rendered
     // once (shared) or for each light from the whole frame.
