@@ -9,7 +9,6 @@
 //! the lens, the chords) is [`crate::model::track`]'s.
 
 use super::target::Target;
-use super::Window;
 use crate::camera::Camera;
 use crate::model::track::{self, LineTrack, ScenePoint, Step};
 use crate::model::trajectory::{Pose, Trajectory};
@@ -170,8 +169,9 @@ pub fn max_path_px(cam: &Camera, target: &Target, traj: &Trajectory) -> f64 {
     max_path_px_in(cam, target, traj, None)
 }
 
-/// [`max_path_px`] over the pixels of `window` only (None, or a window that
-/// is the whole image: the whole sensor, the same number): the grid's points
+/// [`max_path_px`] over the pixels of `window` only, `[x0, y0, w, h]` px
+/// (None, or a window that is the whole image: the whole sensor, the same
+/// number; a [`Window`](super::Window) as its four fields): the grid's points
 /// span the window edge to edge, no farther apart than the whole sensor's
 /// grid (at least 2 x 2 points), and the rotation bound is the image motion
 /// of each step's rotation at the window's largest distances from the
@@ -182,9 +182,9 @@ pub fn max_path_px_in(
     cam: &Camera,
     target: &Target,
     traj: &Trajectory,
-    window: Option<Window>,
+    window: Option<[u32; 4]>,
 ) -> f64 {
-    let window = window.filter(|w| (w.x0, w.y0, w.w, w.h) != (0, 0, cam.width, cam.height));
+    let window = window.filter(|&w| w != [0, 0, cam.width, cam.height]);
     let grid = match window {
         None => Grid::whole(cam),
         Some(win) => Grid::over(cam, win),
@@ -216,9 +216,9 @@ pub fn max_path_px_in(
         // motion of a rotation at normalised image point (x, y), component
         // by component at the window's largest |x| and |y| (so about the
         // optical axis the bound grows with the radius, not the focal length).
-        Some(win) => {
-            let (x0, y0) = (f64::from(win.x0), f64::from(win.y0));
-            let (x1, y1) = (x0 + f64::from(win.w), y0 + f64::from(win.h));
+        Some([x0, y0, w, h]) => {
+            let (x0, y0) = (f64::from(x0), f64::from(y0));
+            let (x1, y1) = (x0 + f64::from(w), y0 + f64::from(h));
             let (mut xm, mut ym) = (0.0f64, 0.0f64);
             for (x, y) in [(x0, y0), (x1, y0), (x0, y1), (x1, y1)] {
                 let (u, v) = cam.pixel_to_mm(x, y);
@@ -266,14 +266,15 @@ impl Grid {
         }
     }
 
-    /// The grid over `win`: as dense as the whole sensor's 33 x 25 grid or denser, at least 2 x 2.
-    fn over(cam: &Camera, win: Window) -> Grid {
-        let (w, h) = (f64::from(win.w), f64::from(win.h));
+    /// The grid over window `[x0, y0, w, h]`: as dense as the whole
+    /// sensor's 33 x 25 grid or denser, at least 2 x 2.
+    fn over(cam: &Camera, [x0, y0, w, h]: [u32; 4]) -> Grid {
+        let (w, h) = (f64::from(w), f64::from(h));
         let n =
             |len: f64, sensor: f64, cells: f64| (len / (sensor / cells)).ceil().max(1.0) as u32 + 1;
         Grid {
-            x0: f64::from(win.x0),
-            y0: f64::from(win.y0),
+            x0: f64::from(x0),
+            y0: f64::from(y0),
             w,
             h,
             nx: n(w, cam.width as f64, 32.0),

@@ -33,6 +33,7 @@ mod motion;
 mod pixel_map;
 pub mod poster;
 pub(crate) mod psf;
+mod rect;
 mod sampling;
 pub mod sharp;
 #[doc(hidden)]
@@ -47,9 +48,10 @@ pub use maps::{blur_maps, BlurMaps, BlurMeans};
 pub use motion::FrameMotion;
 pub use poster::Background;
 pub use psf::{psf, Psf};
+pub use rect::Window;
 pub use sharp::{render_sharp_at, SharpAt};
 pub use target::{project, Target, TargetKind, DEFAULT_BACKGROUND};
-pub use window::{render_window, Window};
+pub use window::render_window;
 
 use crate::camera::Camera;
 use crate::error::{Error, Result};
@@ -395,7 +397,8 @@ fn prepare(job: &RenderJob) -> Result<Pass> {
     if let Some(w) = job.spacing_window {
         w.check("spacing_window", cam.width, cam.height)?;
     }
-    let lmax = maps::max_path_px_in(cam, &job.target, &job.trajectory, job.spacing_window);
+    let window = job.spacing_window.map(|w| [w.x0, w.y0, w.w, w.h]);
+    let lmax = maps::max_path_px_in(cam, &job.target, &job.trajectory, window);
     let defocus = cam.lens.is_some();
     let analytic = match job.integrator {
         Integrator::Analytic if defocus => {
