@@ -372,7 +372,7 @@ impl ExperimentConfig {
     /// Rendered at the `fast` preset (0.5 px between instants, not 0.25):
     /// less time for the map (docs/performance.md), at a render difference the
     /// report measures (its render-quality note, without sensor noise: 0.02/255
-    /// on average and 0.21/255 at the 99th percentile on the demo's most
+    /// on average and 0.16/255 at the 99th percentile on the demo's most
     /// blurred frame), far below the sensor noise of any of the map's lights.
     pub fn demo_full() -> Self {
         ExperimentConfig {
