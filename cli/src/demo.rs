@@ -21,7 +21,7 @@ over 2-s blocks of the walks; then the experiment's own frames (its seed, judged
 (35 s), moderate (16 s) and fast (5 s) walks, both boards, six lights from 500 to 100,000 e-/s, seeds 1-5, at the
 fast render preset (the report measures it against default); the experiment's own frames stay the demo's.
 
-Time on the 2-core VM (docs/performance.md): about 2 min (measured 2026-12-04); --full about 31 min (2026-12-04).
+Time on the 2-core VM (docs/performance.md): about 2 min (measured 2026-12-04); --full about 28 min (2026-12-04).
 
 Examples:
   mmbm demo

@@ -40,8 +40,8 @@ pub trait Progress: Send + Sync {
     fn start(&self, what: &str, total: u64) -> Box<dyn ProgressTask>;
 }
 
-/// One running job of a [`Progress`].
-pub trait ProgressTask {
+/// One running job of a [`Progress`] (shared by the threads that do its steps).
+pub trait ProgressTask: Send + Sync {
     /// Says what the job does now (e.g. the walk and policy of a frame).
     fn message(&self, msg: &str);
     /// Counts `n` more steps done.

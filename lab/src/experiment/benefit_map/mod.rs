@@ -319,39 +319,66 @@ pub fn benefit_map_with(
                         vo: vec![0.0; nl * np],
                     });
                 }
-                for (pi, (_, frames)) in w.runs.iter().enumerate() {
-                    // The policy's kept frames are judged in parallel (each
-                    // frame's seed is its place in the serial order, so the
-                    // result does not depend on the thread count), then
-                    // tallied in order.
-                    let kept: Vec<&Frame> = frames.iter().filter(|f| f.kept).collect();
-                    if let Some(f) = kept.first() {
-                        bar.message(&format!("{g} {board} {}", f.policy));
-                    }
-                    let judged: Vec<(Vec<Judged>, FrameFeatures)> = kept
-                        .par_iter()
-                        .enumerate()
-                        .map(|(j, f)| {
-                            judge_at_lights(
-                                board,
-                                surround,
-                                w,
-                                f,
-                                cam,
-                                quality,
-                                (renders + j) as u32,
-                                &lights,
-                                renders_how,
-                            )
-                        })
-                        .collect::<Result<_>>()?;
-                    renders += kept.len();
-                    bar.advance(kept.len() as u64);
-                    for (n, (f, (js, feats))) in kept.iter().zip(&judged).enumerate() {
-                        let b = wb.index(f.trigger_t);
+                // Each policy's kept frames are judged in parallel, and so are
+                // the policies (no core waits at the end of a policy); each
+                // frame's seed is its place in the serial order (policies in
+                // order, frames in order), so the result does not depend on
+                // the thread count. A policy keeps only what the tally needs
+                // (the verdicts and the inliers to its previous kept frame),
+                // then the frames are tallied in order.
+                let kept: Vec<Vec<&Frame>> = w
+                    .runs
+                    .iter()
+                    .map(|(_, frames)| frames.iter().filter(|f| f.kept).collect())
+                    .collect();
+                let seed0s: Vec<usize> = kept
+                    .iter()
+                    .scan(renders, |n, k| {
+                        let seed0 = *n;
+                        *n += k.len();
+                        Some(seed0)
+                    })
+                    .collect();
+                renders += kept.iter().map(Vec::len).sum::<usize>();
+                let judged: Vec<Vec<Tallied>> = kept
+                    .par_iter()
+                    .zip(&seed0s)
+                    .map(|(kept, &seed0)| -> Result<Vec<Tallied>> {
+                        if let Some(f) = kept.first() {
+                            bar.message(&format!("{g} {board} {}", f.policy));
+                        }
+                        let judged: Vec<(Vec<Judged>, FrameFeatures)> = kept
+                            .par_iter()
+                            .enumerate()
+                            .map(|(j, f)| {
+                                judge_at_lights(
+                                    board,
+                                    surround,
+                                    w,
+                                    f,
+                                    cam,
+                                    quality,
+                                    (seed0 + j) as u32,
+                                    &lights,
+                                    renders_how,
+                                )
+                            })
+                            .collect::<Result<_>>()?;
+                        bar.advance(kept.len() as u64);
                         // Inlier matches to the previous kept frame, per
                         // light (None for the walk's first kept frame).
-                        let inl = (n > 0).then(|| tracked(&judged[n - 1].1, feats));
+                        let mut out = Vec::with_capacity(judged.len());
+                        let mut prev: Option<FrameFeatures> = None;
+                        for (js, feats) in judged {
+                            out.push((js, prev.as_ref().map(|p| tracked(p, &feats))));
+                            prev = Some(feats);
+                        }
+                        Ok(out)
+                    })
+                    .collect::<Result<_>>()?;
+                for (pi, (kept, judged)) in kept.iter().zip(&judged).enumerate() {
+                    for (f, (js, inl)) in kept.iter().zip(judged) {
+                        let b = wb.index(f.trigger_t);
                         for (li, j) in js.iter().enumerate() {
                             let k = li * np + pi;
                             blocks[first + b].sharp[k] += f64::from(u8::from(j.ok));
@@ -415,6 +442,11 @@ pub fn benefit_map_with(
         seconds: t_start.elapsed().as_secs_f64(),
     }))
 }
+
+/// A judged frame as the tally needs it: its verdict at each light and its
+/// inlier matches to its policy's previous kept frame at each light (None
+/// for the first).
+type Tallied = (Vec<Judged>, Option<Vec<usize>>);
 
 /// Inlier matches of `cur` to `prev` at each light, against the true
 /// homography between the two frames (0 when the board does not give one).
