@@ -4,6 +4,7 @@ KeyboardInterrupt within a second, never a PanicException, returns nothing,
 and leaves the module usable."""
 
 import os
+import select
 import signal
 import subprocess
 import sys
@@ -14,11 +15,17 @@ import pytest
 # Each call takes far longer than the test waits (measured on 2 loaded cores:
 # series and metric of the 4e6 samples about 20 s, frames about 70 s,
 # simulate about 8 s, the renders hours): if it is not stopped, the child
-# prints "finished" (or the test times out) and the test fails.
+# prints "finished" (or nothing for ANSWER_S) and the test fails.
 CHILD = r"""
-import sys, time
+import signal, sys, time
 import numpy as np
 import mmbm
+
+# Python's own Ctrl-C handler, whatever the child inherited: a process
+# started in the background by a shell without job control (`cmd &` in a
+# script, as `nohup ... &` runs CI) starts with SIGINT ignored, and Python
+# then installs no handler, so the signal would never arrive.
+signal.signal(signal.SIGINT, signal.default_int_handler)
 
 which = sys.argv[1]
 n = 4_000_000
@@ -49,6 +56,7 @@ except KeyboardInterrupt:
 
 WAIT_S = 0.8  # into the call before Ctrl-C
 LIMIT_S = 3.0  # from Ctrl-C to KeyboardInterrupt
+ANSWER_S = 60.0  # the longest the test waits for any answer to Ctrl-C
 
 
 @pytest.mark.parametrize("which", ["render", "render_maps", "series", "frames", "simulate", "metric"])
@@ -66,6 +74,9 @@ def test_ctrl_c_interrupts_a_long_call(which):
         assert p.poll() is None, "the call ended before the interrupt: make it longer"
         sent = time.monotonic()
         p.send_signal(signal.SIGINT)
+        # Bounded: a child that does not stop must fail the test, not hang it.
+        answered, _, _ = select.select([p.stdout], [], [], ANSWER_S)
+        assert answered, f"{which}: no answer {ANSWER_S} s after SIGINT"
         line = p.stdout.readline().strip()
         took = time.monotonic() - sent
         rest, err = p.communicate(timeout=60)
