@@ -39,3 +39,32 @@ fn shared_renders_give_the_unshared_numbers() {
     let c = &shared.cells;
     assert!(sharp(&c[0]) != sharp(&c[2]) || reps(&c[0]) != reps(&c[2]));
 }
+
+/// The map judges a walk's policies and each policy's frames in parallel;
+/// each frame's seed is its place in the serial order, so one thread and
+/// three give every number the same.
+#[test]
+fn the_thread_count_changes_no_number() {
+    let cfg = tiny_map::config(
+        &[1_000.0, 20_000.0],
+        &["deadline:5", "deadline:5+exp:3:0.02", "ae:5:cap=10ms"],
+        &[3.0, 40.0],
+    );
+    let q: Quality = cfg.quality.parse().unwrap();
+    let with = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| benefit_map_with(&cfg, q, false, Renders::Shared))
+            .unwrap()
+            .unwrap()
+    };
+    let (one, three) = (with(1), with(3));
+    assert_eq!(one.renders, three.renders);
+    assert!(one.renders > 0);
+    // Every number of every cell (Debug: NaN equals NaN there).
+    for (a, b) in one.cells.iter().zip(&three.cells) {
+        assert_eq!(format!("{a:?}"), format!("{b:?}"));
+    }
+}
