@@ -1,7 +1,8 @@
 //! The benefit map's shared renders (each frame's judged window rendered
 //! once for all lights, `Renders::Shared`) give the very numbers of the
 //! unshared reference (the whole frame and its sharp reference rendered
-//! again for each light, the window cut from them: `Renders::PerLight`).
+//! again for each light, the window cut from them: `Renders::PerLight`),
+//! and its parallel judging gives the same numbers on any thread count.
 
 use mmbm::render::Quality;
 use mmbm_lab::experiment::{benefit_map_with, Renders};

@@ -54,33 +54,24 @@ fn inputs(d: &Path) {
     std::fs::create_dir_all(d.join("sub")).unwrap();
 }
 
-/// Every file under `d` (relative paths, sorted) with its bytes.
+/// Every file under `d` (relative paths, sorted, as [`names`] lists them)
+/// with its bytes ("link" for a symlink, nothing for a folder).
 fn snapshot(d: &Path) -> Vec<(PathBuf, Vec<u8>)> {
-    let mut v = Vec::new();
-    let mut stack = vec![d.to_path_buf()];
-    while let Some(p) = stack.pop() {
-        for e in std::fs::read_dir(&p).unwrap() {
-            let e = e.unwrap();
-            let path = e.path();
-            let t = e.file_type().unwrap();
-            if t.is_dir() {
-                stack.push(path.clone());
-                v.push((path.strip_prefix(d).unwrap().to_path_buf(), Vec::new()));
+    names(d)
+        .into_iter()
+        .map(|p| {
+            let path = d.join(&p);
+            let t = std::fs::symlink_metadata(&path).unwrap().file_type();
+            let bytes = if t.is_dir() {
+                Vec::new()
             } else if t.is_symlink() {
-                v.push((
-                    path.strip_prefix(d).unwrap().to_path_buf(),
-                    b"link".to_vec(),
-                ));
+                b"link".to_vec()
             } else {
-                v.push((
-                    path.strip_prefix(d).unwrap().to_path_buf(),
-                    std::fs::read(&path).unwrap(),
-                ));
-            }
-        }
-    }
-    v.sort();
-    v
+                std::fs::read(&path).unwrap()
+            };
+            (p, bytes)
+        })
+        .collect()
 }
 
 /// Every path under `d` (relative, sorted), read while the command may still

@@ -331,15 +331,14 @@ pub fn benefit_map_with(
                     .iter()
                     .map(|(_, frames)| frames.iter().filter(|f| f.kept).collect())
                     .collect();
+                // Each policy's first seed: the frames counted before it.
                 let seed0s: Vec<usize> = kept
                     .iter()
-                    .scan(renders, |n, k| {
-                        let seed0 = *n;
-                        *n += k.len();
-                        Some(seed0)
+                    .map(|k| {
+                        renders += k.len();
+                        renders - k.len()
                     })
                     .collect();
-                renders += kept.iter().map(Vec::len).sum::<usize>();
                 let judged: Vec<Vec<Tallied>> = kept
                     .par_iter()
                     .zip(&seed0s)
@@ -366,7 +365,7 @@ pub fn benefit_map_with(
                             .collect::<Result<_>>()?;
                         bar.advance(kept.len() as u64);
                         // Inlier matches to the previous kept frame, per
-                        // light (None for the walk's first kept frame).
+                        // light (None for the policy's first in the walk).
                         let mut out = Vec::with_capacity(judged.len());
                         let mut prev: Option<FrameFeatures> = None;
                         for (js, feats) in judged {
